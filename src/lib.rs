@@ -1,0 +1,2 @@
+//! prespline: pre-evaluated interactive editing of spline curves and surfaces.
+pub mod geom;
