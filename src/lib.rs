@@ -1,2 +1,5 @@
 //! prespline: pre-evaluated interactive editing of spline curves and surfaces.
+// Numerical kernels index several arrays with the same loop counter (basis rows, control points,
+// derivative orders); iterator zips would obscure the textbook algorithms they follow.
+#![allow(clippy::needless_range_loop)]
 pub mod geom;

@@ -1,0 +1,541 @@
+//! Tensor-product Bézier and B-spline surfaces, rational too: partial derivatives, unit normals
+//! with a fallback where Su × Sv vanishes, Gaussian and mean curvature.
+
+use super::basis::hermite_into;
+use super::bezier::{check_points, check_weights};
+use super::bspline::de_boor;
+use super::error::{GeomError, GeomResult};
+use super::knots::KnotVector;
+use super::point::{binomial, to_homogeneous};
+use glam::{DVec3, DVec4};
+
+/// S(u,v) = Σ_i Σ_j P_ij N_i(u) N_j(v). Control points are row-major, `points[i * nv + j]`, with
+/// i along u. A Bézier surface is the special case of Bézier knot vectors on [0,1]².
+#[derive(Debug, Clone, PartialEq)]
+pub struct TensorSurface {
+    degree: [usize; 2],
+    knots: [KnotVector; 2],
+    count: [usize; 2],
+    points: Vec<DVec3>,
+    weights: Option<Vec<f64>>,
+}
+
+/// All partial derivatives ∂^{a+b}S/∂u^a∂v^b for a, b ≤ n.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Partials {
+    n: usize,
+    values: Vec<DVec3>,
+}
+
+impl Partials {
+    pub fn zeros(n: usize) -> Self {
+        Self {
+            n,
+            values: vec![DVec3::ZERO; (n + 1) * (n + 1)],
+        }
+    }
+
+    /// Highest order per direction.
+    pub fn order(&self) -> usize {
+        self.n
+    }
+
+    #[inline]
+    pub fn get(&self, a: usize, b: usize) -> DVec3 {
+        self.values[a * (self.n + 1) + b]
+    }
+
+    #[inline]
+    pub fn set(&mut self, a: usize, b: usize, v: DVec3) {
+        self.values[a * (self.n + 1) + b] = v;
+    }
+}
+
+impl TensorSurface {
+    /// A B-spline (or NURBS, with weights) surface; `points` row-major with `count = [nu, nv]`.
+    pub fn bspline(
+        degree: [usize; 2],
+        knots: [Vec<f64>; 2],
+        count: [usize; 2],
+        points: Vec<DVec3>,
+        weights: Option<Vec<f64>>,
+    ) -> GeomResult<Self> {
+        check_grid(count, &points)?;
+        let [ku, kv] = knots;
+        let ku = KnotVector::for_bspline(ku, degree[0], count[0]).map_err(|e| direction(e, "u"))?;
+        let kv = KnotVector::for_bspline(kv, degree[1], count[1]).map_err(|e| direction(e, "v"))?;
+        if let Some(w) = &weights {
+            check_weights(w, points.len())?;
+        }
+        Ok(Self {
+            degree,
+            knots: [ku, kv],
+            count,
+            points,
+            weights,
+        })
+    }
+
+    /// A Bézier (or rational Bézier) patch of degree (nu−1, nv−1) on [0,1]².
+    pub fn bezier(
+        count: [usize; 2],
+        points: Vec<DVec3>,
+        weights: Option<Vec<f64>>,
+    ) -> GeomResult<Self> {
+        check_grid(count, &points)?;
+        if let Some(w) = &weights {
+            check_weights(w, points.len())?;
+        }
+        let degree = [count[0] - 1, count[1] - 1];
+        let knots = [
+            KnotVector::bezier(degree[0], 0.0, 1.0),
+            KnotVector::bezier(degree[1], 0.0, 1.0),
+        ];
+        Ok(Self {
+            degree,
+            knots,
+            count,
+            points,
+            weights,
+        })
+    }
+
+    /// The same Bézier patch with its parameters mapped linearly onto [a, b] × [c, d] (how ERBS
+    /// local patches are placed). Only meaningful for Bézier patches.
+    pub fn with_bezier_domain(mut self, domain: [(f64, f64); 2]) -> GeomResult<Self> {
+        for (dir, (a, b)) in domain.iter().enumerate() {
+            if !(a.is_finite() && b.is_finite() && a < b) {
+                return Err(GeomError::new(
+                    "interval",
+                    format!("[{a}, {b}] is not a finite interval with a < b"),
+                ));
+            }
+            self.knots[dir] = KnotVector::bezier(self.degree[dir], *a, *b);
+        }
+        Ok(self)
+    }
+
+    pub fn degree(&self) -> [usize; 2] {
+        self.degree
+    }
+
+    pub fn knots(&self) -> &[KnotVector; 2] {
+        &self.knots
+    }
+
+    /// [nu, nv].
+    pub fn count(&self) -> [usize; 2] {
+        self.count
+    }
+
+    pub fn points(&self) -> &[DVec3] {
+        &self.points
+    }
+
+    pub fn weights(&self) -> Option<&[f64]> {
+        self.weights.as_deref()
+    }
+
+    pub fn is_rational(&self) -> bool {
+        self.weights.is_some()
+    }
+
+    pub fn point(&self, i: usize, j: usize) -> DVec3 {
+        self.points[i * self.count[1] + j]
+    }
+
+    pub fn translate_point(&mut self, i: usize, j: usize, delta: DVec3) {
+        self.points[i * self.count[1] + j] += delta;
+    }
+
+    /// Replaces every control point by `f(point)` (weights unchanged), e.g. an affine map.
+    pub fn map_points(&mut self, f: impl Fn(DVec3) -> DVec3) {
+        for p in &mut self.points {
+            *p = f(*p);
+        }
+    }
+
+    /// Sets weight (i, j), making the surface rational (other weights 1) if it was not.
+    pub fn set_weight(&mut self, i: usize, j: usize, w: f64) {
+        let n = self.points.len();
+        let nv = self.count[1];
+        self.weights.get_or_insert_with(|| vec![1.0; n])[i * nv + j] = w;
+    }
+
+    /// Homogeneous control points (w P, w), row-major.
+    pub fn homogeneous_points(&self) -> Vec<DVec4> {
+        match &self.weights {
+            Some(w) => self
+                .points
+                .iter()
+                .zip(w)
+                .map(|(&p, &w)| to_homogeneous(p, w))
+                .collect(),
+            None => self.points.iter().map(|p| p.extend(1.0)).collect(),
+        }
+    }
+
+    /// Parameter domains [(u0, u1), (v0, v1)].
+    pub fn domain(&self) -> [(f64, f64); 2] {
+        [
+            self.knots[0].domain(self.degree[0], self.count[0]),
+            self.knots[1].domain(self.degree[1], self.count[1]),
+        ]
+    }
+
+    /// FindSpan in each direction.
+    pub fn find_spans(&self, u: f64, v: f64) -> [usize; 2] {
+        [
+            self.knots[0].find_span(self.degree[0], self.count[0], u),
+            self.knots[1].find_span(self.degree[1], self.count[1], v),
+        ]
+    }
+
+    /// ∂^{a+b}S/∂u^a∂v^b for a, b ≤ n, as P = M_u · C · M_vᵀ with the two Hermite matrices
+    /// (RatSurfaceDerivs, NURBS Book A4.4, for rational surfaces).
+    pub fn derivatives(&self, u: f64, v: f64, n: usize) -> Partials {
+        let [du, dv] = self.degree;
+        let [su, sv] = self.find_spans(u, v);
+        let [(u0, u1), (v0, v1)] = self.domain();
+        let mut mu = vec![0.0; (du + 1) * (du + 1)];
+        let mut mv = vec![0.0; (dv + 1) * (dv + 1)];
+        hermite_into(&self.knots[0], du, su, u.clamp(u0, u1), &mut mu);
+        hermite_into(&self.knots[1], dv, sv, v.clamp(v0, v1), &mut mv);
+        let nv = self.count[1];
+        let mut out = Partials::zeros(n);
+        match &self.weights {
+            None => {
+                for a in 0..=n.min(du) {
+                    for b in 0..=n.min(dv) {
+                        let mut acc = DVec3::ZERO;
+                        for k in 0..=du {
+                            let row = (su - du + k) * nv + sv - dv;
+                            let mut inner = DVec3::ZERO;
+                            for l in 0..=dv {
+                                inner += self.points[row + l] * mv[b * (dv + 1) + l];
+                            }
+                            acc += inner * mu[a * (du + 1) + k];
+                        }
+                        out.set(a, b, acc);
+                    }
+                }
+            }
+            Some(w) => {
+                let mut hom = vec![DVec4::ZERO; (n + 1) * (n + 1)];
+                for a in 0..=n.min(du) {
+                    for b in 0..=n.min(dv) {
+                        let mut acc = DVec4::ZERO;
+                        for k in 0..=du {
+                            let row = (su - du + k) * nv + sv - dv;
+                            let mut inner = DVec4::ZERO;
+                            for l in 0..=dv {
+                                let idx = row + l;
+                                inner +=
+                                    to_homogeneous(self.points[idx], w[idx]) * mv[b * (dv + 1) + l];
+                            }
+                            acc += inner * mu[a * (du + 1) + k];
+                        }
+                        hom[a * (n + 1) + b] = acc;
+                    }
+                }
+                rational_surface_derivs(&hom, n, &mut out);
+            }
+        }
+        out
+    }
+
+    /// S(u, v) by de Boor's algorithm as a curve of curves (independent of the Hermite path).
+    pub fn eval(&self, u: f64, v: f64) -> DVec3 {
+        let [du, dv] = self.degree;
+        let [nu, nv] = self.count;
+        let h = self.homogeneous_points();
+        let column: Vec<DVec4> = (0..nu)
+            .map(|i| de_boor(&self.knots[1], dv, &h[i * nv..(i + 1) * nv], v))
+            .collect();
+        let p = de_boor(&self.knots[0], du, &column, u);
+        p.truncate() / p.w
+    }
+
+    /// Unit normal at (u, v), defined everywhere; see [`normal_with_fallback`].
+    pub fn normal(&self, u: f64, v: f64) -> DVec3 {
+        let p = self.derivatives(u, v, 1);
+        normal_with_fallback(
+            p.get(1, 0),
+            p.get(0, 1),
+            p.get(1, 1),
+            self.domain(),
+            u,
+            v,
+            |u, v| {
+                let q = self.derivatives(u, v, 1);
+                (q.get(1, 0), q.get(0, 1))
+            },
+        )
+    }
+
+    /// Gaussian and mean curvature (K, H) at (u, v) from the fundamental forms, with the normal
+    /// orientation Su × Sv; `None` where the parameterisation is singular.
+    pub fn curvatures(&self, u: f64, v: f64) -> Option<(f64, f64)> {
+        let p = self.derivatives(u, v, 2);
+        curvatures_from_partials(&p)
+    }
+}
+
+/// Gaussian and mean curvature from partials up to order (2, 2) (only Su, Sv, Suu, Suv, Svv
+/// are used).
+pub fn curvatures_from_partials(p: &Partials) -> Option<(f64, f64)> {
+    let (su, sv) = (p.get(1, 0), p.get(0, 1));
+    let n = regular_normal(su, sv)?;
+    let (e, f, g) = (su.dot(su), su.dot(sv), sv.dot(sv));
+    let (l, m, nn) = (p.get(2, 0).dot(n), p.get(1, 1).dot(n), p.get(0, 2).dot(n));
+    let det = e * g - f * f;
+    Some((
+        (l * nn - m * m) / det,
+        (e * nn - 2.0 * f * m + g * l) / (2.0 * det),
+    ))
+}
+
+/// normalize(Su × Sv), or `None` where the cross product is negligible against |Su|·|Sv| scale
+/// (a collapsed edge, a cusp, or a vanishing derivative).
+pub fn regular_normal(su: DVec3, sv: DVec3) -> Option<DVec3> {
+    let c = su.cross(sv);
+    let scale = su.length_squared().max(sv.length_squared());
+    let len2 = c.length_squared();
+    if scale > 0.0 && len2 > 1e-20 * scale * scale && len2.is_finite() {
+        Some(c / len2.sqrt())
+    } else {
+        None
+    }
+}
+
+/// The normal where Su × Sv vanishes, as a one-sided limit from the inside of the domain.
+///
+/// 1. If Sv ≈ 0 along an edge u = const (e.g. the teapot's lid top, where a whole patch edge
+///    collapses to a point), Sv(u+h, v) ≈ h·Suv, so the normal is ±normalize(Su × Suv) with the
+///    sign of the step h towards the interior; symmetrically ±normalize(Suv × Sv) when Su ≈ 0.
+/// 2. Otherwise (a corner where both vanish, or parallel partials) the regular normal at points
+///    nudged towards the domain centre by 1e-7, 1e-5, 1e-3 of the domain size.
+/// 3. As the last resort +Z, so that every sample has a defined unit normal.
+pub fn normal_with_fallback(
+    su: DVec3,
+    sv: DVec3,
+    suv: DVec3,
+    domain: [(f64, f64); 2],
+    u: f64,
+    v: f64,
+    first_partials: impl Fn(f64, f64) -> (DVec3, DVec3),
+) -> DVec3 {
+    if let Some(n) = regular_normal(su, sv) {
+        return n;
+    }
+    let [(u0, u1), (v0, v1)] = domain;
+    let (uc, vc) = (0.5 * (u0 + u1), 0.5 * (v0 + v1));
+    let inward_u = if u <= uc { 1.0 } else { -1.0 };
+    let inward_v = if v <= vc { 1.0 } else { -1.0 };
+    let (lu, lv) = (su.length(), sv.length());
+    let limit = if lv <= 1e-10 * lu {
+        regular_normal(su, suv * inward_u)
+    } else if lu <= 1e-10 * lv {
+        regular_normal(suv * inward_v, sv)
+    } else {
+        None
+    };
+    if let Some(n) = limit {
+        return n;
+    }
+    for eps in [1e-7, 1e-5, 1e-3] {
+        let (un, vn) = (u + eps * (uc - u), v + eps * (vc - v));
+        let (a, b) = first_partials(un, vn);
+        if let Some(n) = regular_normal(a, b) {
+            return n;
+        }
+    }
+    DVec3::Z
+}
+
+/// RatSurfaceDerivs (NURBS Book A4.4) on the full square a, b ≤ n: projects homogeneous partials
+/// `hom[a*(n+1)+b]` of (w·S, w) to Euclidean partials of S by the quotient rule.
+pub fn rational_surface_derivs(hom: &[DVec4], n: usize, out: &mut Partials) {
+    let w = n + 1;
+    let wd = |a: usize, b: usize| hom[a * w + b].w;
+    for k in 0..=n {
+        for l in 0..=n {
+            let mut v = hom[k * w + l].truncate();
+            for j in 1..=l {
+                v -= out.get(k, l - j) * (binomial(l, j) * wd(0, j));
+            }
+            for i in 1..=k {
+                v -= out.get(k - i, l) * (binomial(k, i) * wd(i, 0));
+                let mut v2 = DVec3::ZERO;
+                for j in 1..=l {
+                    v2 += out.get(k - i, l - j) * (binomial(l, j) * wd(i, j));
+                }
+                v -= v2 * binomial(k, i);
+            }
+            out.set(k, l, v / wd(0, 0));
+        }
+    }
+}
+
+fn check_grid(count: [usize; 2], points: &[DVec3]) -> GeomResult<()> {
+    if count[0] == 0 || count[1] == 0 {
+        return Err(GeomError::new(
+            "points",
+            format!("empty control net ({} × {})", count[0], count[1]),
+        ));
+    }
+    if points.len() != count[0] * count[1] {
+        return Err(GeomError::new(
+            "points",
+            format!(
+                "{} points do not form a {} × {} net",
+                points.len(),
+                count[0],
+                count[1]
+            ),
+        ));
+    }
+    check_points(points)
+}
+
+fn direction(mut e: GeomError, dir: &str) -> GeomError {
+    e.message = format!("{dir} direction: {}", e.message);
+    e
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A bicubic patch over a saddle-ish net with irregular knots in u.
+    fn patch(rational: bool) -> TensorSurface {
+        let (nu, nv) = (6, 4);
+        let mut pts = Vec::new();
+        for i in 0..nu {
+            for j in 0..nv {
+                let (x, y) = (i as f64, j as f64);
+                pts.push(DVec3::new(
+                    x,
+                    y,
+                    0.3 * x * y - 0.2 * x * x + (x + 2.0 * y).sin(),
+                ));
+            }
+        }
+        let w = rational.then(|| (0..nu * nv).map(|k| 0.6 + 0.15 * (k % 5) as f64).collect());
+        TensorSurface::bspline(
+            [3, 2],
+            [
+                vec![0., 0., 0., 0., 0.7, 1.9, 3., 3., 3., 3.],
+                vec![0., 0., 0., 0.5, 1., 1., 1.],
+            ],
+            [nu, nv],
+            pts,
+            w,
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn hermite_partials_match_de_boor_and_finite_differences() {
+        for rational in [false, true] {
+            let s = patch(rational);
+            for &(u, v) in &[
+                (0.0, 0.0),
+                (0.35, 0.2),
+                (1.2, 0.77),
+                (2.9, 1.0),
+                (3.0, 0.45),
+            ] {
+                let p = s.derivatives(u, v, 2);
+                assert!((p.get(0, 0) - s.eval(u, v)).length() < 1e-13);
+                let h = 1e-5;
+                let (uc, vc) = (u.clamp(h, 3.0 - h), v.clamp(h, 1.0 - h));
+                let q = s.derivatives(uc, vc, 2);
+                let fu = (s.eval(uc + h, vc) - s.eval(uc - h, vc)) / (2.0 * h);
+                let fv = (s.eval(uc, vc + h) - s.eval(uc, vc - h)) / (2.0 * h);
+                assert!((fu - q.get(1, 0)).length() < 1e-6 * (1.0 + fu.length()));
+                assert!((fv - q.get(0, 1)).length() < 1e-6 * (1.0 + fv.length()));
+                let fuv = (s.derivatives(uc, vc + h, 1).get(1, 0)
+                    - s.derivatives(uc, vc - h, 1).get(1, 0))
+                    / (2.0 * h);
+                assert!((fuv - q.get(1, 1)).length() < 1e-6 * (1.0 + fuv.length()));
+            }
+        }
+    }
+
+    #[test]
+    fn collapsed_edge_gets_the_limit_normal() {
+        // A cap of revolution: the whole u = 0 edge is the pole (0, 0, 1).
+        let pole = DVec3::new(0.0, 0.0, 1.0);
+        let mut pts = Vec::new();
+        for i in 0..4 {
+            for j in 0..4 {
+                if i == 0 {
+                    pts.push(pole);
+                } else {
+                    // Row 1 lies in the tangent plane z = 1, so the pole is a smooth point.
+                    let a = std::f64::consts::FRAC_PI_2 * j as f64 / 3.0;
+                    let r = i as f64 / 3.0;
+                    let z = if i == 1 { 1.0 } else { 1.0 - 0.3 * r * r };
+                    pts.push(DVec3::new(r * a.cos(), r * a.sin(), z));
+                }
+            }
+        }
+        let s = TensorSurface::bezier([4, 4], pts, None).unwrap();
+        for j in 0..=4 {
+            let v = j as f64 / 4.0;
+            let n = s.normal(0.0, v);
+            assert!((n.length() - 1.0).abs() < 1e-14);
+            // The limit normal at the pole of a surface of revolution about z is ±z; orientation
+            // must agree with the regular normals next to it.
+            let inner = s.normal(1e-4, v);
+            assert!(n.dot(inner) > 0.99, "v={v}: {n:?} vs {inner:?}");
+            assert!(n.z.abs() > 0.999_999, "{n:?}");
+        }
+    }
+
+    #[test]
+    fn sphere_curvatures() {
+        // Rational biquadratic patch: an octant of the unit sphere.
+        let r2 = std::f64::consts::FRAC_1_SQRT_2;
+        let pts = vec![
+            DVec3::new(0., 0., 1.),
+            DVec3::new(0., 0., 1.),
+            DVec3::new(0., 0., 1.),
+            DVec3::new(1., 0., 1.),
+            DVec3::new(1., 1., 1.),
+            DVec3::new(0., 1., 1.),
+            DVec3::new(1., 0., 0.),
+            DVec3::new(1., 1., 0.),
+            DVec3::new(0., 1., 0.),
+        ];
+        let w = vec![1., r2, 1., r2, 0.5, r2, 1., r2, 1.];
+        let s = TensorSurface::bezier([3, 3], pts, Some(w)).unwrap();
+        for &(u, v) in &[(0.3, 0.3), (0.5, 0.9), (0.8, 0.1)] {
+            assert!((s.eval(u, v).length() - 1.0).abs() < 1e-14);
+            let (k, h) = s.curvatures(u, v).unwrap();
+            assert!((k - 1.0).abs() < 1e-10, "K = {k}");
+            assert!((h.abs() - 1.0).abs() < 1e-10, "H = {h}");
+        }
+        // The pole (u = 0) is a collapsed edge: the normal is still ±z.
+        assert!(s.normal(0.0, 0.4).z.abs() > 0.999_999);
+    }
+
+    #[test]
+    fn grid_validation() {
+        let e = TensorSurface::bezier([2, 2], vec![DVec3::ZERO; 3], None).unwrap_err();
+        assert!(
+            e.message.contains("3 points do not form a 2 × 2 net"),
+            "{e}"
+        );
+        let e = TensorSurface::bspline(
+            [1, 1],
+            [vec![0., 0., 1.], vec![0., 0., 1., 1.]],
+            [2, 2],
+            vec![DVec3::ZERO; 4],
+            None,
+        )
+        .unwrap_err();
+        assert!(e.message.starts_with("u direction"), "{e}");
+    }
+}
