@@ -3,3 +3,4 @@
 // derivative orders); iterator zips would obscure the textbook algorithms they follow.
 #![allow(clippy::needless_range_loop)]
 pub mod geom;
+pub mod scene;
