@@ -4,3 +4,5 @@
 #![allow(clippy::needless_range_loop)]
 pub mod geom;
 pub mod scene;
+pub mod sampling;
+pub mod cli;

@@ -1,0 +1,140 @@
+//! `prespline sample`: samples every object of a scene (optionally after edits) and prints the
+//! DESIGN.md JSON contract on stdout.
+
+use super::CliError;
+use crate::sampling::{SampleMode, SampledObject};
+use crate::scene::edit::{apply_all, parse_edits};
+use crate::scene::{Scene, Shape};
+use std::fmt::Write;
+use std::path::Path;
+
+/// Highest derivative order `--derivatives` accepts.
+pub const MAX_DERIVATIVES: usize = 20;
+
+/// Options of one `sample` run.
+#[derive(Debug, Clone)]
+pub struct SampleArgs<'a> {
+    pub scene: &'a Path,
+    pub derivatives: usize,
+    pub edits: Option<&'a Path>,
+    /// Apply edits to the model and re-sample from scratch instead of the delta path.
+    pub full: bool,
+}
+
+/// Runs the command and returns the complete output text (nothing is printed on error, so a
+/// failure never leaves partial output).
+pub fn run(args: &SampleArgs) -> Result<String, CliError> {
+    if args.derivatives > MAX_DERIVATIVES {
+        return Err(CliError(format!(
+            "--derivatives {} exceeds the supported maximum {MAX_DERIVATIVES}",
+            args.derivatives
+        )));
+    }
+    let mut scene = Scene::load(args.scene).map_err(|e| CliError::in_file(args.scene, e))?;
+    let edits = match args.edits {
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| CliError(format!("cannot read {}: {e}", path.display())))?;
+            parse_edits(&text, &scene).map_err(|e| CliError::in_file(path, e))?
+        }
+        None => Vec::new(),
+    };
+    let mode = SampleMode::Derivatives(args.derivatives);
+    let objects: Vec<SampledObject> = if args.full {
+        apply_all(&mut scene, &edits);
+        scene.objects.iter().map(|o| SampledObject::new(&o.shape, o.samples, mode)).collect()
+    } else {
+        let mut objects: Vec<SampledObject> =
+            scene.objects.iter().map(|o| SampledObject::new(&o.shape, o.samples, mode)).collect();
+        for e in &edits {
+            objects[e.object].apply(&e.op);
+        }
+        objects
+    };
+    let mut out = String::with_capacity(1 << 16);
+    out.push_str("{\"objects\": [\n");
+    for (i, (meta, obj)) in scene.objects.iter().zip(&objects).enumerate() {
+        write_object(&mut out, &meta.name, &meta.shape, obj)?;
+        out.push_str(if i + 1 < objects.len() { ",\n" } else { "\n" });
+    }
+    out.push_str("]}\n");
+    Ok(out)
+}
+
+fn write_object(out: &mut String, name: &str, shape: &Shape, obj: &SampledObject) -> Result<(), CliError> {
+    let grid = obj.grid();
+    if let Some(bad) = grid.data.iter().position(|v| !v.is_finite()) {
+        return Err(CliError(format!(
+            "object '{name}': evaluation overflowed (non-finite value in sample {}); scale the coordinates down",
+            bad / grid.stride()
+        )));
+    }
+    let name_json = serde_json::to_string(name).expect("strings serialise");
+    let _ = write!(out, "  {{\"name\": {name_json}, \"type\": \"{}\", \"params\": ", shape.type_name());
+    let params = obj.params();
+    let g = grid.partials.max_order() + 1;
+    if shape.is_surface() {
+        out.push('[');
+        numbers(out, params[0]);
+        out.push_str(", ");
+        numbers(out, params[1]);
+        out.push_str("], \"samples\": [");
+        let [mu, mv] = grid.dims;
+        for i in 0..mu {
+            out.push_str(if i == 0 { "[" } else { ", [" });
+            for j in 0..mv {
+                out.push_str(if j == 0 { "[" } else { ", [" });
+                let s = grid.sample(i, j);
+                for a in 0..g {
+                    out.push_str(if a == 0 { "[" } else { ", [" });
+                    for b in 0..g {
+                        if b > 0 {
+                            out.push_str(", ");
+                        }
+                        vec3(out, s[a * g + b].to_array());
+                    }
+                    out.push(']');
+                }
+                out.push(']');
+            }
+            out.push(']');
+        }
+        out.push_str("]}");
+    } else {
+        numbers(out, params[0]);
+        out.push_str(", \"samples\": [");
+        for j in 0..grid.dims[0] {
+            out.push_str(if j == 0 { "[" } else { ", [" });
+            for (r, v) in grid.sample(j, 0).iter().enumerate() {
+                if r > 0 {
+                    out.push_str(", ");
+                }
+                vec3(out, v.to_array());
+            }
+            out.push(']');
+        }
+        out.push_str("]}");
+    }
+    Ok(())
+}
+
+/// Shortest round-trip decimal; Rust's `{:?}` for f64 prints exactly that, with exponents for
+/// very large and small magnitudes (valid JSON).
+fn number(out: &mut String, x: f64) {
+    let _ = write!(out, "{x:?}");
+}
+
+fn numbers(out: &mut String, v: &[f64]) {
+    out.push('[');
+    for (i, &x) in v.iter().enumerate() {
+        if i > 0 {
+            out.push_str(", ");
+        }
+        number(out, x);
+    }
+    out.push(']');
+}
+
+fn vec3(out: &mut String, v: [f64; 3]) {
+    numbers(out, &v);
+}

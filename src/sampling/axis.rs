@@ -1,0 +1,143 @@
+//! Pre-evaluation data of one parameter direction of a B-spline (the paper's S, I and M).
+
+use crate::geom::basis::hermite_into;
+use crate::geom::knots::{KnotVector, uniform_params};
+use std::ops::Range;
+
+/// Pre-evaluated basis data for one direction: sample parameters S, the span of each sample,
+/// the rows 0..=g of the B-spline-Hermite matrix at each sample, and per control point the index
+/// range I of samples it influences.
+#[derive(Debug, Clone)]
+pub struct HermiteTable {
+    /// Sample parameters S (m values, both domain ends included).
+    pub params: Vec<f64>,
+    /// FindSpan of each sample.
+    pub spans: Vec<usize>,
+    degree: usize,
+    /// Derivative rows kept per sample: min(g, d) + 1 (rows above the degree are zero).
+    rows: usize,
+    /// Highest derivative order g requested.
+    order: usize,
+    /// Per sample, `rows × (d+1)` values, row-major.
+    m: Vec<f64>,
+    /// Per control point k: samples whose span i satisfies i−d ≤ k ≤ i (may be empty).
+    ranges: Vec<Range<usize>>,
+}
+
+impl HermiteTable {
+    /// Pre-evaluates `samples` uniform parameters over the domain of a degree-`degree` B-spline
+    /// with `n` control points, keeping derivatives up to order `order`.
+    pub fn new(knots: &KnotVector, degree: usize, n: usize, samples: usize, order: usize) -> Self {
+        let (a, b) = knots.domain(degree, n);
+        let params = uniform_params(a, b, samples);
+        Self::at_params(knots, degree, n, params, order)
+    }
+
+    /// Pre-evaluation at given parameters (non-decreasing, inside the domain).
+    pub fn at_params(knots: &KnotVector, degree: usize, n: usize, params: Vec<f64>, order: usize) -> Self {
+        let w = degree + 1;
+        let rows = order.min(degree) + 1;
+        let mut m = Vec::with_capacity(params.len() * rows * w);
+        let mut full = vec![0.0; w * w];
+        let mut spans = Vec::with_capacity(params.len());
+        for &t in &params {
+            let span = knots.find_span(degree, n, t);
+            hermite_into(knots, degree, span, t, &mut full);
+            m.extend_from_slice(&full[..rows * w]);
+            spans.push(span);
+        }
+        // I_k: spans are non-decreasing in the sample index, so {j : span_j ∈ [k, k+d]} is an
+        // interval; found with two monotone cursors.
+        let mut ranges = Vec::with_capacity(n);
+        let (mut lo, mut hi) = (0usize, 0usize);
+        for k in 0..n {
+            while lo < spans.len() && spans[lo] < k {
+                lo += 1;
+            }
+            hi = hi.max(lo);
+            while hi < spans.len() && spans[hi] <= k + degree {
+                hi += 1;
+            }
+            ranges.push(lo..hi);
+        }
+        Self { params, spans, degree, rows, order, m, ranges }
+    }
+
+    pub fn degree(&self) -> usize {
+        self.degree
+    }
+
+    /// Highest derivative order g this table was built for.
+    pub fn order(&self) -> usize {
+        self.order
+    }
+
+    pub fn len(&self) -> usize {
+        self.params.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.params.is_empty()
+    }
+
+    /// Index of the first control point active at sample j (span − d).
+    #[inline]
+    pub fn first(&self, j: usize) -> usize {
+        self.spans[j] - self.degree
+    }
+
+    /// Row r of M at sample j (the r-th derivatives of the d+1 active basis functions), or
+    /// `None` when r exceeds the degree (all zero).
+    #[inline]
+    pub fn row(&self, j: usize, r: usize) -> Option<&[f64]> {
+        if r >= self.rows {
+            return None;
+        }
+        let w = self.degree + 1;
+        let base = (j * self.rows + r) * w;
+        Some(&self.m[base..base + w])
+    }
+
+    /// Coefficient of control point k in the r-th derivative at sample j (0 if inactive).
+    #[inline]
+    pub fn coeff(&self, j: usize, r: usize, k: usize) -> f64 {
+        let first = self.first(j);
+        if r >= self.rows || k < first || k > first + self.degree {
+            return 0.0;
+        }
+        self.m[(j * self.rows + r) * (self.degree + 1) + (k - first)]
+    }
+
+    /// The samples control point k influences (the paper's I_k).
+    #[inline]
+    pub fn range(&self, k: usize) -> Range<usize> {
+        self.ranges[k].clone()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn paper_example_ranges_cover_pieces_two_to_five() {
+        // Degree 3, 10 control points, knots {0,0,0,0,1,…,6,7,7,7,7}: moving C4 changes pieces
+        // 2–5, i.e. parameters in [1, 5].
+        let knots = KnotVector::clamped_uniform(3, 10, 0.0, 7.0);
+        let t = HermiteTable::new(&knots, 3, 10, 71, 1);
+        let r = t.range(4);
+        assert_eq!(t.params[r.start], 1.0);
+        assert!(t.params[r.end - 1] < 5.0 && t.params[r.end] == 5.0);
+        let pieces: std::collections::BTreeSet<usize> = r.clone().map(|j| t.spans[j] - 3 + 1).collect();
+        assert_eq!(pieces.into_iter().collect::<Vec<_>>(), vec![2, 3, 4, 5]);
+        // Outside I_4 the basis function of C4 vanishes; inside it is the matrix entry.
+        for j in 0..t.len() {
+            let c = t.coeff(j, 0, 4);
+            if !r.contains(&j) {
+                assert_eq!(c, 0.0);
+            }
+        }
+        assert_eq!(t.range(0), 0..10);
+        assert_eq!(t.range(9).end, 71);
+    }
+}

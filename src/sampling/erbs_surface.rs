@@ -1,0 +1,223 @@
+//! Pre-evaluated ERBS surfaces: local patches sampled on their support sub-grids at the parent's
+//! parameters, blended by the Leibniz rule in both directions.
+
+use super::axis::HermiteTable;
+use super::dirty::DirtyRegion;
+use super::erbs_axis::ErbsAxis;
+use super::grid::{PartialSet, SampleGrid};
+use super::normals::NormalSource;
+use super::spline_surface::{Rect, two_pass};
+use crate::geom::ErbsSurface;
+use crate::geom::knots::KnotVector;
+use crate::geom::point::binomial;
+use glam::{DMat4, DVec3};
+use std::ops::Range;
+
+/// One local patch's pre-evaluation on its support rows × cols: Bernstein-Hermite tables per
+/// direction and the patch's own partials there.
+#[derive(Debug, Clone)]
+struct LocalPatch {
+    rows: Range<usize>,
+    cols: Range<usize>,
+    tables: [HermiteTable; 2],
+    samples: Vec<DVec3>,
+}
+
+/// For output partial (a, b): Σ over (a', b') ≤ (a, b) of C(a,a')C(b,b') Wu^(a−a') Wv^(b−b') s^(a'b').
+type BlendTerm = (f64, usize, usize, usize);
+
+#[derive(Debug, Clone)]
+pub struct ErbsSurfaceSampler {
+    surface: ErbsSurface,
+    axes: [ErbsAxis; 2],
+    partials: Vec<(usize, usize)>,
+    terms: Vec<Vec<BlendTerm>>,
+    patches: Vec<LocalPatch>,
+    grid: SampleGrid,
+}
+
+impl ErbsSurfaceSampler {
+    pub fn new(surface: ErbsSurface, samples: [usize; 2], set: PartialSet, normals: bool) -> Self {
+        let g = set.max_order();
+        let [ku, kv] = surface.knots();
+        let axes = [
+            ErbsAxis::new(ku, surface.bfunction(), samples[0], g),
+            ErbsAxis::new(kv, surface.bfunction(), samples[1], g),
+        ];
+        let partials = set.list();
+        let slot = |a: usize, b: usize| partials.iter().position(|&p| p == (a, b)).expect("downward closed");
+        let terms = partials
+            .iter()
+            .map(|&(a, b)| {
+                let mut t = Vec::new();
+                for a2 in 0..=a {
+                    for b2 in 0..=b {
+                        t.push((binomial(a, a2) * binomial(b, b2), a - a2, b - b2, slot(a2, b2)));
+                    }
+                }
+                t
+            })
+            .collect();
+        let [nu, nv] = surface.count();
+        let stride = set.len();
+        let mut patches = Vec::with_capacity(nu * nv);
+        for k in 0..nu {
+            for l in 0..nv {
+                let p = surface.local_patch(k, l);
+                let [da, db] = p.degree();
+                let (rows, cols) = (axes[0].range(k), axes[1].range(l));
+                let tu = HermiteTable::at_params(
+                    &KnotVector::bezier(da, ku[k], ku[k + 2]),
+                    da,
+                    da + 1,
+                    axes[0].params[rows.clone()].to_vec(),
+                    g,
+                );
+                let tv = HermiteTable::at_params(
+                    &KnotVector::bezier(db, kv[l], kv[l + 2]),
+                    db,
+                    db + 1,
+                    axes[1].params[cols.clone()].to_vec(),
+                    g,
+                );
+                let n = rows.len() * cols.len() * stride;
+                patches.push(LocalPatch { rows, cols, tables: [tu, tv], samples: vec![DVec3::ZERO; n] });
+            }
+        }
+        let grid = SampleGrid::new(samples, set, normals);
+        let mut s = Self { surface, axes, partials, terms, patches, grid };
+        s.full();
+        s
+    }
+
+    pub fn surface(&self) -> &ErbsSurface {
+        &self.surface
+    }
+
+    pub fn grid(&self) -> &SampleGrid {
+        &self.grid
+    }
+
+    pub fn params(&self) -> [&[f64]; 2] {
+        [&self.axes[0].params, &self.axes[1].params]
+    }
+
+    /// Exact sampling: every local patch from its control points (two passes on its sub-grid),
+    /// then the blend.
+    pub fn full(&mut self) -> DirtyRegion {
+        self.grid.data.fill(DVec3::ZERO);
+        for idx in 0..self.patches.len() {
+            self.sample_patch(idx);
+            let delta = self.patches[idx].samples.clone();
+            self.blend_in(idx, &delta);
+        }
+        let [mu, mv] = self.grid.dims;
+        self.update_normals(0..mu, 0..mv);
+        DirtyRegion::Surface { rows: 0..mu, cols: 0..mv }
+    }
+
+    fn sample_patch(&mut self, idx: usize) {
+        let nv = self.surface.count()[1];
+        let patch = self.surface.local_patch(idx / nv, idx % nv);
+        let p = &mut self.patches[idx];
+        let rect = Rect {
+            rows: p.rows.clone(),
+            cols: p.cols.clone(),
+            origin: (p.rows.start, p.cols.start),
+            width: p.cols.len(),
+            stride: self.partials.len(),
+        };
+        two_pass(&p.tables[0], &p.tables[1], patch.points(), patch.count()[1], &self.partials, &rect, &mut p.samples);
+    }
+
+    /// Affine map of local patch (k, l): Δs = A·s − s on its pre-sampled partials (positions as
+    /// points, derivatives as vectors), blended into the parent.
+    pub fn transform_local(&mut self, k: usize, l: usize, a: &DMat4) -> DirtyRegion {
+        self.surface.transform_local(k, l, a);
+        let idx = k * self.surface.count()[1] + l;
+        let stride = self.partials.len();
+        let p = &mut self.patches[idx];
+        let mut delta = vec![DVec3::ZERO; p.samples.len()];
+        for (n, (d, s)) in delta.iter_mut().zip(p.samples.iter_mut()).enumerate() {
+            let moved = if n % stride == 0 { a.transform_point3(*s) } else { a.transform_vector3(*s) };
+            *d = moved - *s;
+            *s = moved;
+        }
+        self.finish(idx, &delta)
+    }
+
+    /// Moves control point (qa, qb) of local patch (k, l): Δs^(ab) = Mu[a][qa] Mv[b][qb] Δ.
+    pub fn translate_local_point(&mut self, k: usize, l: usize, qa: usize, qb: usize, delta: DVec3) -> DirtyRegion {
+        self.surface.translate_local_point(k, l, qa, qb, delta);
+        let idx = k * self.surface.count()[1] + l;
+        let stride = self.partials.len();
+        let p = &mut self.patches[idx];
+        let width = p.cols.len();
+        let mut d = vec![DVec3::ZERO; p.samples.len()];
+        for li in 0..p.rows.len() {
+            for lj in 0..width {
+                let base = (li * width + lj) * stride;
+                for (slot, &(a, b)) in self.partials.iter().enumerate() {
+                    let c = p.tables[0].row(li, a).map_or(0.0, |r| r[qa]) * p.tables[1].row(lj, b).map_or(0.0, |r| r[qb]);
+                    d[base + slot] = delta * c;
+                    p.samples[base + slot] += delta * c;
+                }
+            }
+        }
+        self.finish(idx, &d)
+    }
+
+    /// Exact re-evaluation of the whole object (drift control; ERBS updates are local anyway).
+    pub fn rebuild(&mut self) -> DirtyRegion {
+        self.full()
+    }
+
+    fn finish(&mut self, idx: usize, delta: &[DVec3]) -> DirtyRegion {
+        let region = self.blend_in(idx, delta);
+        let (rows, cols) = (self.patches[idx].rows.clone(), self.patches[idx].cols.clone());
+        self.update_normals(rows, cols);
+        region
+    }
+
+    /// ∂^{ab}P += Σ C(a,a')C(b,b') Wu_k^(a−a') Wv_l^(b−b') Δs^(a'b') over the patch's support.
+    fn blend_in(&mut self, idx: usize, delta: &[DVec3]) -> DirtyRegion {
+        let nv = self.surface.count()[1];
+        let (k, l) = (idx / nv, idx % nv);
+        let p = &self.patches[idx];
+        let stride = self.partials.len();
+        let mv = self.grid.dims[1];
+        let width = p.cols.len();
+        for i in p.rows.clone() {
+            let wu = self.axes[0].weights(i, k);
+            for j in p.cols.clone() {
+                let wv = self.axes[1].weights(j, l);
+                let d = &delta[((i - p.rows.start) * width + (j - p.cols.start)) * stride..][..stride];
+                let out = &mut self.grid.data[(i * mv + j) * stride..][..stride];
+                for (slot, terms) in self.terms.iter().enumerate() {
+                    let mut acc = DVec3::ZERO;
+                    for &(c, ia, ib, s) in terms {
+                        acc += d[s] * (c * wu[ia] * wv[ib]);
+                    }
+                    out[slot] += acc;
+                }
+            }
+        }
+        DirtyRegion::Surface { rows: p.rows.clone(), cols: p.cols.clone() }
+    }
+
+    fn update_normals(&mut self, rows: Range<usize>, cols: Range<usize>) {
+        let params = [self.axes[0].params.as_slice(), self.axes[1].params.as_slice()];
+        super::normals::update(&mut self.grid, rows, cols, params, &self.surface);
+    }
+}
+
+impl NormalSource for ErbsSurface {
+    fn first_partials(&self, u: f64, v: f64) -> (DVec3, DVec3, DVec3) {
+        let p = self.derivatives(u, v, 1);
+        (p.get(1, 0), p.get(0, 1), p.get(1, 1))
+    }
+
+    fn domain(&self) -> [(f64, f64); 2] {
+        ErbsSurface::domain(self)
+    }
+}
