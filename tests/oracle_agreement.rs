@@ -179,6 +179,7 @@ impl Case<'_> {
         };
         let _ = std::fs::remove_file(&scene_path);
         let _ = std::fs::remove_file(&edits_path);
+        let _ = std::fs::remove_file(format!("{}.expected.json", scene_path.display()));
         outcome.map_err(|message| {
             let saved = failure_dir().join(&label);
             let _ = std::fs::create_dir_all(&saved);
