@@ -1,0 +1,36 @@
+//! Independent reference evaluator ("oracle") for `prespline sample`.
+//!
+//! This module is shared by several integration-test binaries (`mod oracle;`). It is written
+//! from the contract in `DESIGN.md` only and deliberately uses algorithms different from the
+//! product's B-spline-Hermite matrices:
+//!
+//! * Bézier curves: derivative control points (hodographs) evaluated by de Casteljau.
+//! * B-splines: local derivative control points (NURBS Book eq. 3.8 / A3.3 `CurveDerivCpts`)
+//!   evaluated by the de Boor triangle (A2 style) on the span containing the parameter.
+//! * Rational objects: homogeneous coordinates, projection by the quotient rule
+//!   (NURBS Book A4.2 `RatCurveDerivs` / A4.4 `RatSurfaceDerivs`).
+//! * Tensor-product surfaces: "curves of curves" (evaluate the u-direction curve of each
+//!   control-point column, then the v-direction curve through the results).
+//! * ERBS: full Leibniz rule over the blend of two local curves / four local patches.
+//! * Expo-rational B-function: graded composite Gauss–Legendre quadrature for B, Taylor
+//!   arithmetic (series exponential) for the derivatives.
+//!
+//! Submodules: [`bfunction`] (the five B-functions), [`eval`] (point evaluation), [`scene`]
+//! (scene/edit JSON, model, `sample` output), [`compare`] (product vs oracle, error measure),
+//! [`random`] + [`rng`] (seeded scenes and edit lists). `gen_expo_table.py` regenerates
+//! `tests/data/expo_bfunction_reference.json` with mpmath; the tests themselves need no Python.
+//!
+//! Running (shared target dir and the global build lock on the development machine):
+//! ```text
+//! cargo test --test oracle_selfcheck     # the oracle against lecture numbers, mpmath, FD, …
+//! cargo test --test oracle_agreement     # `prespline sample` against the oracle
+//! PRESPLINE_ORACLE_SEED=1000007 cargo test --test oracle_agreement curves   # one seed
+//! ```
+#![allow(dead_code)]
+
+pub mod bfunction;
+pub mod compare;
+pub mod eval;
+pub mod random;
+pub mod rng;
+pub mod scene;

@@ -1,0 +1,1644 @@
+//! Tests of the reference evaluator (`tests/oracle/`) itself: exact lecture numbers, the
+//! expo-rational B-function against an mpmath table, B-function identities, finite differences,
+//! partition of unity, ERBS interpolation, an independent Cox–de Boor basis-function path, edit
+//! semantics, the scene round trip and the comparison logic used against the product.
+
+// Index loops over derivative orders and coordinates read best as they are written in the books.
+#![allow(clippy::needless_range_loop)]
+
+mod oracle;
+
+use oracle::bfunction::{self, BFunction, EXPO_SCALE};
+use oracle::compare::compare_output;
+use oracle::eval::{
+    self, Basis, Homogeneous, Point3, bspline_derivatives, project_curve_derivatives,
+};
+use oracle::random::{self, Kind, Options};
+use oracle::rng::Rng;
+use oracle::scene::{Edit, Index, Object, Scene, Shape, apply_edits, sample_params};
+use serde_json::{Value, json};
+
+fn close(a: f64, b: f64, tol: f64) -> bool {
+    (a - b).abs() <= tol
+}
+
+fn assert_point(actual: Point3, expected: [f64; 3], tol: f64, what: &str) {
+    for k in 0..3 {
+        assert!(
+            close(actual[k], expected[k], tol),
+            "{what}: got {actual:?}, expected {expected:?}"
+        );
+    }
+}
+
+fn curve(points: &[[f64; 3]], weights: Option<Vec<f64>>, basis: Basis) -> Object {
+    Object {
+        name: "c".into(),
+        shape: Shape::Curve {
+            basis,
+            points: points.to_vec(),
+            weights,
+        },
+        samples: vec![2],
+    }
+}
+
+const LECTURE_POINTS: [[f64; 3]; 4] = [
+    [1.0, 1.0, 0.0],
+    [1.0, 10.0, 0.0],
+    [10.0, 10.0, 0.0],
+    [10.0, 1.0, 0.0],
+];
+
+// ---------------------------------------------------------------------------------------------
+// Lecture numbers
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn lecture_cubic_bezier_de_casteljau() {
+    let c = curve(&LECTURE_POINTS, None, Basis::Bezier);
+    let d = c.curve_derivatives(1.0 / 3.0, 3);
+    assert_point(d[0], [10.0 / 3.0, 7.0, 0.0], 1e-14, "C(1/3)");
+    assert_point(d[1], [12.0, 9.0, 0.0], 1e-13, "C'(1/3)");
+    // C'' = 6 Σ Δ²P B¹: Δ²P_0 = (9, -9), Δ²P_1 = (-9, -9) → C''(1/3) = 6((2/3)(9,-9) + (1/3)(-9,-9)).
+    assert_point(d[2], [18.0, -54.0, 0.0], 1e-12, "C''(1/3)");
+    // C''' = 6 Δ³P_0 = 6 (-18, 0).
+    assert_point(d[3], [-108.0, 0.0, 0.0], 1e-12, "C'''");
+    assert_point(c.curve_derivatives(0.0, 0)[0], [1.0, 1.0, 0.0], 0.0, "C(0)");
+    assert_point(
+        c.curve_derivatives(1.0, 0)[0],
+        [10.0, 1.0, 0.0],
+        0.0,
+        "C(1)",
+    );
+}
+
+#[test]
+fn lecture_uniform_cubic_de_boor() {
+    let knots: Vec<f64> = (0..8).map(f64::from).collect();
+    let c = curve(&LECTURE_POINTS, None, Basis::BSpline { degree: 3, knots });
+    let d = c.curve_derivatives(10.0 / 3.0, 1);
+    assert_point(d[0], [79.0 / 18.0, 171.0 / 18.0, 0.0], 1e-14, "D(10/3)");
+    // Derivative: the hodograph of the uniform cubic is a uniform quadratic B-spline with
+    // Q_i = P_{i+1} − P_i (p / (t_{i+4} − t_{i+1}) = 1), evaluated at local u = 1/3 on span 3:
+    // weights ½(1−u)², ½(−2u²+2u+1), ½u² = 2/9, 13/18, 1/18.
+    let q = [[0.0, 9.0], [9.0, 0.0], [0.0, -9.0]];
+    let w = [2.0 / 9.0, 13.0 / 18.0, 1.0 / 18.0];
+    let expected = [
+        w[0] * q[0][0] + w[1] * q[1][0] + w[2] * q[2][0],
+        w[0] * q[0][1] + w[1] * q[1][1] + w[2] * q[2][1],
+        0.0,
+    ];
+    assert_point(d[1], expected, 1e-13, "D'(10/3)");
+}
+
+#[test]
+fn quarter_circle_rational_bezier() {
+    let s = std::f64::consts::FRAC_1_SQRT_2;
+    let c = curve(
+        &[[1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
+        Some(vec![1.0, s, 1.0]),
+        Basis::Bezier,
+    );
+    for j in 0..=64 {
+        let t = j as f64 / 64.0;
+        let d = c.curve_derivatives(t, 3);
+        let [x, y, _] = d[0];
+        assert!(
+            close(x * x + y * y, 1.0, 4e-16),
+            "|C({t})| = {}",
+            (x * x + y * y).sqrt()
+        );
+        // Tangent ⟂ radius and turning counter-clockwise: C' = |C'| (−y, x).
+        let speed = (d[1][0].powi(2) + d[1][1].powi(2)).sqrt();
+        assert_point(
+            d[1],
+            [-y * speed, x * speed, 0.0],
+            1e-14,
+            "tangent direction",
+        );
+        // d²/dt² (C·C) = 0 → C·C'' + |C'|² = 0.
+        let dot = x * d[2][0] + y * d[2][1] + speed * speed;
+        assert!(close(dot, 0.0, 1e-13), "C·C'' + |C'|² = {dot} at {t}");
+        // d³/dt³ (C·C) = 0 → C·C''' + 3 C'·C'' = 0.
+        let third = x * d[3][0] + y * d[3][1] + 3.0 * (d[1][0] * d[2][0] + d[1][1] * d[2][1]);
+        assert!(close(third, 0.0, 1e-12), "third identity {third} at {t}");
+    }
+    let mid = c.curve_derivatives(0.5, 0)[0];
+    assert_point(mid, [s, s, 0.0], 2e-16, "C(1/2)");
+    // Endpoint derivatives: C'(0) = 2 w1/w0 (P1 − P0) = (0, √2), C'(1) = (−√2, 0).
+    let root2 = std::f64::consts::SQRT_2;
+    assert_point(
+        c.curve_derivatives(0.0, 1)[1],
+        [0.0, root2, 0.0],
+        1e-15,
+        "C'(0)",
+    );
+    assert_point(
+        c.curve_derivatives(1.0, 1)[1],
+        [-root2, 0.0, 0.0],
+        1e-15,
+        "C'(1)",
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// B-functions
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn expo_scale_constant() {
+    let integral = 2.0 * bfunction::expo_integral_lower(0.5);
+    let from_quadrature = 1.0 / integral;
+    assert!(
+        close(from_quadrature, EXPO_SCALE, 2.0 * f64::EPSILON * EXPO_SCALE),
+        "quadrature S_F = {from_quadrature:.17}, constant {EXPO_SCALE:.17}"
+    );
+    let table: Value = serde_json::from_str(REFERENCE).unwrap();
+    let reference: f64 = table["scale"].as_str().unwrap().parse().unwrap();
+    assert_eq!(
+        reference, EXPO_SCALE,
+        "constant is the correctly rounded S_F"
+    );
+    let printed_in_design = 1.657_137_679_738_210_5_f64;
+    assert!(close(printed_in_design, EXPO_SCALE, 2.3e-16));
+}
+
+const REFERENCE: &str = include_str!("data/expo_bfunction_reference.json");
+
+/// (t, [B, B', …, B^(6)]) from the mpmath table.
+fn reference_table() -> Vec<(f64, Vec<f64>)> {
+    let table: Value = serde_json::from_str(REFERENCE).unwrap();
+    table["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| {
+            let t: f64 = p["t"].as_str().unwrap().parse().unwrap();
+            let d = p["derivatives"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|x| x.as_str().unwrap().parse::<f64>().unwrap())
+                .collect();
+            (t, d)
+        })
+        .collect()
+}
+
+#[test]
+fn expo_bfunction_matches_mpmath() {
+    let table = reference_table();
+    assert!(table.len() >= 20);
+    let orders = table[0].1.len();
+    // Per-order magnitude over the table, the natural scale of errors in derivative r.
+    let scale: Vec<f64> = (0..orders)
+        .map(|r| table.iter().map(|(_, d)| d[r].abs()).fold(1.0, f64::max))
+        .collect();
+    let mut worst_abs = vec![0.0f64; orders];
+    let mut worst_rel = vec![0.0f64; orders];
+    let mut worst_pointwise = vec![0.0f64; orders];
+    for (t, reference) in &table {
+        let ours = BFunction::Expo.derivatives(*t, orders - 1);
+        for r in 0..orders {
+            let err = (ours[r] - reference[r]).abs();
+            worst_abs[r] = worst_abs[r].max(err);
+            worst_rel[r] = worst_rel[r].max(err / scale[r]);
+            // Pointwise relative accuracy where the value is not tiny compared to its order.
+            if reference[r].abs() > 1e-6 * scale[r] {
+                let rel = err / reference[r].abs();
+                worst_pointwise[r] = worst_pointwise[r].max(rel);
+                assert!(
+                    rel < 1e-13,
+                    "B^({r})({t}): {} vs {} (rel {rel:e})",
+                    ours[r],
+                    reference[r]
+                );
+            }
+        }
+    }
+    for r in 0..orders {
+        println!(
+            "expo B^({r}): max |err| {:.2e}, max |err|/max|B^({r})| {:.2e} (max |B^({r})| {:.3e}), \
+             max relative error where |B^({r})| > 1e-6 max {:.2e}",
+            worst_abs[r], worst_rel[r], scale[r], worst_pointwise[r]
+        );
+    }
+    assert!(
+        worst_abs[0] <= 2.5e-16,
+        "B absolute error {:e}",
+        worst_abs[0]
+    );
+    for r in 1..orders {
+        assert!(
+            worst_rel[r] <= 4e-15,
+            "B^({r}) scaled error {:e}",
+            worst_rel[r]
+        );
+    }
+}
+
+#[test]
+fn bfunction_end_values_and_symmetry() {
+    for b in BFunction::ALL {
+        let at0 = b.derivatives(0.0, 0)[0];
+        let at1 = b.derivatives(1.0, 0)[0];
+        assert_eq!(at0, 0.0, "{b:?}: B(0)");
+        assert!(close(at1, 1.0, 1e-16), "{b:?}: B(1) = {at1}");
+        // B'(0) = B'(1) = 0 for all five.
+        assert!(b.derivatives(0.0, 1)[1].abs() < 1e-15, "{b:?}: B'(0)");
+        assert!(b.derivatives(1.0, 1)[1].abs() < 1e-15, "{b:?}: B'(1)");
+        let mut rng = Rng::new(7);
+        let mut previous = 0.0;
+        for j in 0..=200 {
+            let t = if j % 2 == 0 {
+                j as f64 / 200.0
+            } else {
+                rng.uniform()
+            };
+            let d = b.derivatives(t, 4);
+            let m = b.derivatives(1.0 - t, 4);
+            assert!(
+                close(d[0] + m[0], 1.0, 3e-16),
+                "{b:?}: B({t}) + B(1−t) = {}",
+                d[0] + m[0]
+            );
+            // B^(r)(1−t) = (−1)^(r+1) B^(r)(t)
+            for r in 1..=4 {
+                let sign = if r % 2 == 1 { 1.0 } else { -1.0 };
+                let scale = [1.0, 2.0, 10.0, 100.0, 1000.0][r];
+                assert!(
+                    close(m[r], sign * d[r], 2e-14 * scale),
+                    "{b:?}: symmetry of B^({r}) at {t}: {} vs {}",
+                    m[r],
+                    sign * d[r]
+                );
+            }
+            if j % 2 == 0 {
+                assert!(d[0] >= previous, "{b:?}: B not monotone at {t}");
+                previous = d[0];
+                assert!((0.0..=1.0).contains(&d[0]));
+            }
+        }
+    }
+}
+
+/// Richardson-extrapolated central difference of f at t with step h (error O(h⁴)).
+fn richardson<F: Fn(f64) -> Vec<f64>>(f: F, t: f64, h: f64) -> Vec<f64> {
+    let central = |h: f64| -> Vec<f64> {
+        let (a, b) = (f(t + h), f(t - h));
+        a.iter().zip(&b).map(|(x, y)| (x - y) / (2.0 * h)).collect()
+    };
+    let (coarse, fine) = (central(h), central(0.5 * h));
+    coarse
+        .iter()
+        .zip(&fine)
+        .map(|(c, f)| (4.0 * f - c) / 3.0)
+        .collect()
+}
+
+#[test]
+fn bfunction_derivatives_match_finite_differences() {
+    let mut rng = Rng::new(11);
+    for b in BFunction::ALL {
+        let mut worst = 0.0f64;
+        for _ in 0..60 {
+            let t = rng.range(0.05, 0.95);
+            let d = b.derivatives(t, 7);
+            let fd = richardson(|x| b.derivatives(x, 6), t, 1e-3);
+            for r in 0..=6 {
+                let scale = 1.0 + d[r + 1].abs() + d[r].abs();
+                let err = (fd[r] - d[r + 1]).abs() / scale;
+                worst = worst.max(err);
+                assert!(
+                    err < 1e-5,
+                    "{b:?}: B^({}) at {t}: {} vs FD {}",
+                    r + 1,
+                    d[r + 1],
+                    fd[r]
+                );
+            }
+        }
+        println!("{b:?}: worst scaled FD error over orders 1..7: {worst:.2e}");
+    }
+}
+
+#[test]
+fn polynomial_bfunctions_have_exact_derivatives() {
+    for (b, coeffs) in [
+        (BFunction::Smoothstep, vec![0.0, 0.0, 3.0, -2.0]),
+        (
+            BFunction::Smootherstep,
+            vec![0.0, 0.0, 0.0, 10.0, -15.0, 6.0],
+        ),
+    ] {
+        for t in [0.0, 0.125, 0.25, 0.5, 0.75, 1.0] {
+            let d = b.derivatives(t, 8);
+            for (r, &value) in d.iter().enumerate() {
+                // r-th derivative of Σ c_k t^k.
+                let mut exact = 0.0;
+                for (k, &c) in coeffs.iter().enumerate().skip(r) {
+                    let falling: f64 = (k - r + 1..=k).map(|x| x as f64).product();
+                    exact += c * falling * t.powi((k - r) as i32);
+                }
+                assert!(
+                    close(value, exact, 1e-13),
+                    "{b:?}^({r})({t}) = {value}, exact {exact}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn trigonometric_and_rational_closed_forms() {
+    use std::f64::consts::PI;
+    for j in 0..=64 {
+        let t = j as f64 / 64.0;
+        let d = BFunction::Trigonometric.derivatives(t, 4);
+        let (s, c) = (PI * t).sin_cos();
+        let expected = [
+            (1.0 - c) / 2.0,
+            PI / 2.0 * s,
+            PI * PI / 2.0 * c,
+            -PI.powi(3) / 2.0 * s,
+            -PI.powi(4) / 2.0 * c,
+        ];
+        for r in 0..=4 {
+            assert!(
+                close(d[r], expected[r], 1e-15 * PI.powi(r as i32)),
+                "trig^({r})({t})"
+            );
+        }
+        let d = BFunction::Rational.derivatives(t, 2);
+        let den = t * t + (1.0 - t) * (1.0 - t);
+        let expected = [
+            t * t / den,
+            2.0 * t * (1.0 - t) / (den * den),
+            2.0 * (1.0 - 2.0 * t) * (1.0 + 2.0 * t - 2.0 * t * t) / (den * den * den),
+        ];
+        for r in 0..=2 {
+            assert!(close(d[r], expected[r], 1e-14), "rational^({r})({t})");
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// B-splines: partition of unity, discontinuities, an independent basis-function path
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn bspline_partition_of_unity() {
+    let mut rng = Rng::new(3);
+    for _ in 0..300 {
+        let p = rng.int(0, 8);
+        let n = p + 1 + rng.int(0, 6);
+        let knots = random::random_bspline_knots(&mut rng, p, n);
+        let (a, b) = (knots[p], knots[n]);
+        for j in 0..10 {
+            let t = if j == 9 { b } else { rng.range(a, b) };
+            let mut total = [0.0; 4];
+            for i in 0..n {
+                let mut unit = vec![[0.0]; n];
+                unit[i] = [1.0];
+                let d = bspline_derivatives(p, &knots, &unit, t, 3);
+                assert!(d[0][0] >= -1e-15, "negative basis function");
+                for k in 0..=3 {
+                    total[k] += d[k][0];
+                }
+            }
+            assert!(
+                close(total[0], 1.0, 1e-14),
+                "Σ N_i = {} (p={p}, t={t}, {knots:?})",
+                total[0]
+            );
+            let ones = vec![[1.0]; n];
+            let d = bspline_derivatives(p, &knots, &ones, t, 3);
+            assert!(close(d[0][0], 1.0, 1e-15));
+            for k in 1..=3 {
+                assert_eq!(d[k][0], 0.0, "derivative {k} of a constant B-spline");
+            }
+        }
+    }
+}
+
+#[test]
+fn bspline_right_hand_values_at_discontinuity() {
+    // Degree 1 with a double interior knot: C0-broken at t = 1. Right-hand value there.
+    let points = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [5.0, 5.0, 0.0],
+        [6.0, 5.0, 0.0],
+    ];
+    let knots = vec![0.0, 0.0, 1.0, 1.0, 2.0, 2.0];
+    let c = curve(&points, None, Basis::BSpline { degree: 1, knots });
+    let at = c.curve_derivatives(1.0, 2);
+    assert_point(at[0], points[2], 0.0, "right-hand value at the break");
+    assert_point(
+        at[1],
+        [1.0, 0.0, 0.0],
+        1e-15,
+        "right-hand derivative at the break",
+    );
+    assert_point(at[2], [0.0; 3], 0.0, "second derivative of a line");
+    assert_point(c.curve_derivatives(2.0, 0)[0], points[3], 0.0, "domain end");
+    assert_point(
+        c.curve_derivatives(0.5, 0)[0],
+        [0.5, 0.0, 0.0],
+        1e-16,
+        "left piece",
+    );
+    // Quadratic, interior knot of multiplicity 2 (C0): derivative jumps; right-hand one wins.
+    let points = [
+        [0.0, 0.0, 0.0],
+        [1.0, 2.0, 0.0],
+        [2.0, 0.0, 0.0],
+        [4.0, 4.0, 0.0],
+        [5.0, 0.0, 0.0],
+    ];
+    let knots = vec![0.0, 0.0, 0.0, 1.0, 1.0, 2.0, 2.0, 2.0];
+    let c = curve(&points, None, Basis::BSpline { degree: 2, knots });
+    let at = c.curve_derivatives(1.0, 1);
+    assert_point(at[0], points[2], 1e-15, "interpolated C0 point");
+    // Right piece is the Bézier (P2, P3, P4) on [1, 2]: C'(1) = 2 (P3 − P2).
+    assert_point(at[1], [4.0, 8.0, 0.0], 1e-14, "right-hand derivative");
+}
+
+/// NURBS Book A2.3 (`DersBasisFuns`): derivatives 0..=n of the p+1 basis functions non-zero on
+/// span i. Used only to cross-check the hodograph/de Boor path.
+fn ders_basis_funs(i: usize, u: f64, p: usize, n: usize, knots: &[f64]) -> Vec<Vec<f64>> {
+    let mut ndu = vec![vec![0.0; p + 1]; p + 1];
+    let mut left = vec![0.0; p + 1];
+    let mut right = vec![0.0; p + 1];
+    ndu[0][0] = 1.0;
+    for j in 1..=p {
+        left[j] = u - knots[i + 1 - j];
+        right[j] = knots[i + j] - u;
+        let mut saved = 0.0;
+        for r in 0..j {
+            ndu[j][r] = right[r + 1] + left[j - r];
+            let temp = ndu[r][j - 1] / ndu[j][r];
+            ndu[r][j] = saved + right[r + 1] * temp;
+            saved = left[j - r] * temp;
+        }
+        ndu[j][j] = saved;
+    }
+    let mut ders = vec![vec![0.0; p + 1]; n + 1];
+    for j in 0..=p {
+        ders[0][j] = ndu[j][p];
+    }
+    let (p_i, n_top) = (p as i64, n.min(p));
+    for r in 0..=p_i {
+        let mut a = [vec![0.0; p + 1], vec![0.0; p + 1]];
+        let (mut s1, mut s2) = (0, 1);
+        a[0][0] = 1.0;
+        for k in 1..=n_top as i64 {
+            let mut d = 0.0;
+            let (rk, pk) = (r - k, p_i - k);
+            if r >= k {
+                a[s2][0] = a[s1][0] / ndu[(pk + 1) as usize][rk as usize];
+                d = a[s2][0] * ndu[rk as usize][pk as usize];
+            }
+            let j1 = if rk >= -1 { 1 } else { -rk };
+            let j2 = if r - 1 <= pk { k - 1 } else { p_i - r };
+            for j in j1..=j2 {
+                let j = j as usize;
+                a[s2][j] =
+                    (a[s1][j] - a[s1][j - 1]) / ndu[(pk + 1) as usize][(rk + j as i64) as usize];
+                d += a[s2][j] * ndu[(rk + j as i64) as usize][pk as usize];
+            }
+            if r <= pk {
+                a[s2][k as usize] = -a[s1][(k - 1) as usize] / ndu[(pk + 1) as usize][r as usize];
+                d += a[s2][k as usize] * ndu[r as usize][pk as usize];
+            }
+            ders[k as usize][r as usize] = d;
+            std::mem::swap(&mut s1, &mut s2);
+        }
+    }
+    let mut factor = p as f64;
+    for k in 1..=n_top {
+        for x in ders[k].iter_mut() {
+            *x *= factor;
+        }
+        factor *= (p - k) as f64;
+    }
+    ders
+}
+
+/// Homogeneous derivatives of a B-spline curve via [`ders_basis_funs`].
+fn curve_by_basis_functions(
+    p: usize,
+    knots: &[f64],
+    pts: &[Homogeneous],
+    t: f64,
+    n: usize,
+) -> Vec<Homogeneous> {
+    let i = eval::find_span(p, knots, pts.len(), t);
+    let ders = ders_basis_funs(i, t, p, n, knots);
+    (0..=n)
+        .map(|k| {
+            let mut v = [0.0; 4];
+            for j in 0..=p {
+                v = eval::add(v, eval::scale(ders[k][j], pts[i - p + j]));
+            }
+            v
+        })
+        .collect()
+}
+
+fn lift(points: &[Point3], weights: Option<&Vec<f64>>) -> Vec<Homogeneous> {
+    points
+        .iter()
+        .enumerate()
+        .map(|(i, &p)| eval::homogeneous(p, weights.map_or(1.0, |w| w[i])))
+        .collect()
+}
+
+/// Max over derivative orders of (max |difference| / max(1, max |value|)).
+fn scaled_difference(a: &[Vec<Point3>], b: &[Vec<Point3>]) -> f64 {
+    let orders = a[0].len();
+    let mut worst = 0.0f64;
+    for r in 0..orders {
+        let scale = a
+            .iter()
+            .flat_map(|d| d[r])
+            .fold(1.0f64, |m, x| m.max(x.abs()));
+        for (x, y) in a.iter().zip(b) {
+            for k in 0..3 {
+                worst = worst.max((x[r][k] - y[r][k]).abs() / scale);
+            }
+        }
+    }
+    worst
+}
+
+#[test]
+fn bspline_curves_match_cox_de_boor_basis_functions() {
+    let opts = Options::default();
+    let mut worst = 0.0f64;
+    for seed in 0..400 {
+        let mut rng = Rng::new(1000 + seed);
+        let object = random::random_object(&mut rng, Kind::BSplineCurve, "c", &opts);
+        let Shape::Curve {
+            basis: Basis::BSpline { degree, knots },
+            points,
+            weights,
+        } = &object.shape
+        else {
+            unreachable!()
+        };
+        let h = lift(points, weights.as_ref());
+        let n = 3;
+        let params = object.params().remove(0);
+        let ours: Vec<Vec<Point3>> = params
+            .iter()
+            .map(|&t| object.curve_derivatives(t, n))
+            .collect();
+        let theirs: Vec<Vec<Point3>> = params
+            .iter()
+            .map(|&t| {
+                let mut hd = curve_by_basis_functions(*degree, knots, &h, t, n);
+                if weights.is_none() {
+                    // Polynomial: w ≡ 1 exactly (the basis-function sums are 1 and 0 only up to
+                    // rounding, which the quotient rule would spread into every order).
+                    hd.iter_mut()
+                        .enumerate()
+                        .for_each(|(k, x)| x[3] = if k == 0 { 1.0 } else { 0.0 });
+                }
+                project_curve_derivatives(&hd)
+            })
+            .collect();
+        let diff = scaled_difference(&ours, &theirs);
+        worst = worst.max(diff);
+        assert!(
+            diff < 1e-12,
+            "seed {seed}: hodograph path vs basis functions differ by {diff:e}"
+        );
+    }
+    println!("B-spline curves, two algorithms: max scaled difference {worst:.2e}");
+}
+
+#[test]
+fn bspline_surfaces_match_cox_de_boor_basis_functions() {
+    let opts = Options {
+        max_samples: 12,
+        ..Options::default()
+    };
+    let mut worst = 0.0f64;
+    for seed in 0..120 {
+        let mut rng = Rng::new(5000 + seed);
+        let object = random::random_object(&mut rng, Kind::BSplineSurface, "s", &opts);
+        let Shape::Surface {
+            basis:
+                [
+                    Basis::BSpline {
+                        degree: du,
+                        knots: ku,
+                    },
+                    Basis::BSpline {
+                        degree: dv,
+                        knots: kv,
+                    },
+                ],
+            points,
+            weights,
+        } = &object.shape
+        else {
+            unreachable!()
+        };
+        let n = 2;
+        let params = object.params();
+        let grid = object.surface_grid(&params[0], &params[1], n);
+        let (mut ours, mut theirs) = (Vec::new(), Vec::new());
+        for (i, &u) in params[0].iter().enumerate() {
+            let si = eval::find_span(*du, ku, points.len(), u);
+            let bu = ders_basis_funs(si, u, *du, n, ku);
+            for (j, &v) in params[1].iter().enumerate() {
+                let sj = eval::find_span(*dv, kv, points[0].len(), v);
+                let bv = ders_basis_funs(sj, v, *dv, n, kv);
+                let mut h = vec![vec![[0.0; 4]; n + 1]; n + 1];
+                for (a, row) in h.iter_mut().enumerate() {
+                    for (b, cell) in row.iter_mut().enumerate() {
+                        for k in 0..=*du {
+                            for l in 0..=*dv {
+                                let (pi, pj) = (si - du + k, sj - dv + l);
+                                let w = weights.as_ref().map_or(1.0, |w| w[pi][pj]);
+                                let pt = eval::homogeneous(points[pi][pj], w);
+                                let c = bu.get(a).map_or(0.0, |x| x[k])
+                                    * bv.get(b).map_or(0.0, |x| x[l]);
+                                *cell = eval::add(*cell, eval::scale(c, pt));
+                            }
+                        }
+                    }
+                }
+                if weights.is_none() {
+                    for (a, row) in h.iter_mut().enumerate() {
+                        for (b, cell) in row.iter_mut().enumerate() {
+                            cell[3] = if a + b == 0 { 1.0 } else { 0.0 };
+                        }
+                    }
+                }
+                let s = eval::project_surface_derivatives(&h);
+                // Flatten (a, b) into one "order" axis for the scaled comparison.
+                ours.push(grid[i][j].iter().flatten().copied().collect::<Vec<_>>());
+                theirs.push(s.iter().flatten().copied().collect::<Vec<_>>());
+            }
+        }
+        let diff = scaled_difference(&ours, &theirs);
+        worst = worst.max(diff);
+        assert!(
+            diff < 1e-12,
+            "seed {seed}: surface paths differ by {diff:e}"
+        );
+    }
+    println!("B-spline surfaces, two algorithms: max scaled difference {worst:.2e}");
+}
+
+#[test]
+fn bezier_equals_clamped_bspline() {
+    let mut rng = Rng::new(99);
+    for _ in 0..200 {
+        let p = rng.int(0, 10);
+        let pts: Vec<Point3> = (0..=p)
+            .map(|_| std::array::from_fn(|_| rng.range(-10.0, 10.0)))
+            .collect();
+        let weights = rng
+            .chance(0.5)
+            .then(|| (0..=p).map(|_| rng.range(0.2, 5.0)).collect::<Vec<_>>());
+        let mut knots = vec![0.0; p + 1];
+        knots.extend(vec![1.0; p + 1]);
+        let bezier = curve(&pts, weights.clone(), Basis::Bezier);
+        let bspline = curve(&pts, weights, Basis::BSpline { degree: p, knots });
+        let ts: Vec<f64> = (0..=20).map(|j| j as f64 / 20.0).collect();
+        let a: Vec<_> = ts.iter().map(|&t| bezier.curve_derivatives(t, 4)).collect();
+        let b: Vec<_> = ts
+            .iter()
+            .map(|&t| bspline.curve_derivatives(t, 4))
+            .collect();
+        let diff = scaled_difference(&a, &b);
+        assert!(diff < 1e-12, "degree {p}: {diff:e}");
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Finite differences on random scenes (all six types)
+// ---------------------------------------------------------------------------------------------
+
+/// Random parameters strictly inside smooth pieces of direction `dir`, with a safe step.
+fn interior_params(object: &Object, dir: usize, rng: &mut Rng, count: usize) -> Vec<(f64, f64)> {
+    let pieces: Vec<(f64, f64)> = match &object.shape {
+        Shape::Curve { basis, points, .. } => breaks(basis, points.len()),
+        Shape::Surface { basis, points, .. } => {
+            let n = if dir == 0 {
+                points.len()
+            } else {
+                points[0].len()
+            };
+            breaks(&basis[dir], n)
+        }
+        Shape::ErbsCurve { knots, .. } => knots[1..knots.len() - 1]
+            .windows(2)
+            .map(|w| (w[0], w[1]))
+            .collect(),
+        Shape::ErbsSurface { knots, .. } => {
+            let k = &knots[dir];
+            k[1..k.len() - 1].windows(2).map(|w| (w[0], w[1])).collect()
+        }
+    };
+    (0..count)
+        .map(|_| {
+            let &(a, b) = rng.pick(&pieces);
+            (
+                rng.range(a + 0.1 * (b - a), b - 0.1 * (b - a)),
+                2e-4 * (b - a),
+            )
+        })
+        .collect()
+}
+
+/// The non-empty knot spans inside the domain.
+fn breaks(basis: &Basis, n: usize) -> Vec<(f64, f64)> {
+    match basis {
+        Basis::Bezier => vec![(0.0, 1.0)],
+        Basis::BSpline { degree, knots } => (*degree..n)
+            .filter(|&i| knots[i] < knots[i + 1])
+            .map(|i| (knots[i], knots[i + 1]))
+            .collect(),
+    }
+}
+
+#[test]
+fn derivatives_match_finite_differences() {
+    let opts = Options {
+        max_samples: 6,
+        ..Options::default()
+    };
+    let order = 3;
+    let mut worst = 0.0f64;
+    for seed in 0..150 {
+        let scene = random::random_scene(seed, &Kind::ALL, &opts);
+        let mut rng = Rng::new(seed ^ 0xF00D);
+        for object in &scene.objects {
+            if object.is_surface() {
+                let params = object.params();
+                let grid = object.surface_grid(&params[0], &params[1], order + 1);
+                let mut scale = vec![vec![1.0f64; order + 2]; order + 2];
+                for cell in grid.iter().flatten() {
+                    for (a, row) in cell.iter().enumerate() {
+                        for (b, v) in row.iter().enumerate() {
+                            scale[a][b] = v.iter().fold(scale[a][b], |m, x| m.max(x.abs()));
+                        }
+                    }
+                }
+                let us = interior_params(object, 0, &mut rng, 4);
+                let vs = interior_params(object, 1, &mut rng, 4);
+                for (&(u, hu), &(v, hv)) in us.iter().zip(&vs) {
+                    let exact = object.surface_derivatives(u, v, order + 1);
+                    let flat = |d: Vec<Vec<Point3>>| -> Vec<f64> {
+                        d.iter()
+                            .take(order + 1)
+                            .flat_map(|r| {
+                                r.iter()
+                                    .take(order + 1)
+                                    .flatten()
+                                    .copied()
+                                    .collect::<Vec<_>>()
+                            })
+                            .collect()
+                    };
+                    let fd_u = richardson(|x| flat(object.surface_derivatives(x, v, order)), u, hu);
+                    let fd_v = richardson(|y| flat(object.surface_derivatives(u, y, order)), v, hv);
+                    for a in 0..=order {
+                        for b in 0..=order {
+                            // Scale: the sample grid may straddle only knots, where expo-rational
+                            // ERBS derivatives vanish; include the values at this point.
+                            let local = |d: Point3, s: f64| d.iter().fold(s, |m, x| m.max(x.abs()));
+                            let su = local(exact[a + 1][b], scale[a + 1][b]);
+                            let sv = local(exact[a][b + 1], scale[a][b + 1]);
+                            for k in 0..3 {
+                                let idx = (a * (order + 1) + b) * 3 + k;
+                                let eu = (fd_u[idx] - exact[a + 1][b][k]).abs() / su;
+                                let ev = (fd_v[idx] - exact[a][b + 1][k]).abs() / sv;
+                                worst = worst.max(eu).max(ev);
+                                assert!(
+                                    eu < 1e-6 && ev < 1e-6,
+                                    "seed {seed} {} ({a},{b})[{k}] at ({u},{v}): u {eu:e}, v {ev:e}",
+                                    object.type_name()
+                                );
+                            }
+                        }
+                    }
+                }
+            } else {
+                let params = object.params();
+                let mut scale = vec![1.0f64; order + 2];
+                for t in &params[0] {
+                    for (r, v) in object.curve_derivatives(*t, order + 1).iter().enumerate() {
+                        scale[r] = v.iter().fold(scale[r], |m, x| m.max(x.abs()));
+                    }
+                }
+                for (t, h) in interior_params(object, 0, &mut rng, 8) {
+                    let exact = object.curve_derivatives(t, order + 1);
+                    let fd = richardson(
+                        |x| {
+                            object
+                                .curve_derivatives(x, order)
+                                .into_iter()
+                                .flatten()
+                                .collect()
+                        },
+                        t,
+                        h,
+                    );
+                    for r in 0..=order {
+                        let s = exact[r + 1]
+                            .iter()
+                            .fold(scale[r + 1], |m, x| m.max(x.abs()));
+                        for k in 0..3 {
+                            let e = (fd[r * 3 + k] - exact[r + 1][k]).abs() / s;
+                            worst = worst.max(e);
+                            assert!(
+                                e < 1e-6,
+                                "seed {seed} {} order {} at {t}: {} vs FD {} ({e:e})",
+                                object.type_name(),
+                                r + 1,
+                                exact[r + 1][k],
+                                fd[r * 3 + k]
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
+    println!("random scenes: worst scaled Richardson FD error {worst:.2e}");
+}
+
+// ---------------------------------------------------------------------------------------------
+// ERBS properties
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn erbs_interpolates_local_curves_at_knots() {
+    let opts = Options::default();
+    for seed in 0..200 {
+        let mut rng = Rng::new(seed);
+        let object = random::random_object(&mut rng, Kind::ErbsCurve, "e", &opts);
+        let Shape::ErbsCurve {
+            knots,
+            locals,
+            bfunction,
+        } = &object.shape
+        else {
+            unreachable!()
+        };
+        let b = bfunction.unwrap_or(BFunction::Expo);
+        // Expo-rational: every derivative of B vanishes at 0 and 1; smootherstep: up to 2; the
+        // others: the first derivative only.
+        let smooth = match b {
+            BFunction::Expo => 4,
+            BFunction::Smootherstep => 2,
+            _ => 1,
+        };
+        for (l, local) in locals.iter().enumerate() {
+            let t = knots[l + 1];
+            let ours = object.curve_derivatives(t, smooth);
+            let direct = eval::erbs_local_curve_derivatives(knots, l, local, t, smooth);
+            for r in 0..=smooth {
+                let scale = 1.0 + direct[r].iter().fold(0.0f64, |m, x| m.max(x.abs()));
+                for k in 0..3 {
+                    assert!(
+                        close(ours[r][k], direct[r][k], 1e-13 * scale),
+                        "seed {seed} {b:?}: c^({r})(t_{}) = {:?}, local {l} gives {:?}",
+                        l + 1,
+                        ours[r],
+                        direct[r]
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn erbs_with_equal_constant_locals_is_constant() {
+    let p = [3.0, -2.0, 7.5];
+    for b in BFunction::ALL {
+        let knots = vec![0.0, 0.0, 0.7, 1.5, 2.0, 2.0];
+        let object = Object {
+            name: "e".into(),
+            shape: Shape::ErbsCurve {
+                knots: knots.clone(),
+                locals: vec![vec![p]; 4],
+                bfunction: Some(b),
+            },
+            samples: vec![2],
+        };
+        for j in 0..=40 {
+            let t = 2.0 * j as f64 / 40.0;
+            let d = object.curve_derivatives(t, 4);
+            assert_point(d[0], p, 1e-14, "constant ERBS");
+            for r in 1..=4 {
+                assert_point(d[r], [0.0; 3], 1e-11, "derivative of constant ERBS");
+            }
+        }
+        let surface = Object {
+            name: "s".into(),
+            shape: Shape::ErbsSurface {
+                knots: [knots.clone(), vec![-1.0, -1.0, 0.0, 1.0, 1.0]],
+                locals: vec![vec![vec![vec![p; 2]; 3]; 3]; 4],
+                bfunction: Some(b),
+            },
+            samples: vec![2, 2],
+        };
+        for (u, v) in [(0.0, -1.0), (0.3, 0.2), (1.5, 0.0), (2.0, 1.0)] {
+            let d = surface.surface_derivatives(u, v, 3);
+            assert_point(d[0][0], p, 1e-14, "constant ERBS surface");
+            for (a, row) in d.iter().enumerate() {
+                for (bb, x) in row.iter().enumerate() {
+                    if a + bb > 0 {
+                        assert_point(*x, [0.0; 3], 1e-10, "derivative of constant surface");
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn erbs_blend_values_by_hand() {
+    let table = reference_table();
+    let b_at = |t: f64| table.iter().find(|(x, _)| *x == t).unwrap().1[0];
+    let (p, q) = ([1.0, 2.0, 3.0], [-4.0, 0.5, 10.0]);
+    // Two constant local curves on [0, 1]: c(t) = (1 − B(t)) P + B(t) Q.
+    let curve = Object {
+        name: "e".into(),
+        shape: Shape::ErbsCurve {
+            knots: vec![0.0, 0.0, 1.0, 1.0],
+            locals: vec![vec![p], vec![q]],
+            bfunction: None,
+        },
+        samples: vec![2],
+    };
+    for t in [0.25, 0.5, 0.75] {
+        let b = b_at(t);
+        let expected = std::array::from_fn(|k| (1.0 - b) * p[k] + b * q[k]);
+        assert_point(
+            curve.curve_derivatives(t, 0)[0],
+            expected,
+            1e-15 * 10.0,
+            "ERBS blend",
+        );
+    }
+    // A linear local curve is mapped onto [t_l, t_{l+2}]: knots 0, 0, 1, 3, 3 → local 1 lives on
+    // [0, 3] and the curve passes through local 1 at s = 1/3 when t = t_2 = 1.
+    let (a, z) = ([0.0, 0.0, 0.0], [3.0, 6.0, -3.0]);
+    let curve = Object {
+        name: "e".into(),
+        shape: Shape::ErbsCurve {
+            knots: vec![0.0, 0.0, 1.0, 3.0, 3.0],
+            locals: vec![vec![p], vec![a, z], vec![q]],
+            bfunction: Some(BFunction::Smoothstep),
+        },
+        samples: vec![2],
+    };
+    let d = curve.curve_derivatives(1.0, 1);
+    assert_point(d[0], [1.0, 2.0, -1.0], 1e-15, "local curve at s = 1/3");
+    assert_point(d[1], [1.0, 2.0, -1.0], 1e-15, "local derivative (z − a)/3");
+    // 2 × 2 constant patches: S(u, v) = Σ B_k(u) B_l(v) P_kl.
+    let corners = [[p, q], [a, z]];
+    let surface = Object {
+        name: "s".into(),
+        shape: Shape::ErbsSurface {
+            knots: [vec![0.0, 0.0, 1.0, 1.0], vec![0.0, 0.0, 1.0, 1.0]],
+            locals: corners
+                .iter()
+                .map(|row| row.iter().map(|&c| vec![vec![c]]).collect())
+                .collect(),
+            bfunction: None,
+        },
+        samples: vec![2, 2],
+    };
+    let (u, v) = (0.25, 0.75);
+    let (bu, bv) = (b_at(u), b_at(v));
+    let wu = [1.0 - bu, bu];
+    let wv = [1.0 - bv, bv];
+    let expected = std::array::from_fn(|k| {
+        (0..2)
+            .map(|i| {
+                (0..2)
+                    .map(|j| wu[i] * wv[j] * corners[i][j][k])
+                    .sum::<f64>()
+            })
+            .sum()
+    });
+    assert_point(
+        surface.surface_derivatives(u, v, 0)[0][0],
+        expected,
+        1e-14,
+        "ERBS patch blend",
+    );
+}
+
+#[test]
+fn erbs_right_hand_second_derivative_at_knot() {
+    // Smoothstep is only C1 at the knots: at t_2 the interval [t_2, t_3) decides.
+    let knots = vec![0.0, 0.0, 1.0, 3.0, 3.0];
+    let locals = vec![
+        vec![[0.0, 0.0, 0.0]],
+        vec![[1.0, 0.0, 0.0], [2.0, 1.0, 0.0]],
+        vec![[5.0, 5.0, 5.0]],
+    ];
+    let object = Object {
+        name: "e".into(),
+        shape: Shape::ErbsCurve {
+            knots: knots.clone(),
+            locals: locals.clone(),
+            bfunction: Some(BFunction::Smoothstep),
+        },
+        samples: vec![2],
+    };
+    let d = object.curve_derivatives(1.0, 2);
+    // On [1, 3): c = c_1 + B(w)(c_2 − c_1), w = (t−1)/2; at w = 0: B = B' = 0, B'' = 6.
+    let c1 = eval::erbs_local_curve_derivatives(&knots, 1, &locals[1], 1.0, 2);
+    let diff = eval::sub([5.0, 5.0, 5.0], c1[0]);
+    assert_point(d[0], c1[0], 1e-15, "value");
+    assert_point(d[1], c1[1], 1e-15, "first derivative");
+    let expected = eval::add(c1[2], eval::scale(6.0 / 4.0, diff));
+    assert_point(d[2], expected, 1e-14, "right-hand second derivative");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Edits
+// ---------------------------------------------------------------------------------------------
+
+fn parse_edit(v: Value) -> Edit {
+    Edit::from_json(&v).unwrap()
+}
+
+#[test]
+fn edit_semantics() {
+    let mut scene = random::random_scene(
+        42,
+        &Kind::ALL,
+        &Options {
+            max_samples: 5,
+            ..Options::default()
+        },
+    );
+    let before = scene.sample_json(2);
+    // Identity transform and zero deltas change nothing.
+    let identity = [
+        [1.0, 0.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0, 0.0],
+        [0.0, 0.0, 0.0, 1.0],
+    ];
+    let noop = vec![
+        parse_edit(json!({"object": "o2", "local": 1, "transform": identity})),
+        parse_edit(json!({"object": "o5", "local": [1, 1], "transform": identity})),
+        parse_edit(json!({"object": "o0", "point": 0, "delta": [0.0, 0.0, 0.0]})),
+        parse_edit(json!({"object": "o4", "point": [0, 0], "delta": [0.0, 0.0, 0.0]})),
+    ];
+    apply_edits(&mut scene, &noop).unwrap();
+    assert_eq!(scene.sample_json(2), before);
+
+    // A row-major translation matrix moves every local control point by its last column.
+    let mut moved = scene.clone();
+    let shift = [
+        [1.0, 0.0, 0.0, 2.0],
+        [0.0, 1.0, 0.0, -3.0],
+        [0.0, 0.0, 1.0, 0.5],
+        [0.0, 0.0, 0.0, 1.0],
+    ];
+    apply_edits(
+        &mut moved,
+        &[parse_edit(
+            json!({"object": "o2", "local": 0, "transform": shift}),
+        )],
+    )
+    .unwrap();
+    let (Shape::ErbsCurve { locals: a, .. }, Shape::ErbsCurve { locals: b, .. }) =
+        (&scene.objects[2].shape, &moved.objects[2].shape)
+    else {
+        unreachable!()
+    };
+    for (p, q) in a[0].iter().zip(&b[0]) {
+        assert_point(
+            *q,
+            [p[0] + 2.0, p[1] - 3.0, p[2] + 0.5],
+            1e-12 * (1.0 + p[0].abs() + p[1].abs()),
+            "translated",
+        );
+    }
+    assert_eq!(a[1..], b[1..]);
+
+    // A weight of 1 on a non-rational curve makes it rational without changing it.
+    let mut plain = Scene {
+        objects: vec![curve(&LECTURE_POINTS, None, Basis::Bezier)],
+    };
+    let reference = plain.objects[0].curve_derivatives(0.3, 3);
+    apply_edits(
+        &mut plain,
+        &[parse_edit(
+            json!({"object": "c", "point": 2, "weight": 1.0}),
+        )],
+    )
+    .unwrap();
+    let Shape::Curve { weights, .. } = &plain.objects[0].shape else {
+        unreachable!()
+    };
+    assert_eq!(weights.as_deref(), Some(&[1.0, 1.0, 1.0, 1.0][..]));
+    let now = plain.objects[0].curve_derivatives(0.3, 3);
+    for r in 0..=3 {
+        assert_point(now[r], reference[r], 1e-12, "weight 1");
+    }
+    // Moving a rational point moves the Cartesian point; the weight stays.
+    apply_edits(
+        &mut plain,
+        &[parse_edit(
+            json!({"object": "c", "point": 2, "weight": 3.0}),
+        )],
+    )
+    .unwrap();
+    apply_edits(
+        &mut plain,
+        &[parse_edit(
+            json!({"object": "c", "point": 2, "delta": [1.0, 0.0, 0.0]}),
+        )],
+    )
+    .unwrap();
+    let Shape::Curve {
+        points, weights, ..
+    } = &plain.objects[0].shape
+    else {
+        unreachable!()
+    };
+    assert_eq!(points[2], [11.0, 10.0, 0.0]);
+    assert_eq!(weights.as_ref().unwrap()[2], 3.0);
+    // The end point of a rational Bézier is its last control point whatever the weights.
+    assert_point(
+        plain.objects[0].curve_derivatives(1.0, 0)[0],
+        [10.0, 1.0, 0.0],
+        1e-15,
+        "end point",
+    );
+
+    // Unknown objects, out-of-range indices and wrong kinds of edit are errors.
+    for bad in [
+        json!({"object": "nope", "point": 0, "delta": [0, 0, 0]}),
+        json!({"object": "o0", "point": 99, "delta": [0, 0, 0]}),
+        json!({"object": "o0", "point": [0, 0], "delta": [0, 0, 0]}),
+        json!({"object": "o2", "point": 0, "delta": [0, 0, 0]}),
+        json!({"object": "o2", "local": 99, "transform": identity}),
+        json!({"object": "o5", "local": [0, 0], "point": [99, 0], "delta": [0, 0, 0]}),
+    ] {
+        let mut s = scene.clone();
+        assert!(
+            apply_edits(&mut s, &[parse_edit(bad.clone())]).is_err(),
+            "accepted {bad}"
+        );
+    }
+}
+
+#[test]
+fn affine_transform_of_all_locals_transforms_the_erbs() {
+    let opts = Options::default();
+    for seed in 0..60 {
+        let mut rng = Rng::new(seed);
+        let kind = if seed % 2 == 0 {
+            Kind::ErbsCurve
+        } else {
+            Kind::ErbsSurface
+        };
+        let object = random::random_object(&mut rng, kind, "e", &opts);
+        let matrix = random::random_affine(&mut rng, object.magnitude());
+        let mut scene = Scene {
+            objects: vec![object.clone()],
+        };
+        let edits: Vec<Edit> = match &object.shape {
+            Shape::ErbsCurve { locals, .. } => (0..locals.len())
+                .map(|l| Edit::LocalTransform {
+                    object: "e".into(),
+                    local: Index::One(l),
+                    matrix,
+                })
+                .collect(),
+            Shape::ErbsSurface { locals, .. } => (0..locals.len())
+                .flat_map(|k| (0..locals[0].len()).map(move |l| (k, l)))
+                .map(|(k, l)| Edit::LocalTransform {
+                    object: "e".into(),
+                    local: Index::Two(k, l),
+                    matrix,
+                })
+                .collect(),
+            _ => unreachable!(),
+        };
+        apply_edits(&mut scene, &edits).unwrap();
+        let linear = |p: Point3| -> Point3 {
+            std::array::from_fn(|r| (0..3).map(|c| matrix[r][c] * p[c]).sum())
+        };
+        let n = 2;
+        let check = |before: Vec<Point3>, after: Vec<Point3>| {
+            let scale = 1.0
+                + before
+                    .iter()
+                    .chain(&after)
+                    .flatten()
+                    .fold(0.0f64, |m, x| m.max(x.abs()));
+            for (r, (x, y)) in before.iter().zip(&after).enumerate() {
+                let expected = if r == 0 {
+                    oracle::scene::affine(&matrix, *x)
+                } else {
+                    linear(*x)
+                };
+                assert_point(*y, expected, 1e-12 * scale, "affine invariance");
+            }
+        };
+        if object.is_surface() {
+            let params = object.params();
+            let (a, b) = (
+                object.surface_grid(&params[0], &params[1], n),
+                scene.objects[0].surface_grid(&params[0], &params[1], n),
+            );
+            for (x, y) in a.iter().flatten().zip(b.iter().flatten()) {
+                check(
+                    x.iter().flatten().copied().collect(),
+                    y.iter().flatten().copied().collect(),
+                );
+            }
+        } else {
+            for t in object.params().remove(0) {
+                check(
+                    object.curve_derivatives(t, n),
+                    scene.objects[0].curve_derivatives(t, n),
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn random_edits_are_valid_and_reversible_deltas() {
+    let opts = Options {
+        max_samples: 6,
+        ..Options::default()
+    };
+    for seed in 0..100 {
+        let scene = random::random_scene(seed, &Kind::ALL, &opts);
+        let mut rng = Rng::new(seed);
+        let edits = random::random_edits(&mut rng, &scene, 25);
+        let json_edits = Value::Array(edits.iter().map(Edit::to_json).collect());
+        let parsed = oracle::scene::parse_edits(&json_edits).unwrap();
+        assert_eq!(parsed, edits, "edit JSON round trip");
+        let mut edited = scene.clone();
+        apply_edits(&mut edited, &edits).unwrap();
+        // Edited models (e.g. objects made rational by a weight edit) stay valid scenes.
+        let reparsed = Scene::from_json(&edited.to_json()).unwrap();
+        assert_eq!(reparsed, edited, "seed {seed}: edited scene round trip");
+        // Undo the pure translations in reverse order: deltas cancel (up to rounding).
+        let deltas: Vec<Edit> = edits
+            .iter()
+            .rev()
+            .filter_map(|e| match e {
+                Edit::PointDelta {
+                    object,
+                    point,
+                    delta,
+                } => Some(Edit::PointDelta {
+                    object: object.clone(),
+                    point: *point,
+                    delta: eval::scale(-1.0, *delta),
+                }),
+                Edit::LocalPointDelta {
+                    object,
+                    local,
+                    point,
+                    delta,
+                } => Some(Edit::LocalPointDelta {
+                    object: object.clone(),
+                    local: *local,
+                    point: *point,
+                    delta: eval::scale(-1.0, *delta),
+                }),
+                _ => None,
+            })
+            .collect();
+        let only_deltas: Vec<Edit> = edits
+            .iter()
+            .filter(|e| matches!(e, Edit::PointDelta { .. } | Edit::LocalPointDelta { .. }))
+            .cloned()
+            .collect();
+        let mut round_trip = scene.clone();
+        apply_edits(&mut round_trip, &only_deltas).unwrap();
+        apply_edits(&mut round_trip, &deltas).unwrap();
+        let report = compare_output(&scene, 1, &round_trip.sample_json(1), 1e-12);
+        assert!(
+            report.ok(),
+            "seed {seed}: delta round trip\n{}",
+            report.describe()
+        );
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Scene model, sampling and the comparison used against the product
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn sample_params_follow_the_formula() {
+    assert_eq!(sample_params(0.0, 1.0, 2), vec![0.0, 1.0]);
+    assert_eq!(sample_params(-1.0, 3.0, 5), vec![-1.0, 0.0, 1.0, 2.0, 3.0]);
+    let p = sample_params(0.1, 0.7, 7);
+    assert_eq!(p[6], 0.7);
+    assert_eq!(p[3], 0.1 + (0.7 - 0.1) * (3.0 / 6.0));
+    assert!(p.windows(2).all(|w| w[0] < w[1]));
+}
+
+#[test]
+fn random_scenes_round_trip_and_sample_in_contract_shape() {
+    for seed in 0..200 {
+        let scene = random::random_scene(
+            seed,
+            &Kind::ALL,
+            &Options {
+                max_samples: 4,
+                ..Options::default()
+            },
+        );
+        let text = serde_json::to_string(&scene.to_json()).unwrap();
+        let parsed = Scene::from_json(&serde_json::from_str(&text).unwrap()).unwrap();
+        assert_eq!(parsed, scene, "seed {seed}: scene JSON round trip");
+        let n = (seed % 3) as usize;
+        let out = scene.sample_json(n);
+        for (entry, object) in out["objects"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .zip(&scene.objects)
+        {
+            assert_eq!(entry["name"], json!(object.name));
+            assert_eq!(entry["type"], json!(object.type_name()));
+            let samples = entry["samples"].as_array().unwrap();
+            if object.is_surface() {
+                assert_eq!(entry["params"].as_array().unwrap().len(), 2);
+                assert_eq!(samples.len(), object.samples[0]);
+                assert_eq!(samples[0].as_array().unwrap().len(), object.samples[1]);
+                assert_eq!(samples[0][0].as_array().unwrap().len(), n + 1);
+                assert_eq!(samples[0][0][0].as_array().unwrap().len(), n + 1);
+                assert_eq!(samples[0][0][0][0].as_array().unwrap().len(), 3);
+            } else {
+                assert_eq!(entry["params"].as_array().unwrap().len(), object.samples[0]);
+                assert_eq!(samples.len(), object.samples[0]);
+                assert_eq!(samples[0].as_array().unwrap().len(), n + 1);
+                assert_eq!(samples[0][0].as_array().unwrap().len(), 3);
+            }
+            for x in flatten_numbers(&entry["samples"]) {
+                assert!(x.is_finite());
+            }
+        }
+        let report = compare_output(&scene, n, &out, 0.0);
+        assert!(
+            report.ok(),
+            "seed {seed}: self comparison\n{}",
+            report.describe()
+        );
+    }
+}
+
+fn flatten_numbers(v: &Value) -> Vec<f64> {
+    match v {
+        Value::Array(items) => items.iter().flat_map(flatten_numbers).collect(),
+        Value::Number(x) => vec![x.as_f64().unwrap()],
+        _ => panic!("not numeric: {v}"),
+    }
+}
+
+#[test]
+fn invalid_scenes_are_rejected() {
+    let good = json!({"objects": [{"name": "c", "type": "bspline_curve", "degree": 2,
+        "knots": [0, 0, 0, 1, 1, 1], "points": [[0,0,0],[1,1,0],[2,0,0]], "samples": 5}]});
+    assert!(Scene::from_json(&good).is_ok());
+    let mut cases = Vec::new();
+    for (key, value) in [
+        ("knots", json!([0, 0, 1, 1, 1])),
+        ("knots", json!([0, 0, 0, 1, 0.5, 1])),
+        ("degree", json!(3)),
+        ("samples", json!(1)),
+        ("extra", json!(1)),
+        ("points", json!([[0, 0], [1, 1, 0], [2, 0, 0]])),
+    ] {
+        let mut bad = good.clone();
+        bad["objects"][0][key] = value;
+        cases.push(bad);
+    }
+    cases.push(json!({"objects": [{"name": "e", "type": "erbs_curve", "knots": [0, 0, 1, 1],
+        "local": [{"points": [[0,0,0]]}, {"points": [[1,0,0]]}], "bfunction": "cubic", "samples": 3}]}));
+    cases.push(
+        json!({"objects": [{"name": "e", "type": "erbs_curve", "knots": [0, 0.5, 1, 1],
+        "local": [{"points": [[0,0,0]]}, {"points": [[1,0,0]]}], "samples": 3}]}),
+    );
+    for bad in cases {
+        assert!(Scene::from_json(&bad).is_err(), "accepted {bad}");
+    }
+}
+
+#[test]
+fn comparison_detects_mismatches() {
+    let scene = random::random_scene(
+        5,
+        &Kind::ALL,
+        &Options {
+            max_samples: 5,
+            ..Options::default()
+        },
+    );
+    let n = 2;
+    let out = scene.sample_json(n);
+    assert!(compare_output(&scene, n, &out, 1e-12).ok());
+
+    // One perturbed number in a surface: reported with its location.
+    let mut bad = out.clone();
+    let x = bad["objects"][4]["samples"][1][0][1][0][2]
+        .as_f64()
+        .unwrap();
+    bad["objects"][4]["samples"][1][0][1][0][2] = json!(x + 1e-6 * (1.0 + x.abs()));
+    let report = compare_output(&scene, n, &bad, 1e-12);
+    assert_eq!(report.mismatch_count, 1, "{}", report.describe());
+    assert!(
+        report.mismatches[0]
+            .location
+            .starts_with("samples[1][0][1][0] "),
+        "{}",
+        report.describe()
+    );
+    assert!(report.mismatches[0].location.ends_with("[2]"));
+
+    // A tiny relative perturbation passes.
+    let mut fine = out.clone();
+    let x = fine["objects"][1]["samples"][0][1][0].as_f64().unwrap();
+    fine["objects"][1]["samples"][0][1][0] = json!(x * (1.0 + 1e-15));
+    assert!(compare_output(&scene, n, &fine, 1e-12).ok());
+
+    // Structural problems.
+    let mut missing = out.clone();
+    missing["objects"].as_array_mut().unwrap().remove(3);
+    assert!(!compare_output(&scene, n, &missing, 1e-12).ok());
+    let mut params = out.clone();
+    let t = params["objects"][0]["params"][1].as_f64().unwrap();
+    params["objects"][0]["params"][1] = json!(t + 1e-9);
+    assert!(
+        !compare_output(&scene, n, &params, 1e-12)
+            .problems
+            .is_empty()
+    );
+    let mut shape = out.clone();
+    shape["objects"][0]["samples"][0]
+        .as_array_mut()
+        .unwrap()
+        .pop();
+    assert!(!compare_output(&scene, n, &shape, 1e-12).problems.is_empty());
+    assert!(
+        !compare_output(&scene, n + 1, &out, 1e-12).ok(),
+        "wrong derivative count"
+    );
+}
+
+/// The generator really produces the features the agreement test relies on.
+#[test]
+fn random_generator_covers_the_contract() {
+    use std::collections::BTreeMap;
+    let mut seen: BTreeMap<&str, usize> = BTreeMap::new();
+    let mut mark = |key: &'static str, yes: bool| {
+        if yes {
+            *seen.entry(key).or_default() += 1;
+        }
+    };
+    let opts = Options::default();
+    for seed in 0..300 {
+        let scene = random::random_scene(seed, &Kind::ALL, &opts);
+        for object in &scene.objects {
+            let params = object.params();
+            mark("2 samples", object.samples.contains(&2));
+            mark("40 samples", object.samples.contains(&40));
+            let mut knot_checks: Vec<(usize, &Vec<f64>, usize)> = Vec::new();
+            match &object.shape {
+                Shape::Curve {
+                    basis,
+                    points,
+                    weights,
+                } => {
+                    mark("rational curve", weights.is_some());
+                    if let Basis::BSpline { degree, knots } = basis {
+                        knot_checks.push((*degree, knots, points.len()));
+                    } else {
+                        mark("bezier degree 0", points.len() == 1);
+                        mark("bezier degree > 5", points.len() > 6);
+                    }
+                }
+                Shape::Surface {
+                    basis,
+                    points,
+                    weights,
+                } => {
+                    mark("rational surface", weights.is_some());
+                    for (dir, b) in basis.iter().enumerate() {
+                        if let Basis::BSpline { degree, knots } = b {
+                            let n = if dir == 0 {
+                                points.len()
+                            } else {
+                                points[0].len()
+                            };
+                            knot_checks.push((*degree, knots, n));
+                        }
+                    }
+                }
+                Shape::ErbsCurve {
+                    knots,
+                    locals,
+                    bfunction,
+                } => {
+                    mark(
+                        bfunction.map_or("erbs default bfunction", |b| b.name()),
+                        true,
+                    );
+                    mark("erbs constant local", locals.iter().any(|l| l.len() == 1));
+                    let interior = &knots[2..knots.len() - 2];
+                    mark(
+                        "erbs param on knot",
+                        params[0].iter().any(|t| interior.contains(t)),
+                    );
+                }
+                Shape::ErbsSurface {
+                    bfunction, locals, ..
+                } => {
+                    mark(
+                        bfunction.map_or("erbs default bfunction", |b| b.name()),
+                        true,
+                    );
+                    mark(
+                        "erbs patch of degree 0 in u",
+                        locals.iter().flatten().any(|g| g.len() == 1),
+                    );
+                }
+            }
+            for (p, knots, n) in knot_checks {
+                mark("bspline degree 0", p == 0);
+                mark("bspline degree > 5", p > 5);
+                let clamped_start = knots[0] == knots[p];
+                mark("clamped start", clamped_start && p > 0);
+                mark("unclamped start", !clamped_start);
+                // Largest multiplicity of a knot value strictly inside the domain.
+                let (a, b) = (knots[p], knots[n]);
+                let max_interior = knots
+                    .iter()
+                    .filter(|&&k| k > a && k < b)
+                    .map(|k| knots.iter().filter(|&&x| x == *k).count())
+                    .max()
+                    .unwrap_or(0);
+                mark(
+                    "interior multiplicity 2..=p",
+                    max_interior >= 2 && max_interior <= p,
+                );
+                mark("interior multiplicity p+1", p > 0 && max_interior == p + 1);
+                let interior: Vec<f64> =
+                    knots.iter().copied().filter(|&k| k > a && k < b).collect();
+                mark(
+                    "bspline param on interior knot",
+                    params.iter().flatten().any(|t| interior.contains(t)),
+                );
+            }
+        }
+    }
+    println!("{seen:#?}");
+    for key in [
+        "2 samples",
+        "40 samples",
+        "rational curve",
+        "rational surface",
+        "bezier degree 0",
+        "bezier degree > 5",
+        "bspline degree 0",
+        "bspline degree > 5",
+        "clamped start",
+        "unclamped start",
+        "interior multiplicity 2..=p",
+        "interior multiplicity p+1",
+        "bspline param on interior knot",
+        "erbs default bfunction",
+        "expo",
+        "smoothstep",
+        "smootherstep",
+        "trigonometric",
+        "rational",
+        "erbs constant local",
+        "erbs param on knot",
+        "erbs patch of degree 0 in u",
+    ] {
+        assert!(
+            seen.get(key).copied().unwrap_or(0) >= 3,
+            "generator rarely produces {key:?}: {seen:?}"
+        );
+    }
+}
