@@ -2,7 +2,7 @@
 // Numerical kernels index several arrays with the same loop counter (basis rows, control points,
 // derivative orders); iterator zips would obscure the textbook algorithms they follow.
 #![allow(clippy::needless_range_loop)]
-pub mod geom;
-pub mod scene;
-pub mod sampling;
 pub mod cli;
+pub mod geom;
+pub mod sampling;
+pub mod scene;

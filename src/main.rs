@@ -7,7 +7,11 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "prespline", version, about = "Pre-evaluated interactive editing of Bézier, B-spline, NURBS and ERBS curves and surfaces")]
+#[command(
+    name = "prespline",
+    version,
+    about = "Pre-evaluated interactive editing of Bézier, B-spline, NURBS and ERBS curves and surfaces"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -34,8 +38,18 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Sample { scene, derivatives, edits, full } => {
-            let args = cli::sample::SampleArgs { scene: &scene, derivatives, edits: edits.as_deref(), full };
+        Command::Sample {
+            scene,
+            derivatives,
+            edits,
+            full,
+        } => {
+            let args = cli::sample::SampleArgs {
+                scene: &scene,
+                derivatives,
+                edits: edits.as_deref(),
+                full,
+            };
             cli::sample::run(&args).and_then(|text| print(&text))
         }
     };

@@ -42,10 +42,17 @@ pub fn run(args: &SampleArgs) -> Result<String, CliError> {
     let mode = SampleMode::Derivatives(args.derivatives);
     let objects: Vec<SampledObject> = if args.full {
         apply_all(&mut scene, &edits);
-        scene.objects.iter().map(|o| SampledObject::new(&o.shape, o.samples, mode)).collect()
+        scene
+            .objects
+            .iter()
+            .map(|o| SampledObject::new(&o.shape, o.samples, mode))
+            .collect()
     } else {
-        let mut objects: Vec<SampledObject> =
-            scene.objects.iter().map(|o| SampledObject::new(&o.shape, o.samples, mode)).collect();
+        let mut objects: Vec<SampledObject> = scene
+            .objects
+            .iter()
+            .map(|o| SampledObject::new(&o.shape, o.samples, mode))
+            .collect();
         for e in &edits {
             objects[e.object].apply(&e.op);
         }
@@ -61,7 +68,12 @@ pub fn run(args: &SampleArgs) -> Result<String, CliError> {
     Ok(out)
 }
 
-fn write_object(out: &mut String, name: &str, shape: &Shape, obj: &SampledObject) -> Result<(), CliError> {
+fn write_object(
+    out: &mut String,
+    name: &str,
+    shape: &Shape,
+    obj: &SampledObject,
+) -> Result<(), CliError> {
     let grid = obj.grid();
     if let Some(bad) = grid.data.iter().position(|v| !v.is_finite()) {
         return Err(CliError(format!(
@@ -70,7 +82,11 @@ fn write_object(out: &mut String, name: &str, shape: &Shape, obj: &SampledObject
         )));
     }
     let name_json = serde_json::to_string(name).expect("strings serialise");
-    let _ = write!(out, "  {{\"name\": {name_json}, \"type\": \"{}\", \"params\": ", shape.type_name());
+    let _ = write!(
+        out,
+        "  {{\"name\": {name_json}, \"type\": \"{}\", \"params\": ",
+        shape.type_name()
+    );
     let params = obj.params();
     let g = grid.partials.max_order() + 1;
     if shape.is_surface() {

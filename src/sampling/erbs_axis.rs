@@ -37,7 +37,13 @@ impl ErbsAxis {
                 start..end
             })
             .collect();
-        Self { params, spans, order, blend, ranges }
+        Self {
+            params,
+            spans,
+            order,
+            blend,
+            ranges,
+        }
     }
 
     /// Samples in the support of local curve l.
@@ -57,5 +63,7 @@ impl ErbsAxis {
 
 /// Leibniz terms ∂^r(W·c) = Σ_k C(r,k) W^(r−k) c^(k), per output order, as (C(r,k), r−k, k).
 pub fn leibniz_terms(g: usize) -> Vec<Vec<(f64, usize, usize)>> {
-    (0..=g).map(|r| (0..=r).map(|k| (binomial(r, k), r - k, k)).collect()).collect()
+    (0..=g)
+        .map(|r| (0..=r).map(|k| (binomial(r, k), r - k, k)).collect())
+        .collect()
 }

@@ -39,12 +39,28 @@ impl ErbsCurveSampler {
                 let range = axis.range(l);
                 let deg = c.degree();
                 let kv = KnotVector::bezier(deg, knots[l], knots[l + 2]);
-                let table = HermiteTable::at_params(&kv, deg, deg + 1, axis.params[range.clone()].to_vec(), order);
-                LocalSamples { first: range.start, table, samples: vec![DVec3::ZERO; range.len() * (order + 1)] }
+                let table = HermiteTable::at_params(
+                    &kv,
+                    deg,
+                    deg + 1,
+                    axis.params[range.clone()].to_vec(),
+                    order,
+                );
+                LocalSamples {
+                    first: range.start,
+                    table,
+                    samples: vec![DVec3::ZERO; range.len() * (order + 1)],
+                }
             })
             .collect();
         let grid = SampleGrid::new([samples, 1], PartialSet::Curve(order), false);
-        let mut s = Self { curve, axis, local, terms: leibniz_terms(order), grid };
+        let mut s = Self {
+            curve,
+            axis,
+            local,
+            terms: leibniz_terms(order),
+            grid,
+        };
         s.full();
         s
     }
@@ -90,7 +106,11 @@ impl ErbsCurveSampler {
         let loc = &mut self.local[l];
         let mut delta = vec![DVec3::ZERO; loc.samples.len()];
         for (idx, (d, s)) in delta.iter_mut().zip(loc.samples.iter_mut()).enumerate() {
-            let moved = if idx % g1 == 0 { a.transform_point3(*s) } else { a.transform_vector3(*s) };
+            let moved = if idx % g1 == 0 {
+                a.transform_point3(*s)
+            } else {
+                a.transform_vector3(*s)
+            };
             *d = moved - *s;
             *s = moved;
         }

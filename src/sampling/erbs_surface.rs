@@ -45,14 +45,24 @@ impl ErbsSurfaceSampler {
             ErbsAxis::new(kv, surface.bfunction(), samples[1], g),
         ];
         let partials = set.list();
-        let slot = |a: usize, b: usize| partials.iter().position(|&p| p == (a, b)).expect("downward closed");
+        let slot = |a: usize, b: usize| {
+            partials
+                .iter()
+                .position(|&p| p == (a, b))
+                .expect("downward closed")
+        };
         let terms = partials
             .iter()
             .map(|&(a, b)| {
                 let mut t = Vec::new();
                 for a2 in 0..=a {
                     for b2 in 0..=b {
-                        t.push((binomial(a, a2) * binomial(b, b2), a - a2, b - b2, slot(a2, b2)));
+                        t.push((
+                            binomial(a, a2) * binomial(b, b2),
+                            a - a2,
+                            b - b2,
+                            slot(a2, b2),
+                        ));
                     }
                 }
                 t
@@ -81,11 +91,23 @@ impl ErbsSurfaceSampler {
                     g,
                 );
                 let n = rows.len() * cols.len() * stride;
-                patches.push(LocalPatch { rows, cols, tables: [tu, tv], samples: vec![DVec3::ZERO; n] });
+                patches.push(LocalPatch {
+                    rows,
+                    cols,
+                    tables: [tu, tv],
+                    samples: vec![DVec3::ZERO; n],
+                });
             }
         }
         let grid = SampleGrid::new(samples, set, normals);
-        let mut s = Self { surface, axes, partials, terms, patches, grid };
+        let mut s = Self {
+            surface,
+            axes,
+            partials,
+            terms,
+            patches,
+            grid,
+        };
         s.full();
         s
     }
@@ -113,7 +135,10 @@ impl ErbsSurfaceSampler {
         }
         let [mu, mv] = self.grid.dims;
         self.update_normals(0..mu, 0..mv);
-        DirtyRegion::Surface { rows: 0..mu, cols: 0..mv }
+        DirtyRegion::Surface {
+            rows: 0..mu,
+            cols: 0..mv,
+        }
     }
 
     fn sample_patch(&mut self, idx: usize) {
@@ -127,7 +152,15 @@ impl ErbsSurfaceSampler {
             width: p.cols.len(),
             stride: self.partials.len(),
         };
-        two_pass(&p.tables[0], &p.tables[1], patch.points(), patch.count()[1], &self.partials, &rect, &mut p.samples);
+        two_pass(
+            &p.tables[0],
+            &p.tables[1],
+            patch.points(),
+            patch.count()[1],
+            &self.partials,
+            &rect,
+            &mut p.samples,
+        );
     }
 
     /// Affine map of local patch (k, l): Δs = A·s − s on its pre-sampled partials (positions as
@@ -139,7 +172,11 @@ impl ErbsSurfaceSampler {
         let p = &mut self.patches[idx];
         let mut delta = vec![DVec3::ZERO; p.samples.len()];
         for (n, (d, s)) in delta.iter_mut().zip(p.samples.iter_mut()).enumerate() {
-            let moved = if n % stride == 0 { a.transform_point3(*s) } else { a.transform_vector3(*s) };
+            let moved = if n % stride == 0 {
+                a.transform_point3(*s)
+            } else {
+                a.transform_vector3(*s)
+            };
             *d = moved - *s;
             *s = moved;
         }
@@ -147,7 +184,14 @@ impl ErbsSurfaceSampler {
     }
 
     /// Moves control point (qa, qb) of local patch (k, l): Δs^(ab) = Mu[a][qa] Mv[b][qb] Δ.
-    pub fn translate_local_point(&mut self, k: usize, l: usize, qa: usize, qb: usize, delta: DVec3) -> DirtyRegion {
+    pub fn translate_local_point(
+        &mut self,
+        k: usize,
+        l: usize,
+        qa: usize,
+        qb: usize,
+        delta: DVec3,
+    ) -> DirtyRegion {
         self.surface.translate_local_point(k, l, qa, qb, delta);
         let idx = k * self.surface.count()[1] + l;
         let stride = self.partials.len();
@@ -158,7 +202,8 @@ impl ErbsSurfaceSampler {
             for lj in 0..width {
                 let base = (li * width + lj) * stride;
                 for (slot, &(a, b)) in self.partials.iter().enumerate() {
-                    let c = p.tables[0].row(li, a).map_or(0.0, |r| r[qa]) * p.tables[1].row(lj, b).map_or(0.0, |r| r[qb]);
+                    let c = p.tables[0].row(li, a).map_or(0.0, |r| r[qa])
+                        * p.tables[1].row(lj, b).map_or(0.0, |r| r[qb]);
                     d[base + slot] = delta * c;
                     p.samples[base + slot] += delta * c;
                 }
@@ -174,7 +219,10 @@ impl ErbsSurfaceSampler {
 
     fn finish(&mut self, idx: usize, delta: &[DVec3]) -> DirtyRegion {
         let region = self.blend_in(idx, delta);
-        let (rows, cols) = (self.patches[idx].rows.clone(), self.patches[idx].cols.clone());
+        let (rows, cols) = (
+            self.patches[idx].rows.clone(),
+            self.patches[idx].cols.clone(),
+        );
         self.update_normals(rows, cols);
         region
     }
@@ -191,7 +239,8 @@ impl ErbsSurfaceSampler {
             let wu = self.axes[0].weights(i, k);
             for j in p.cols.clone() {
                 let wv = self.axes[1].weights(j, l);
-                let d = &delta[((i - p.rows.start) * width + (j - p.cols.start)) * stride..][..stride];
+                let d =
+                    &delta[((i - p.rows.start) * width + (j - p.cols.start)) * stride..][..stride];
                 let out = &mut self.grid.data[(i * mv + j) * stride..][..stride];
                 for (slot, terms) in self.terms.iter().enumerate() {
                     let mut acc = DVec3::ZERO;
@@ -202,11 +251,17 @@ impl ErbsSurfaceSampler {
                 }
             }
         }
-        DirtyRegion::Surface { rows: p.rows.clone(), cols: p.cols.clone() }
+        DirtyRegion::Surface {
+            rows: p.rows.clone(),
+            cols: p.cols.clone(),
+        }
     }
 
     fn update_normals(&mut self, rows: Range<usize>, cols: Range<usize>) {
-        let params = [self.axes[0].params.as_slice(), self.axes[1].params.as_slice()];
+        let params = [
+            self.axes[0].params.as_slice(),
+            self.axes[1].params.as_slice(),
+        ];
         super::normals::update(&mut self.grid, rows, cols, params, &self.surface);
     }
 }

@@ -32,7 +32,9 @@ pub fn exact_grid(shape: &Shape, samples: Samples, set: &PartialSet) -> SampleGr
             for (i, &u) in pu.iter().enumerate() {
                 for (j, &v) in pv.iter().enumerate() {
                     let p = match shape {
-                        Shape::BezierSurface(s) | Shape::BSplineSurface(s) => s.derivatives(u, v, g),
+                        Shape::BezierSurface(s) | Shape::BSplineSurface(s) => {
+                            s.derivatives(u, v, g)
+                        }
                         Shape::ErbsSurface(s) => s.derivatives(u, v, g),
                         _ => unreachable!("surface samples for a curve"),
                     };

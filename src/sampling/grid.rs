@@ -68,7 +68,12 @@ impl SampleGrid {
     pub fn new(dims: [usize; 2], partials: PartialSet, with_normals: bool) -> Self {
         let n = dims[0] * dims[1];
         let stride = partials.len();
-        Self { dims, partials, data: vec![DVec3::ZERO; n * stride], normals: with_normals.then(|| vec![DVec3::Z; n]) }
+        Self {
+            dims,
+            partials,
+            data: vec![DVec3::ZERO; n * stride],
+            normals: with_normals.then(|| vec![DVec3::Z; n]),
+        }
     }
 
     #[inline]
@@ -99,7 +104,11 @@ impl SampleGrid {
 
     /// Largest |component| over every stored value of partial slot p (for relative tolerances).
     pub fn scale(&self, p: usize) -> f64 {
-        self.data.iter().skip(p).step_by(self.stride()).fold(0.0, |m, v| m.max(v.abs().max_element()))
+        self.data
+            .iter()
+            .skip(p)
+            .step_by(self.stride())
+            .fold(0.0, |m, v| m.max(v.abs().max_element()))
     }
 
     /// Largest absolute difference to another grid of the same shape, per partial slot,

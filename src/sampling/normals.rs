@@ -13,10 +13,21 @@ pub trait NormalSource {
 }
 
 /// Recomputes normals of the samples in `rows × cols` from the stored Su, Sv.
-pub fn update(grid: &mut SampleGrid, rows: Range<usize>, cols: Range<usize>, params: [&[f64]; 2], model: &impl NormalSource) {
-    let Some(normals) = grid.normals.as_mut() else { return };
+pub fn update(
+    grid: &mut SampleGrid,
+    rows: Range<usize>,
+    cols: Range<usize>,
+    params: [&[f64]; 2],
+    model: &impl NormalSource,
+) {
+    let Some(normals) = grid.normals.as_mut() else {
+        return;
+    };
     let stride = grid.partials.len();
-    let (iu, iv) = (grid.partials.index(1, 0).expect("normals need Su"), grid.partials.index(0, 1).expect("normals need Sv"));
+    let (iu, iv) = (
+        grid.partials.index(1, 0).expect("normals need Su"),
+        grid.partials.index(0, 1).expect("normals need Sv"),
+    );
     let mv = grid.dims[1];
     for i in rows {
         for j in cols.clone() {

@@ -50,9 +50,16 @@ impl SampledObject {
             (Shape::BezierCurve(c) | Shape::BSplineCurve(c), Samples::Curve(m)) => {
                 Sampler::SplineCurve(SplineCurveSampler::new(c.clone(), m, curve_order))
             }
-            (Shape::ErbsCurve(c), Samples::Curve(m)) => Sampler::ErbsCurve(ErbsCurveSampler::new(c.clone(), m, curve_order)),
+            (Shape::ErbsCurve(c), Samples::Curve(m)) => {
+                Sampler::ErbsCurve(ErbsCurveSampler::new(c.clone(), m, curve_order))
+            }
             (Shape::BezierSurface(s) | Shape::BSplineSurface(s), Samples::Surface(m)) => {
-                Sampler::SplineSurface(SplineSurfaceSampler::new(s.clone(), m, surface_set, normals))
+                Sampler::SplineSurface(SplineSurfaceSampler::new(
+                    s.clone(),
+                    m,
+                    surface_set,
+                    normals,
+                ))
             }
             (Shape::ErbsSurface(s), Samples::Surface(m)) => {
                 Sampler::ErbsSurface(ErbsSurfaceSampler::new(s.clone(), m, surface_set, normals))
@@ -99,10 +106,14 @@ impl SampledObject {
     /// The current model (after every applied edit).
     pub fn shape(&self) -> Shape {
         match &self.sampler {
-            Sampler::SplineCurve(s) if self.type_name == "bezier_curve" => Shape::BezierCurve(s.curve().clone()),
+            Sampler::SplineCurve(s) if self.type_name == "bezier_curve" => {
+                Shape::BezierCurve(s.curve().clone())
+            }
             Sampler::SplineCurve(s) => Shape::BSplineCurve(s.curve().clone()),
             Sampler::ErbsCurve(s) => Shape::ErbsCurve(s.curve().clone()),
-            Sampler::SplineSurface(s) if self.type_name == "bezier_surface" => Shape::BezierSurface(s.surface().clone()),
+            Sampler::SplineSurface(s) if self.type_name == "bezier_surface" => {
+                Shape::BezierSurface(s.surface().clone())
+            }
             Sampler::SplineSurface(s) => Shape::BSplineSurface(s.surface().clone()),
             Sampler::ErbsSurface(s) => Shape::ErbsSurface(s.surface().clone()),
         }
@@ -111,29 +122,76 @@ impl SampledObject {
     /// Applies a validated edit through the delta path; returns the samples it touched.
     pub fn apply(&mut self, op: &EditOp) -> DirtyRegion {
         let region = match (&mut self.sampler, op) {
-            (Sampler::SplineCurve(s), EditOp::TranslatePoint { point: Index2::One(k), delta }) => s.translate_point(*k, *delta),
-            (Sampler::SplineCurve(s), EditOp::SetWeight { point: Index2::One(k), weight }) => s.set_weight(*k, *weight),
-            (Sampler::SplineSurface(s), EditOp::TranslatePoint { point: Index2::Two(k, l), delta }) => {
-                s.translate_point(*k, *l, *delta)
-            }
-            (Sampler::SplineSurface(s), EditOp::SetWeight { point: Index2::Two(k, l), weight }) => s.set_weight(*k, *l, *weight),
-            (Sampler::ErbsCurve(s), EditOp::TransformLocal { local: Index2::One(l), matrix }) => s.transform_local(*l, matrix),
+            (
+                Sampler::SplineCurve(s),
+                EditOp::TranslatePoint {
+                    point: Index2::One(k),
+                    delta,
+                },
+            ) => s.translate_point(*k, *delta),
+            (
+                Sampler::SplineCurve(s),
+                EditOp::SetWeight {
+                    point: Index2::One(k),
+                    weight,
+                },
+            ) => s.set_weight(*k, *weight),
+            (
+                Sampler::SplineSurface(s),
+                EditOp::TranslatePoint {
+                    point: Index2::Two(k, l),
+                    delta,
+                },
+            ) => s.translate_point(*k, *l, *delta),
+            (
+                Sampler::SplineSurface(s),
+                EditOp::SetWeight {
+                    point: Index2::Two(k, l),
+                    weight,
+                },
+            ) => s.set_weight(*k, *l, *weight),
             (
                 Sampler::ErbsCurve(s),
-                EditOp::TranslateLocalPoint { local: Index2::One(l), point: Index2::One(q), delta },
+                EditOp::TransformLocal {
+                    local: Index2::One(l),
+                    matrix,
+                },
+            ) => s.transform_local(*l, matrix),
+            (
+                Sampler::ErbsCurve(s),
+                EditOp::TranslateLocalPoint {
+                    local: Index2::One(l),
+                    point: Index2::One(q),
+                    delta,
+                },
             ) => s.translate_local_point(*l, *q, *delta),
-            (Sampler::ErbsSurface(s), EditOp::TransformLocal { local: Index2::Two(k, l), matrix }) => {
-                s.transform_local(*k, *l, matrix)
-            }
             (
                 Sampler::ErbsSurface(s),
-                EditOp::TranslateLocalPoint { local: Index2::Two(k, l), point: Index2::Two(a, b), delta },
+                EditOp::TransformLocal {
+                    local: Index2::Two(k, l),
+                    matrix,
+                },
+            ) => s.transform_local(*k, *l, matrix),
+            (
+                Sampler::ErbsSurface(s),
+                EditOp::TranslateLocalPoint {
+                    local: Index2::Two(k, l),
+                    point: Index2::Two(a, b),
+                    delta,
+                },
             ) => s.translate_local_point(*k, *l, *a, *b, *delta),
-            (_, op) => panic!("edit {op:?} does not fit a {} (validate first)", self.type_name),
+            (_, op) => panic!(
+                "edit {op:?} does not fit a {} (validate first)",
+                self.type_name
+            ),
         };
-        self.touched = std::mem::replace(&mut self.touched, DirtyRegion::Nothing).union(region.clone());
+        self.touched =
+            std::mem::replace(&mut self.touched, DirtyRegion::Nothing).union(region.clone());
         self.edits_since_rebuild += 1;
-        if self.rebuild_interval.is_some_and(|n| self.edits_since_rebuild >= n) {
+        if self
+            .rebuild_interval
+            .is_some_and(|n| self.edits_since_rebuild >= n)
+        {
             self.rebuild_touched();
         }
         region
@@ -146,7 +204,9 @@ impl SampledObject {
         match (&mut self.sampler, touched) {
             (_, DirtyRegion::Nothing) => DirtyRegion::Nothing,
             (Sampler::SplineCurve(s), DirtyRegion::Curve(r)) => s.rebuild(r),
-            (Sampler::SplineSurface(s), DirtyRegion::Surface { rows, cols }) => s.rebuild(rows, cols),
+            (Sampler::SplineSurface(s), DirtyRegion::Surface { rows, cols }) => {
+                s.rebuild(rows, cols)
+            }
             (Sampler::ErbsCurve(s), _) => s.full(),
             (Sampler::ErbsSurface(s), _) => s.rebuild(),
             (_, region) => panic!("region {region:?} does not fit a {}", self.type_name),

@@ -15,7 +15,11 @@ pub struct QuotientRule {
 impl QuotientRule {
     pub fn new(set: &PartialSet) -> Self {
         let list = set.list();
-        let slot = |a: usize, b: usize| list.iter().position(|&p| p == (a, b)).expect("downward-closed set");
+        let slot = |a: usize, b: usize| {
+            list.iter()
+                .position(|&p| p == (a, b))
+                .expect("downward-closed set")
+        };
         let terms = list
             .iter()
             .map(|&(k, l)| {
@@ -23,7 +27,11 @@ impl QuotientRule {
                 for i in 0..=k {
                     for j in 0..=l {
                         if (i, j) != (0, 0) {
-                            t.push((binomial(k, i) * binomial(l, j), slot(i, j), slot(k - i, l - j)));
+                            t.push((
+                                binomial(k, i) * binomial(l, j),
+                                slot(i, j),
+                                slot(k - i, l - j),
+                            ));
                         }
                     }
                 }
@@ -54,7 +62,11 @@ mod tests {
 
     #[test]
     fn matches_the_curve_rule() {
-        let h = [DVec4::new(1.0, 2.0, 3.0, 0.7), DVec4::new(-0.5, 0.3, 1.0, 0.2), DVec4::new(0.1, -2.0, 0.4, -0.3)];
+        let h = [
+            DVec4::new(1.0, 2.0, 3.0, 0.7),
+            DVec4::new(-0.5, 0.3, 1.0, 0.2),
+            DVec4::new(0.1, -2.0, 0.4, -0.3),
+        ];
         let mut a = [DVec3::ZERO; 3];
         let mut b = [DVec3::ZERO; 3];
         rational_curve_derivs(&h, &mut a);

@@ -26,7 +26,13 @@ impl SplineCurveSampler {
         let table = HermiteTable::new(curve.knots(), curve.degree(), n, samples, order);
         let set = PartialSet::Curve(order);
         let grid = SampleGrid::new([samples, 1], set.clone(), false);
-        let mut s = Self { curve, table, grid, hom: None, rule: QuotientRule::new(&set) };
+        let mut s = Self {
+            curve,
+            table,
+            grid,
+            hom: None,
+            rule: QuotientRule::new(&set),
+        };
         s.full();
         s
     }
@@ -45,7 +51,10 @@ impl SplineCurveSampler {
 
     /// Full sampling from the pre-evaluated matrices: P_j = M_j · c.
     pub fn full(&mut self) -> DirtyRegion {
-        self.hom = self.curve.is_rational().then(|| vec![DVec4::ZERO; self.grid.data.len()]);
+        self.hom = self
+            .curve
+            .is_rational()
+            .then(|| vec![DVec4::ZERO; self.grid.data.len()]);
         self.rebuild(0..self.table.len())
     }
 
@@ -75,7 +84,10 @@ impl SplineCurveSampler {
                             None => DVec4::ZERO,
                         };
                     }
-                    self.rule.project(&hom[j * g..(j + 1) * g], &mut self.grid.data[j * g..(j + 1) * g]);
+                    self.rule.project(
+                        &hom[j * g..(j + 1) * g],
+                        &mut self.grid.data[j * g..(j + 1) * g],
+                    );
                 }
             }
         }
@@ -127,7 +139,10 @@ impl SplineCurveSampler {
     fn add_homogeneous(&mut self, k: usize, dh: DVec4) -> DirtyRegion {
         let g = self.grid.stride();
         let rows = g.min(self.table.degree() + 1);
-        let hom = self.hom.as_mut().expect("rational curves keep homogeneous samples");
+        let hom = self
+            .hom
+            .as_mut()
+            .expect("rational curves keep homogeneous samples");
         let range = self.table.range(k);
         for j in range.clone() {
             let col = k - self.table.first(j);
@@ -135,7 +150,10 @@ impl SplineCurveSampler {
                 let c = self.table.row(j, r).expect("r ≤ degree")[col];
                 hom[j * g + r] += dh * c;
             }
-            self.rule.project(&hom[j * g..(j + 1) * g], &mut self.grid.data[j * g..(j + 1) * g]);
+            self.rule.project(
+                &hom[j * g..(j + 1) * g],
+                &mut self.grid.data[j * g..(j + 1) * g],
+            );
         }
         DirtyRegion::Curve(range)
     }

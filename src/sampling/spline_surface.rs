@@ -27,16 +27,31 @@ pub struct SplineSurfaceSampler {
 impl SplineSurfaceSampler {
     /// Samples `samples = [mu, mv]` over the domain; `normals` adds unit normals (needs a set with
     /// first partials).
-    pub fn new(surface: TensorSurface, samples: [usize; 2], set: PartialSet, normals: bool) -> Self {
+    pub fn new(
+        surface: TensorSurface,
+        samples: [usize; 2],
+        set: PartialSet,
+        normals: bool,
+    ) -> Self {
         let g = set.max_order();
         let [nu, nv] = surface.count();
         let [du, dv] = surface.degree();
         let [ku, kv] = surface.knots();
-        let tables = [HermiteTable::new(ku, du, nu, samples[0], g), HermiteTable::new(kv, dv, nv, samples[1], g)];
+        let tables = [
+            HermiteTable::new(ku, du, nu, samples[0], g),
+            HermiteTable::new(kv, dv, nv, samples[1], g),
+        ];
         let grid = SampleGrid::new(samples, set.clone(), normals);
         let partials = set.list();
         let rule = QuotientRule::new(&set);
-        let mut s = Self { surface, tables, grid, partials, hom: None, rule };
+        let mut s = Self {
+            surface,
+            tables,
+            grid,
+            partials,
+            hom: None,
+            rule,
+        };
         s.full();
         s
     }
@@ -54,7 +69,10 @@ impl SplineSurfaceSampler {
     }
 
     pub fn full(&mut self) -> DirtyRegion {
-        self.hom = self.surface.is_rational().then(|| vec![DVec4::ZERO; self.grid.data.len()]);
+        self.hom = self
+            .surface
+            .is_rational()
+            .then(|| vec![DVec4::ZERO; self.grid.data.len()]);
         let [mu, mv] = self.grid.dims;
         self.rebuild(0..mu, 0..mv)
     }
@@ -67,15 +85,40 @@ impl SplineSurfaceSampler {
         let stride = self.grid.stride();
         let mv = self.grid.dims[1];
         let [tu, tv] = &self.tables;
-        let target = Rect { rows: rows.clone(), cols: cols.clone(), origin: (0, 0), width: mv, stride };
+        let target = Rect {
+            rows: rows.clone(),
+            cols: cols.clone(),
+            origin: (0, 0),
+            width: mv,
+            stride,
+        };
         match &mut self.hom {
-            None => two_pass(tu, tv, self.surface.points(), nv, &self.partials, &target, &mut self.grid.data),
+            None => two_pass(
+                tu,
+                tv,
+                self.surface.points(),
+                nv,
+                &self.partials,
+                &target,
+                &mut self.grid.data,
+            ),
             Some(hom) => {
-                two_pass(tu, tv, &self.surface.homogeneous_points(), nv, &self.partials, &target, hom);
+                two_pass(
+                    tu,
+                    tv,
+                    &self.surface.homogeneous_points(),
+                    nv,
+                    &self.partials,
+                    &target,
+                    hom,
+                );
                 for i in rows.clone() {
                     for j in cols.clone() {
                         let base = (i * mv + j) * stride;
-                        self.rule.project(&hom[base..base + stride], &mut self.grid.data[base..base + stride]);
+                        self.rule.project(
+                            &hom[base..base + stride],
+                            &mut self.grid.data[base..base + stride],
+                        );
                     }
                 }
             }
@@ -97,9 +140,11 @@ impl SplineSurfaceSampler {
                     let cu = k - tu.first(i);
                     for j in cols.clone() {
                         let cv = l - tv.first(j);
-                        let out = &mut self.grid.data[(i * mv + j) * stride..(i * mv + j + 1) * stride];
+                        let out =
+                            &mut self.grid.data[(i * mv + j) * stride..(i * mv + j + 1) * stride];
                         for (p, &(a, b)) in self.partials.iter().enumerate() {
-                            let c = tu.row(i, a).map_or(0.0, |r| r[cu]) * tv.row(j, b).map_or(0.0, |r| r[cv]);
+                            let c = tu.row(i, a).map_or(0.0, |r| r[cu])
+                                * tv.row(j, b).map_or(0.0, |r| r[cv]);
                             out[p] += delta * c;
                         }
                     }
@@ -133,17 +178,24 @@ impl SplineSurfaceSampler {
         let [tu, tv] = &self.tables;
         let stride = self.grid.stride();
         let mv = self.grid.dims[1];
-        let hom = self.hom.as_mut().expect("rational surfaces keep homogeneous samples");
+        let hom = self
+            .hom
+            .as_mut()
+            .expect("rational surfaces keep homogeneous samples");
         for i in rows.clone() {
             let cu = k - tu.first(i);
             for j in cols.clone() {
                 let cv = l - tv.first(j);
                 let base = (i * mv + j) * stride;
                 for (p, &(a, b)) in self.partials.iter().enumerate() {
-                    let c = tu.row(i, a).map_or(0.0, |r| r[cu]) * tv.row(j, b).map_or(0.0, |r| r[cv]);
+                    let c =
+                        tu.row(i, a).map_or(0.0, |r| r[cu]) * tv.row(j, b).map_or(0.0, |r| r[cv]);
                     hom[base + p] += dh * c;
                 }
-                self.rule.project(&hom[base..base + stride], &mut self.grid.data[base..base + stride]);
+                self.rule.project(
+                    &hom[base..base + stride],
+                    &mut self.grid.data[base..base + stride],
+                );
             }
         }
         self.update_normals(rows.clone(), cols.clone());
@@ -151,7 +203,10 @@ impl SplineSurfaceSampler {
     }
 
     fn update_normals(&mut self, rows: Range<usize>, cols: Range<usize>) {
-        let params = [self.tables[0].params.as_slice(), self.tables[1].params.as_slice()];
+        let params = [
+            self.tables[0].params.as_slice(),
+            self.tables[1].params.as_slice(),
+        ];
         super::normals::update(&mut self.grid, rows, cols, params, &self.surface);
     }
 }

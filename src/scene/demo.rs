@@ -3,7 +3,9 @@
 //! NURBS circle, and the Utah teapot.
 
 use super::{Samples, Scene, SceneObject, Shape, parse_scene};
-use crate::geom::{BFunctionKind, BSplineCurve, BezierCurve, ErbsCurve, ErbsSurface, KnotVector, TensorSurface};
+use crate::geom::{
+    BFunctionKind, BSplineCurve, BezierCurve, ErbsCurve, ErbsSurface, KnotVector, TensorSurface,
+};
 use glam::DVec3;
 
 /// Newell's teapot (32 bicubic Bézier patches), the file shipped in `examples/`.
@@ -56,7 +58,8 @@ fn bspline_surface() -> TensorSurface {
         for j in 0..n {
             let x = -3.0 + 6.0 * i as f64 / (n - 1) as f64;
             let y = -3.0 + 6.0 * j as f64 / (n - 1) as f64;
-            let z = 0.8 * (0.9 * x).sin() * (0.7 * y).cos() + if (i, j) == (3, 4) { 1.5 } else { 0.0 };
+            let z =
+                0.8 * (0.9 * x).sin() * (0.7 * y).cos() + if (i, j) == (3, 4) { 1.5 } else { 0.0 };
             pts.push(DVec3::new(x - 9.0, y, z));
         }
     }
@@ -67,7 +70,10 @@ fn bspline_surface() -> TensorSurface {
 /// ERBS surface with 4 × 4 biquadratic local patches, each a small dome over its grid cell.
 fn erbs_surface() -> ErbsSurface {
     let n = 4;
-    let knots: Vec<f64> = std::iter::once(0.0).chain((0..n).map(|i| i as f64)).chain(std::iter::once((n - 1) as f64)).collect();
+    let knots: Vec<f64> = std::iter::once(0.0)
+        .chain((0..n).map(|i| i as f64))
+        .chain(std::iter::once((n - 1) as f64))
+        .collect();
     let mut patches = Vec::new();
     for k in 0..n {
         for l in 0..n {
@@ -76,20 +82,33 @@ fn erbs_surface() -> ErbsSurface {
             for a in 0..3 {
                 for b in 0..3 {
                     let (x, y) = (a as f64 - 1.0, b as f64 - 1.0);
-                    let h = if a == 1 && b == 1 { 0.9 + 0.3 * ((k + l) % 2) as f64 } else { 0.0 };
+                    let h = if a == 1 && b == 1 {
+                        0.9 + 0.3 * ((k + l) % 2) as f64
+                    } else {
+                        0.0
+                    };
                     pts.push(centre + DVec3::new(1.2 * x, 1.2 * y, h));
                 }
             }
             patches.push(TensorSurface::bezier([3, 3], pts, None).expect("valid patch"));
         }
     }
-    ErbsSurface::new([knots.clone(), knots], [n, n], patches, BFunctionKind::ExpoRational).expect("valid demo ERBS")
+    ErbsSurface::new(
+        [knots.clone(), knots],
+        [n, n],
+        patches,
+        BFunctionKind::ExpoRational,
+    )
+    .expect("valid demo ERBS")
 }
 
 /// ERBS curve with 5 quadratic local curves along a wave above the ERBS surface.
 fn erbs_curve() -> ErbsCurve {
     let n = 5;
-    let knots: Vec<f64> = std::iter::once(0.0).chain((0..n).map(|i| i as f64)).chain(std::iter::once((n - 1) as f64)).collect();
+    let knots: Vec<f64> = std::iter::once(0.0)
+        .chain((0..n).map(|i| i as f64))
+        .chain(std::iter::once((n - 1) as f64))
+        .collect();
     let local = (0..n)
         .map(|l| {
             let x = -3.0 + 1.5 * l as f64;
@@ -108,8 +127,21 @@ fn erbs_curve() -> ErbsCurve {
 /// The exact NURBS circle: degree 2, nine control points on a square, weights 1 and √2/2.
 pub fn nurbs_circle(centre: DVec3, radius: f64) -> BSplineCurve {
     let w = std::f64::consts::FRAC_1_SQRT_2;
-    let corners = [(1., 0.), (1., 1.), (0., 1.), (-1., 1.), (-1., 0.), (-1., -1.), (0., -1.), (1., -1.), (1., 0.)];
-    let pts = corners.iter().map(|&(x, y)| centre + DVec3::new(x, y, 0.0) * radius).collect();
+    let corners = [
+        (1., 0.),
+        (1., 1.),
+        (0., 1.),
+        (-1., 1.),
+        (-1., 0.),
+        (-1., -1.),
+        (0., -1.),
+        (1., -1.),
+        (1., 0.),
+    ];
+    let pts = corners
+        .iter()
+        .map(|&(x, y)| centre + DVec3::new(x, y, 0.0) * radius)
+        .collect();
     let weights = (0..9).map(|i| if i % 2 == 1 { w } else { 1.0 }).collect();
     let knots = vec![0., 0., 0., 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1., 1., 1.];
     BSplineCurve::new(2, knots, pts, Some(weights)).expect("valid circle")

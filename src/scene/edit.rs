@@ -29,42 +29,79 @@ pub enum EditOp {
     /// Map every control point of an ERBS local curve/patch by p ↦ (A·[p;1]).xyz (A affine).
     TransformLocal { local: Index2, matrix: DMat4 },
     /// Translate one control point of an ERBS local curve/patch.
-    TranslateLocalPoint { local: Index2, point: Index2, delta: DVec3 },
+    TranslateLocalPoint {
+        local: Index2,
+        point: Index2,
+        delta: DVec3,
+    },
 }
 
 impl EditOp {
     /// Applies the edit to the model (control data). Indices must have been validated.
     pub fn apply_to(&self, shape: &mut Shape) {
         match (self, shape) {
-            (EditOp::TranslatePoint { point: Index2::One(i), delta }, Shape::BezierCurve(c) | Shape::BSplineCurve(c)) => {
-                c.translate_point(*i, *delta)
-            }
             (
-                EditOp::TranslatePoint { point: Index2::Two(i, j), delta },
+                EditOp::TranslatePoint {
+                    point: Index2::One(i),
+                    delta,
+                },
+                Shape::BezierCurve(c) | Shape::BSplineCurve(c),
+            ) => c.translate_point(*i, *delta),
+            (
+                EditOp::TranslatePoint {
+                    point: Index2::Two(i, j),
+                    delta,
+                },
                 Shape::BezierSurface(s) | Shape::BSplineSurface(s),
             ) => s.translate_point(*i, *j, *delta),
-            (EditOp::SetWeight { point: Index2::One(i), weight }, Shape::BezierCurve(c) | Shape::BSplineCurve(c)) => {
-                c.set_weight(*i, *weight)
-            }
             (
-                EditOp::SetWeight { point: Index2::Two(i, j), weight },
+                EditOp::SetWeight {
+                    point: Index2::One(i),
+                    weight,
+                },
+                Shape::BezierCurve(c) | Shape::BSplineCurve(c),
+            ) => c.set_weight(*i, *weight),
+            (
+                EditOp::SetWeight {
+                    point: Index2::Two(i, j),
+                    weight,
+                },
                 Shape::BezierSurface(s) | Shape::BSplineSurface(s),
             ) => s.set_weight(*i, *j, *weight),
-            (EditOp::TransformLocal { local: Index2::One(l), matrix }, Shape::ErbsCurve(c)) => {
-                c.transform_local(*l, matrix)
-            }
-            (EditOp::TransformLocal { local: Index2::Two(k, l), matrix }, Shape::ErbsSurface(s)) => {
-                s.transform_local(*k, *l, matrix)
-            }
             (
-                EditOp::TranslateLocalPoint { local: Index2::One(l), point: Index2::One(q), delta },
+                EditOp::TransformLocal {
+                    local: Index2::One(l),
+                    matrix,
+                },
+                Shape::ErbsCurve(c),
+            ) => c.transform_local(*l, matrix),
+            (
+                EditOp::TransformLocal {
+                    local: Index2::Two(k, l),
+                    matrix,
+                },
+                Shape::ErbsSurface(s),
+            ) => s.transform_local(*k, *l, matrix),
+            (
+                EditOp::TranslateLocalPoint {
+                    local: Index2::One(l),
+                    point: Index2::One(q),
+                    delta,
+                },
                 Shape::ErbsCurve(c),
             ) => c.translate_local_point(*l, *q, *delta),
             (
-                EditOp::TranslateLocalPoint { local: Index2::Two(k, l), point: Index2::Two(a, b), delta },
+                EditOp::TranslateLocalPoint {
+                    local: Index2::Two(k, l),
+                    point: Index2::Two(a, b),
+                    delta,
+                },
                 Shape::ErbsSurface(s),
             ) => s.translate_local_point(*k, *l, *a, *b, *delta),
-            (op, shape) => panic!("edit {op:?} does not fit a {} (validate first)", shape.type_name()),
+            (op, shape) => panic!(
+                "edit {op:?} does not fit a {} (validate first)",
+                shape.type_name()
+            ),
         }
     }
 }
@@ -72,18 +109,29 @@ impl EditOp {
 /// Parses an edits file (a JSON list) against `scene`, validating object names, kinds and
 /// indices. Nothing is applied.
 pub fn parse_edits(text: &str, scene: &Scene) -> Result<Vec<Edit>, SceneError> {
-    let v: Value = serde_json::from_str(text).map_err(|e| SceneError(format!("invalid JSON: {e}")))?;
-    let list = v
-        .as_array()
-        .ok_or_else(|| SceneError(format!("the edits file must be a JSON list of edits, found {}", kind(&v))))?;
-    list.iter().enumerate().map(|(k, e)| parse_edit(k, e, scene)).collect()
+    let v: Value =
+        serde_json::from_str(text).map_err(|e| SceneError(format!("invalid JSON: {e}")))?;
+    let list = v.as_array().ok_or_else(|| {
+        SceneError(format!(
+            "the edits file must be a JSON list of edits, found {}",
+            kind(&v)
+        ))
+    })?;
+    list.iter()
+        .enumerate()
+        .map(|(k, e)| parse_edit(k, e, scene))
+        .collect()
 }
 
 fn parse_edit(k: usize, v: &Value, scene: &Scene) -> Result<Edit, SceneError> {
     let at = At(format!("edit {k}"));
-    let obj = v.as_object().ok_or_else(|| SceneError(format!("edit {k}: expected an object, found {}", kind(v))))?;
+    let obj = v
+        .as_object()
+        .ok_or_else(|| SceneError(format!("edit {k}: expected an object, found {}", kind(v))))?;
     let name = as_str(&at, "object", require(&at, obj, "object")?)?;
-    let object = scene.find(name).ok_or_else(|| at.err("object", format!("unknown object '{name}'")))?;
+    let object = scene
+        .find(name)
+        .ok_or_else(|| at.err("object", format!("unknown object '{name}'")))?;
     let shape = &scene.objects[object].shape;
     let at = At(format!("edit {k} (object '{name}')"));
     let ty = shape.type_name();
@@ -92,19 +140,31 @@ fn parse_edit(k: usize, v: &Value, scene: &Scene) -> Result<Edit, SceneError> {
         let erbs_dims = match shape {
             Shape::ErbsCurve(_) => 1,
             Shape::ErbsSurface(_) => 2,
-            _ => return Err(at.err("local", format!("a {ty} has no local curves or patches (only ERBS objects do)"))),
+            _ => {
+                return Err(at.err(
+                    "local",
+                    format!("a {ty} has no local curves or patches (only ERBS objects do)"),
+                ));
+            }
         };
         let local = index(&at, "local", require(&at, obj, "local")?, erbs_dims)?;
         check_local(&at, shape, local)?;
         if has("transform") {
             check_fields(&at, obj, &["object", "local", "transform"])?;
-            EditOp::TransformLocal { local, matrix: affine(&at, require(&at, obj, "transform")?)? }
+            EditOp::TransformLocal {
+                local,
+                matrix: affine(&at, require(&at, obj, "transform")?)?,
+            }
         } else {
             check_fields(&at, obj, &["object", "local", "point", "delta"])?;
             let point = index(&at, "point", require(&at, obj, "point")?, erbs_dims)?;
             check_local_point(&at, shape, local, point)?;
             let delta = as_point(&at, "delta", "delta", require(&at, obj, "delta")?)?;
-            EditOp::TranslateLocalPoint { local, point, delta }
+            EditOp::TranslateLocalPoint {
+                local,
+                point,
+                delta,
+            }
         }
     } else {
         let dims = match shape {
@@ -141,16 +201,26 @@ fn index(at: &At, field: &str, v: &Value, dims: usize) -> Result<Index2, SceneEr
         return Ok(Index2::One(as_usize(at, field, "index", v)?));
     }
     match v.as_array() {
-        Some(a) if a.len() == 2 => Ok(Index2::Two(as_usize(at, field, "index", &a[0])?, as_usize(at, field, "index", &a[1])?)),
+        Some(a) if a.len() == 2 => Ok(Index2::Two(
+            as_usize(at, field, "index", &a[0])?,
+            as_usize(at, field, "index", &a[1])?,
+        )),
         _ => Err(at.err(field, format!("expected [i, j] for a surface, found {v}"))),
     }
 }
 
 fn out_of_range(at: &At, field: &str, idx: Index2, bounds: Index2) -> SceneError {
     let msg = match (idx, bounds) {
-        (Index2::One(i), Index2::One(n)) => format!("index {i} out of range (valid: 0..={})", n.saturating_sub(1)),
+        (Index2::One(i), Index2::One(n)) => format!(
+            "index {i} out of range (valid: 0..={})",
+            n.saturating_sub(1)
+        ),
         (Index2::Two(i, j), Index2::Two(n, m)) => {
-            format!("index [{i}, {j}] out of range (valid: [0..={}, 0..={}])", n.saturating_sub(1), m.saturating_sub(1))
+            format!(
+                "index [{i}, {j}] out of range (valid: [0..={}, 0..={}])",
+                n.saturating_sub(1),
+                m.saturating_sub(1)
+            )
         }
         _ => "index has the wrong number of components".to_string(),
     };
@@ -168,10 +238,16 @@ fn within(idx: Index2, bounds: Index2) -> bool {
 fn check_point(at: &At, shape: &Shape, p: Index2) -> Result<(), SceneError> {
     let bounds = match shape {
         Shape::BezierCurve(c) | Shape::BSplineCurve(c) => Index2::One(c.points().len()),
-        Shape::BezierSurface(s) | Shape::BSplineSurface(s) => Index2::Two(s.count()[0], s.count()[1]),
+        Shape::BezierSurface(s) | Shape::BSplineSurface(s) => {
+            Index2::Two(s.count()[0], s.count()[1])
+        }
         _ => unreachable!("ERBS objects are rejected before"),
     };
-    if within(p, bounds) { Ok(()) } else { Err(out_of_range(at, "point", p, bounds)) }
+    if within(p, bounds) {
+        Ok(())
+    } else {
+        Err(out_of_range(at, "point", p, bounds))
+    }
 }
 
 fn check_local(at: &At, shape: &Shape, l: Index2) -> Result<(), SceneError> {
@@ -180,7 +256,11 @@ fn check_local(at: &At, shape: &Shape, l: Index2) -> Result<(), SceneError> {
         Shape::ErbsSurface(s) => Index2::Two(s.count()[0], s.count()[1]),
         _ => unreachable!("only ERBS objects get here"),
     };
-    if within(l, bounds) { Ok(()) } else { Err(out_of_range(at, "local", l, bounds)) }
+    if within(l, bounds) {
+        Ok(())
+    } else {
+        Err(out_of_range(at, "local", l, bounds))
+    }
 }
 
 fn check_local_point(at: &At, shape: &Shape, l: Index2, p: Index2) -> Result<(), SceneError> {
@@ -192,25 +272,41 @@ fn check_local_point(at: &At, shape: &Shape, l: Index2, p: Index2) -> Result<(),
         }
         _ => unreachable!("validated by check_local"),
     };
-    if within(p, bounds) { Ok(()) } else { Err(out_of_range(at, "point", p, bounds)) }
+    if within(p, bounds) {
+        Ok(())
+    } else {
+        Err(out_of_range(at, "point", p, bounds))
+    }
 }
 
 /// A row-major 4×4 affine matrix (last row 0 0 0 1).
 fn affine(at: &At, v: &Value) -> Result<DMat4, SceneError> {
     let rows = as_array(at, "transform", v)?;
     if rows.len() != 4 {
-        return Err(at.err("transform", format!("expected 4 rows, found {}", rows.len())));
+        return Err(at.err(
+            "transform",
+            format!("expected 4 rows, found {}", rows.len()),
+        ));
     }
     let mut m = [[0.0; 4]; 4];
     for (r, row) in rows.iter().enumerate() {
         let vals = as_f64_list(at, "transform", &format!("row {r} entry"), row)?;
         if vals.len() != 4 {
-            return Err(at.err("transform", format!("row {r} has {} entries, expected 4", vals.len())));
+            return Err(at.err(
+                "transform",
+                format!("row {r} has {} entries, expected 4", vals.len()),
+            ));
         }
         m[r].copy_from_slice(&vals);
     }
     if m[3] != [0.0, 0.0, 0.0, 1.0] {
-        return Err(at.err("transform", format!("not affine: the last row must be [0, 0, 0, 1], found {:?}", m[3])));
+        return Err(at.err(
+            "transform",
+            format!(
+                "not affine: the last row must be [0, 0, 0, 1], found {:?}",
+                m[3]
+            ),
+        ));
     }
     Ok(DMat4::from_cols_array_2d(&m).transpose())
 }
@@ -220,4 +316,79 @@ pub fn apply_all(scene: &mut Scene, edits: &[Edit]) {
     for e in edits {
         e.op.apply_to(&mut scene.objects[e.object].shape);
     }
+}
+
+/// What an edit acts on, for merging: ops on different targets commute.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Target {
+    Point(usize, Index2),
+    Weight(usize, Index2),
+    Local(usize, Index2),
+}
+
+fn target(e: &Edit) -> Target {
+    match e.op {
+        EditOp::TranslatePoint { point, .. } => Target::Point(e.object, point),
+        EditOp::SetWeight { point, .. } => Target::Weight(e.object, point),
+        EditOp::TransformLocal { local, .. } | EditOp::TranslateLocalPoint { local, .. } => {
+            Target::Local(e.object, local)
+        }
+    }
+}
+
+/// Merges the edits of one frame so each touched control point or local patch is updated once:
+/// consecutive translations of a point add up, consecutive transforms of a local curve compose
+/// (A2·A1), consecutive moves of one local control point add up, and the last weight of a point
+/// wins. Edits on different targets commute (a point's position and its weight are independent,
+/// as are distinct local curves), so targets are applied in first-touch order; edits on one
+/// target keep their order.
+pub fn merge_edits(edits: &[Edit]) -> Vec<Edit> {
+    let mut groups: Vec<(Target, Vec<Edit>)> = Vec::new();
+    for e in edits {
+        let key = target(e);
+        let group = match groups.iter_mut().find(|(k, _)| *k == key) {
+            Some((_, g)) => g,
+            None => {
+                groups.push((key, Vec::new()));
+                &mut groups.last_mut().expect("just pushed").1
+            }
+        };
+        let merged = match (group.last().map(|x| &x.op), &e.op) {
+            (
+                Some(EditOp::TranslatePoint { point, delta: a }),
+                EditOp::TranslatePoint { delta: b, .. },
+            ) => Some(EditOp::TranslatePoint {
+                point: *point,
+                delta: *a + *b,
+            }),
+            (Some(EditOp::SetWeight { .. }), EditOp::SetWeight { .. }) => Some(e.op.clone()),
+            (
+                Some(EditOp::TransformLocal { local, matrix: a }),
+                EditOp::TransformLocal { matrix: b, .. },
+            ) => Some(EditOp::TransformLocal {
+                local: *local,
+                matrix: *b * *a,
+            }),
+            (
+                Some(EditOp::TranslateLocalPoint {
+                    local,
+                    point: p,
+                    delta: a,
+                }),
+                EditOp::TranslateLocalPoint {
+                    point: q, delta: b, ..
+                },
+            ) if p == q => Some(EditOp::TranslateLocalPoint {
+                local: *local,
+                point: *p,
+                delta: *a + *b,
+            }),
+            _ => None,
+        };
+        match merged {
+            Some(op) => group.last_mut().expect("merged with the last edit").op = op,
+            None => group.push(e.clone()),
+        }
+    }
+    groups.into_iter().flat_map(|(_, g)| g).collect()
 }

@@ -43,20 +43,31 @@ pub fn check_fields(at: &At, obj: &Map<String, Value>, allowed: &[&str]) -> Resu
     Ok(())
 }
 
-pub fn require<'a>(at: &At, obj: &'a Map<String, Value>, field: &str) -> Result<&'a Value, SceneError> {
+pub fn require<'a>(
+    at: &At,
+    obj: &'a Map<String, Value>,
+    field: &str,
+) -> Result<&'a Value, SceneError> {
     obj.get(field).ok_or_else(|| at.err(field, "missing"))
 }
 
-pub fn as_object<'a>(at: &At, field: &str, v: &'a Value) -> Result<&'a Map<String, Value>, SceneError> {
-    v.as_object().ok_or_else(|| at.err(field, format!("expected an object, found {}", kind(v))))
+pub fn as_object<'a>(
+    at: &At,
+    field: &str,
+    v: &'a Value,
+) -> Result<&'a Map<String, Value>, SceneError> {
+    v.as_object()
+        .ok_or_else(|| at.err(field, format!("expected an object, found {}", kind(v))))
 }
 
 pub fn as_array<'a>(at: &At, field: &str, v: &'a Value) -> Result<&'a Vec<Value>, SceneError> {
-    v.as_array().ok_or_else(|| at.err(field, format!("expected an array, found {}", kind(v))))
+    v.as_array()
+        .ok_or_else(|| at.err(field, format!("expected an array, found {}", kind(v))))
 }
 
 pub fn as_str<'a>(at: &At, field: &str, v: &'a Value) -> Result<&'a str, SceneError> {
-    v.as_str().ok_or_else(|| at.err(field, format!("expected a string, found {}", kind(v))))
+    v.as_str()
+        .ok_or_else(|| at.err(field, format!("expected a string, found {}", kind(v))))
 }
 
 /// A finite number. (JSON itself cannot spell NaN or infinity; out-of-range literals are caught
@@ -65,15 +76,23 @@ pub fn as_f64(at: &At, field: &str, what: &str, v: &Value) -> Result<f64, SceneE
     match v.as_f64() {
         Some(x) if x.is_finite() => Ok(x),
         Some(x) => Err(at.err(field, format!("{what} is {x}, not a finite number"))),
-        None => Err(at.err(field, format!("{what}: expected a number, found {}", kind(v)))),
+        None => Err(at.err(
+            field,
+            format!("{what}: expected a number, found {}", kind(v)),
+        )),
     }
 }
 
 /// A non-negative integer (1.0 is not accepted: counts and indices are integers).
 pub fn as_usize(at: &At, field: &str, what: &str, v: &Value) -> Result<usize, SceneError> {
     match v.as_u64() {
-        Some(x) => usize::try_from(x).map_err(|_| at.err(field, format!("{what} {x} is too large"))),
-        None => Err(at.err(field, format!("{what}: expected a non-negative integer, found {v}"))),
+        Some(x) => {
+            usize::try_from(x).map_err(|_| at.err(field, format!("{what} {x} is too large")))
+        }
+        None => Err(at.err(
+            field,
+            format!("{what}: expected a non-negative integer, found {v}"),
+        )),
     }
 }
 
@@ -87,11 +106,17 @@ pub fn as_f64_list(at: &At, field: &str, what: &str, v: &Value) -> Result<Vec<f6
 
 /// [x, y, z].
 pub fn as_point(at: &At, field: &str, what: &str, v: &Value) -> Result<DVec3, SceneError> {
-    let a = v
-        .as_array()
-        .ok_or_else(|| at.err(field, format!("{what}: expected [x, y, z], found {}", kind(v))))?;
+    let a = v.as_array().ok_or_else(|| {
+        at.err(
+            field,
+            format!("{what}: expected [x, y, z], found {}", kind(v)),
+        )
+    })?;
     if a.len() != 3 {
-        return Err(at.err(field, format!("{what}: expected 3 coordinates, found {}", a.len())));
+        return Err(at.err(
+            field,
+            format!("{what}: expected 3 coordinates, found {}", a.len()),
+        ));
     }
     let c = |i: usize| as_f64(at, field, &format!("{what} coordinate {i}"), &a[i]);
     Ok(DVec3::new(c(0)?, c(1)?, c(2)?))
@@ -103,7 +128,10 @@ pub fn as_points(at: &At, field: &str, v: &Value) -> Result<Vec<DVec3>, SceneErr
     if a.is_empty() {
         return Err(at.err(field, "no points"));
     }
-    a.iter().enumerate().map(|(i, p)| as_point(at, field, &format!("point {i}"), p)).collect()
+    a.iter()
+        .enumerate()
+        .map(|(i, p)| as_point(at, field, &format!("point {i}"), p))
+        .collect()
 }
 
 /// A rectangular [rows][cols] array, flattened row-major, with its shape.
@@ -120,14 +148,20 @@ pub fn as_grid<T>(
     let mut cols = None;
     let mut out = Vec::new();
     for (i, row) in rows.iter().enumerate() {
-        let r = row
-            .as_array()
-            .ok_or_else(|| at.err(field, format!("row {i}: expected an array, found {}", kind(row))))?;
+        let r = row.as_array().ok_or_else(|| {
+            at.err(
+                field,
+                format!("row {i}: expected an array, found {}", kind(row)),
+            )
+        })?;
         match cols {
             None if r.is_empty() => return Err(at.err(field, format!("row {i} is empty"))),
             None => cols = Some(r.len()),
             Some(c) if c != r.len() => {
-                return Err(at.err(field, format!("row {i} has {} entries, row 0 has {c}", r.len())));
+                return Err(at.err(
+                    field,
+                    format!("row {i} has {} entries, row 0 has {c}", r.len()),
+                ));
             }
             Some(_) => {}
         }

@@ -76,7 +76,10 @@ impl Shape {
     }
 
     pub fn is_surface(&self) -> bool {
-        matches!(self, Shape::BezierSurface(_) | Shape::BSplineSurface(_) | Shape::ErbsSurface(_))
+        matches!(
+            self,
+            Shape::BezierSurface(_) | Shape::BSplineSurface(_) | Shape::ErbsSurface(_)
+        )
     }
 
     /// Parameter domain per direction (one entry for curves).

@@ -1,19 +1,27 @@
 //! Scene file → [`Scene`], validating everything with one-line errors.
 
 use super::json::*;
-use super::{MAX_CURVE_SAMPLES, MAX_DEGREE, MAX_SURFACE_SAMPLES, Samples, Scene, SceneError, SceneObject, Shape};
+use super::{
+    MAX_CURVE_SAMPLES, MAX_DEGREE, MAX_SURFACE_SAMPLES, Samples, Scene, SceneError, SceneObject,
+    Shape,
+};
 use crate::geom::{
-    BFunctionKind, BSplineCurve, BezierCurve, ErbsCurve, ErbsSurface, GeomError, KnotVector, TensorSurface,
+    BFunctionKind, BSplineCurve, BezierCurve, ErbsCurve, ErbsSurface, GeomError, KnotVector,
+    TensorSurface,
 };
 use glam::DVec3;
 use serde_json::{Map, Value};
 
 /// Parses and validates scene JSON text.
 pub fn parse_scene(text: &str) -> Result<Scene, SceneError> {
-    let v: Value = serde_json::from_str(text).map_err(|e| SceneError(format!("invalid JSON: {e}")))?;
-    let top = v
-        .as_object()
-        .ok_or_else(|| SceneError(format!("the scene must be a JSON object {{\"objects\": [...]}}, found {}", kind(&v))))?;
+    let v: Value =
+        serde_json::from_str(text).map_err(|e| SceneError(format!("invalid JSON: {e}")))?;
+    let top = v.as_object().ok_or_else(|| {
+        SceneError(format!(
+            "the scene must be a JSON object {{\"objects\": [...]}}, found {}",
+            kind(&v)
+        ))
+    })?;
     let at = At("scene".into());
     check_fields(&at, top, &["objects"])?;
     let list = as_array(&at, "objects", require(&at, top, "objects")?)?;
@@ -35,9 +43,12 @@ const CURVE_FIELDS: [&str; 4] = ["name", "type", "samples", "color"];
 
 fn parse_object(i: usize, v: &Value) -> Result<SceneObject, SceneError> {
     let at = At(format!("objects[{i}]"));
-    let obj = v
-        .as_object()
-        .ok_or_else(|| SceneError(format!("objects[{i}]: expected an object, found {}", kind(v))))?;
+    let obj = v.as_object().ok_or_else(|| {
+        SceneError(format!(
+            "objects[{i}]: expected an object, found {}",
+            kind(v)
+        ))
+    })?;
     let name = as_str(&at, "name", require(&at, obj, "name")?)?;
     if name.is_empty() {
         return Err(at.err("name", "empty name"));
@@ -49,9 +60,12 @@ fn parse_object(i: usize, v: &Value) -> Result<SceneObject, SceneError> {
             check_fields(&at, obj, &fields(&["points", "weights"]))?;
             let points = as_points(&at, "points", require(&at, obj, "points")?)?;
             check_degree(&at, "points", points.len() - 1)?;
-            let weights = opt(obj, "weights").map(|w| as_f64_list(&at, "weights", "weight", w)).transpose()?;
+            let weights = opt(obj, "weights")
+                .map(|w| as_f64_list(&at, "weights", "weight", w))
+                .transpose()?;
             let knots = KnotVector::bezier(points.len() - 1, 0.0, 1.0).into_vec();
-            let c = BSplineCurve::new(points.len() - 1, knots, points, weights).map_err(|e| geom(&at, e))?;
+            let c = BSplineCurve::new(points.len() - 1, knots, points, weights)
+                .map_err(|e| geom(&at, e))?;
             (Shape::BezierCurve(c), curve_samples(&at, obj)?)
         }
         "bspline_curve" => {
@@ -60,7 +74,9 @@ fn parse_object(i: usize, v: &Value) -> Result<SceneObject, SceneError> {
             check_degree(&at, "degree", degree)?;
             let knots = as_f64_list(&at, "knots", "knot", require(&at, obj, "knots")?)?;
             let points = as_points(&at, "points", require(&at, obj, "points")?)?;
-            let weights = opt(obj, "weights").map(|w| as_f64_list(&at, "weights", "weight", w)).transpose()?;
+            let weights = opt(obj, "weights")
+                .map(|w| as_f64_list(&at, "weights", "weight", w))
+                .transpose()?;
             let c = BSplineCurve::new(degree, knots, points, weights).map_err(|e| geom(&at, e))?;
             (Shape::BSplineCurve(c), curve_samples(&at, obj)?)
         }
@@ -89,7 +105,10 @@ fn parse_object(i: usize, v: &Value) -> Result<SceneObject, SceneError> {
             check_fields(&at, obj, &fields(&["degree", "knots", "points", "weights"]))?;
             let dv = as_array(&at, "degree", require(&at, obj, "degree")?)?;
             if dv.len() != 2 {
-                return Err(at.err("degree", format!("expected [du, dv], found {} entries", dv.len())));
+                return Err(at.err(
+                    "degree",
+                    format!("expected [du, dv], found {} entries", dv.len()),
+                ));
             }
             let degree = [
                 as_usize(&at, "degree", "degree[0]", &dv[0])?,
@@ -98,7 +117,13 @@ fn parse_object(i: usize, v: &Value) -> Result<SceneObject, SceneError> {
             check_degree(&at, "degree", degree[0].max(degree[1]))?;
             let kv = as_array(&at, "knots", require(&at, obj, "knots")?)?;
             if kv.len() != 2 {
-                return Err(at.err("knots", format!("expected [[u knots], [v knots]], found {} entries", kv.len())));
+                return Err(at.err(
+                    "knots",
+                    format!(
+                        "expected [[u knots], [v knots]], found {} entries",
+                        kv.len()
+                    ),
+                ));
             }
             let knots = [
                 as_f64_list(&at, "knots", "u knot", &kv[0])?,
@@ -106,21 +131,29 @@ fn parse_object(i: usize, v: &Value) -> Result<SceneObject, SceneError> {
             ];
             let (count, points) = point_grid(&at, "points", require(&at, obj, "points")?)?;
             let weights = weight_grid(&at, obj, count)?;
-            let s = TensorSurface::bspline(degree, knots, count, points, weights).map_err(|e| geom(&at, e))?;
+            let s = TensorSurface::bspline(degree, knots, count, points, weights)
+                .map_err(|e| geom(&at, e))?;
             (Shape::BSplineSurface(s), surface_samples(&at, obj)?)
         }
         "erbs_surface" => {
             check_fields(&at, obj, &fields(&["knots", "local", "bfunction"]))?;
             let kv = as_array(&at, "knots", require(&at, obj, "knots")?)?;
             if kv.len() != 2 {
-                return Err(at.err("knots", format!("expected [[u knots], [v knots]], found {} entries", kv.len())));
+                return Err(at.err(
+                    "knots",
+                    format!(
+                        "expected [[u knots], [v knots]], found {} entries",
+                        kv.len()
+                    ),
+                ));
             }
             let knots = [
                 as_f64_list(&at, "knots", "u knot", &kv[0])?,
                 as_f64_list(&at, "knots", "v knot", &kv[1])?,
             ];
-            let (count, patches) =
-                as_grid(&at, "local", require(&at, obj, "local")?, |idx, v| local_patch(&at, &format!("local{idx}"), v))?;
+            let (count, patches) = as_grid(&at, "local", require(&at, obj, "local")?, |idx, v| {
+                local_patch(&at, &format!("local{idx}"), v)
+            })?;
             let bf = bfunction(&at, obj)?;
             let s = ErbsSurface::new(knots, count, patches, bf).map_err(|e| geom(&at, e))?;
             (Shape::ErbsSurface(s), surface_samples(&at, obj)?)
@@ -135,7 +168,12 @@ fn parse_object(i: usize, v: &Value) -> Result<SceneObject, SceneError> {
         }
     };
     let color = opt(obj, "color").map(|c| parse_color(&at, c)).transpose()?;
-    Ok(SceneObject { name: name.to_string(), shape, samples, color })
+    Ok(SceneObject {
+        name: name.to_string(),
+        shape,
+        samples,
+        color,
+    })
 }
 
 /// The common fields plus the type's own.
@@ -153,7 +191,10 @@ fn geom(at: &At, e: GeomError) -> SceneError {
 
 fn check_degree(at: &At, field: &str, degree: usize) -> Result<(), SceneError> {
     if degree > MAX_DEGREE {
-        return Err(at.err(field, format!("degree {degree} exceeds the supported maximum {MAX_DEGREE}")));
+        return Err(at.err(
+            field,
+            format!("degree {degree} exceeds the supported maximum {MAX_DEGREE}"),
+        ));
     }
     Ok(())
 }
@@ -175,14 +216,20 @@ fn surface_samples(at: &At, obj: &Map<String, Value>) -> Result<Samples, SceneEr
     check_count(at, mu, MAX_SURFACE_SAMPLES)?;
     check_count(at, mv, MAX_SURFACE_SAMPLES)?;
     if mu.saturating_mul(mv) > MAX_SURFACE_SAMPLES {
-        return Err(at.err("samples", format!("{mu} × {mv} samples exceed the limit of {MAX_SURFACE_SAMPLES}")));
+        return Err(at.err(
+            "samples",
+            format!("{mu} × {mv} samples exceed the limit of {MAX_SURFACE_SAMPLES}"),
+        ));
     }
     Ok(Samples::Surface([mu, mv]))
 }
 
 fn check_count(at: &At, m: usize, max: usize) -> Result<(), SceneError> {
     if m < 2 {
-        return Err(at.err("samples", format!("{m} samples: at least 2 are needed (both ends are sampled)")));
+        return Err(at.err(
+            "samples",
+            format!("{m} samples: at least 2 are needed (both ends are sampled)"),
+        ));
     }
     if m > max {
         return Err(at.err("samples", format!("{m} samples exceed the limit of {max}")));
@@ -191,17 +238,30 @@ fn check_count(at: &At, m: usize, max: usize) -> Result<(), SceneError> {
 }
 
 fn bfunction(at: &At, obj: &Map<String, Value>) -> Result<BFunctionKind, SceneError> {
-    let Some(v) = obj.get("bfunction") else { return Ok(BFunctionKind::default()) };
+    let Some(v) = obj.get("bfunction") else {
+        return Ok(BFunctionKind::default());
+    };
     let name = as_str(at, "bfunction", v)?;
     BFunctionKind::from_name(name).ok_or_else(|| {
         let names: Vec<_> = BFunctionKind::ALL.iter().map(|k| k.name()).collect();
-        at.err("bfunction", format!("unknown B-function '{name}' (expected one of: {})", names.join(", ")))
+        at.err(
+            "bfunction",
+            format!(
+                "unknown B-function '{name}' (expected one of: {})",
+                names.join(", ")
+            ),
+        )
     })
 }
 
 fn local_curve(at: &At, which: &str, v: &Value) -> Result<BezierCurve, SceneError> {
     let la = At(format!("{}: {which}", at.0));
-    let obj = as_object(at, "local", v).map_err(|_| at.err("local", format!("{which}: expected {{\"points\": [...]}}, found {}", kind(v))))?;
+    let obj = as_object(at, "local", v).map_err(|_| {
+        at.err(
+            "local",
+            format!("{which}: expected {{\"points\": [...]}}, found {}", kind(v)),
+        )
+    })?;
     check_fields(&la, obj, &["points"])?;
     let points = as_points(&la, "points", require(&la, obj, "points")?)?;
     check_degree(&la, "points", points.len() - 1)?;
@@ -210,7 +270,12 @@ fn local_curve(at: &At, which: &str, v: &Value) -> Result<BezierCurve, SceneErro
 
 fn local_patch(at: &At, which: &str, v: &Value) -> Result<TensorSurface, SceneError> {
     let la = At(format!("{}: {which}", at.0));
-    let obj = as_object(at, "local", v).map_err(|_| at.err("local", format!("{which}: expected {{\"points\": [...]}}, found {}", kind(v))))?;
+    let obj = as_object(at, "local", v).map_err(|_| {
+        at.err(
+            "local",
+            format!("{which}: expected {{\"points\": [...]}}, found {}", kind(v)),
+        )
+    })?;
     check_fields(&la, obj, &["points"])?;
     let (count, points) = point_grid(&la, "points", require(&la, obj, "points")?)?;
     check_degree(&la, "points", count[0].max(count[1]) - 1)?;
@@ -218,16 +283,29 @@ fn local_patch(at: &At, which: &str, v: &Value) -> Result<TensorSurface, SceneEr
 }
 
 fn point_grid(at: &At, field: &str, v: &Value) -> Result<([usize; 2], Vec<DVec3>), SceneError> {
-    as_grid(at, field, v, |idx, p| as_point(at, field, &format!("point {idx}"), p))
+    as_grid(at, field, v, |idx, p| {
+        as_point(at, field, &format!("point {idx}"), p)
+    })
 }
 
-fn weight_grid(at: &At, obj: &Map<String, Value>, count: [usize; 2]) -> Result<Option<Vec<f64>>, SceneError> {
-    let Some(v) = obj.get("weights") else { return Ok(None) };
-    let (shape, w) = as_grid(at, "weights", v, |idx, x| as_f64(at, "weights", &format!("weight {idx}"), x))?;
+fn weight_grid(
+    at: &At,
+    obj: &Map<String, Value>,
+    count: [usize; 2],
+) -> Result<Option<Vec<f64>>, SceneError> {
+    let Some(v) = obj.get("weights") else {
+        return Ok(None);
+    };
+    let (shape, w) = as_grid(at, "weights", v, |idx, x| {
+        as_f64(at, "weights", &format!("weight {idx}"), x)
+    })?;
     if shape != count {
         return Err(at.err(
             "weights",
-            format!("{} × {} weights for {} × {} control points", shape[0], shape[1], count[0], count[1]),
+            format!(
+                "{} × {} weights for {} × {} control points",
+                shape[0], shape[1], count[0], count[1]
+            ),
         ));
     }
     Ok(Some(w))
@@ -236,7 +314,10 @@ fn weight_grid(at: &At, obj: &Map<String, Value>, count: [usize; 2]) -> Result<O
 fn parse_color(at: &At, v: &Value) -> Result<[f64; 3], SceneError> {
     let p = as_point(at, "color", "color", v)?;
     if p.min_element() < 0.0 || p.max_element() > 1.0 {
-        return Err(at.err("color", format!("components must lie in [0, 1], found {:?}", p.to_array())));
+        return Err(at.err(
+            "color",
+            format!("components must lie in [0, 1], found {:?}", p.to_array()),
+        ));
     }
     Ok(p.to_array())
 }

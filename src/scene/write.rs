@@ -12,14 +12,23 @@ pub fn scene_to_json(scene: &Scene) -> String {
     for (i, o) in scene.objects.iter().enumerate() {
         s.push_str("  ");
         write_object(&mut s, o);
-        s.push_str(if i + 1 < scene.objects.len() { ",\n" } else { "\n" });
+        s.push_str(if i + 1 < scene.objects.len() {
+            ",\n"
+        } else {
+            "\n"
+        });
     }
     s.push_str("]}\n");
     s
 }
 
 fn write_object(s: &mut String, o: &SceneObject) {
-    let _ = write!(s, "{{\"name\": {}, \"type\": \"{}\"", json_string(&o.name), o.shape.type_name());
+    let _ = write!(
+        s,
+        "{{\"name\": {}, \"type\": \"{}\"",
+        json_string(&o.name),
+        o.shape.type_name()
+    );
     match &o.shape {
         Shape::BezierCurve(c) => {
             field(s, "points", &points(c.points()));
@@ -37,8 +46,11 @@ fn write_object(s: &mut String, o: &SceneObject) {
         }
         Shape::ErbsCurve(c) => {
             field(s, "knots", &numbers(c.knots()));
-            let local: Vec<String> =
-                c.local_curves().iter().map(|l| format!("{{\"points\": {}}}", points(l.points()))).collect();
+            let local: Vec<String> = c
+                .local_curves()
+                .iter()
+                .map(|l| format!("{{\"points\": {}}}", points(l.points())))
+                .collect();
             field(s, "local", &format!("[{}]", local.join(", ")));
             bfunction(s, c.bfunction());
         }
@@ -60,8 +72,9 @@ fn write_object(s: &mut String, o: &SceneObject) {
             let [nu, nv] = e.count();
             let rows: Vec<String> = (0..nu)
                 .map(|k| {
-                    let row: Vec<String> =
-                        (0..nv).map(|l| format!("{{\"points\": {}}}", point_grid(e.local_patch(k, l)))).collect();
+                    let row: Vec<String> = (0..nv)
+                        .map(|l| format!("{{\"points\": {}}}", point_grid(e.local_patch(k, l))))
+                        .collect();
                     format!("[{}]", row.join(", "))
                 })
                 .collect();
