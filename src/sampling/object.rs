@@ -213,6 +213,18 @@ impl SampledObject {
         }
     }
 
+    /// Full sampling from the pre-evaluated data, as the constructor does.
+    pub fn rebuild_all(&mut self) -> DirtyRegion {
+        self.touched = DirtyRegion::Nothing;
+        self.edits_since_rebuild = 0;
+        match &mut self.sampler {
+            Sampler::SplineCurve(s) => s.full(),
+            Sampler::ErbsCurve(s) => s.full(),
+            Sampler::SplineSurface(s) => s.full(),
+            Sampler::ErbsSurface(s) => s.full(),
+        }
+    }
+
     /// Samples in the grid (rows × cols).
     pub fn sample_count(&self) -> usize {
         let [a, b] = self.grid().dims;
