@@ -38,8 +38,10 @@ impl DeviceCaps {
 
     /// Whether `samples` (1, 2, 4, 8, ...) can be used for MSAA targets.
     pub fn supports_samples(&self, samples: u32) -> bool {
-        self.sample_counts
-            .contains(vk::SampleCountFlags::from_raw(samples))
+        samples.is_power_of_two()
+            && self
+                .sample_counts
+                .contains(vk::SampleCountFlags::from_raw(samples))
     }
 }
 
@@ -280,8 +282,9 @@ impl Device {
 
     /// Locks the allocator. `None` only after [`Device::destroy`] started, which cannot be
     /// observed from safe code since `destroy` takes `self`.
-    pub(crate) fn allocator(&self) -> GpuResult<MutexGuard<'_, Option<Allocator>>> {
-        Ok(self.allocator.lock().unwrap_or_else(|p| p.into_inner()))
+    pub(crate) fn allocator(&self) -> MutexGuard<'_, Option<Allocator>> {
+        // A poisoned lock only means a panic elsewhere; the allocator itself is consistent.
+        self.allocator.lock().unwrap_or_else(|p| p.into_inner())
     }
 
     /// Blocks until the GPU is idle.
@@ -302,5 +305,46 @@ impl Device {
         );
         // SAFETY: all children were destroyed by the caller and the GPU is idle.
         unsafe { self.raw.destroy_device(None) };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use vk::PhysicalDeviceType as T;
+
+    fn list() -> Vec<(String, vk::PhysicalDeviceType)> {
+        vec![
+            ("llvmpipe (LLVM 15)".into(), T::CPU),
+            ("Intel(R) UHD 620".into(), T::INTEGRATED_GPU),
+            ("NVIDIA GeForce RTX 4070".into(), T::DISCRETE_GPU),
+            ("Virtio GPU".into(), T::VIRTUAL_GPU),
+        ]
+    }
+
+    #[test]
+    fn prefers_discrete_then_integrated_then_virtual_then_cpu() {
+        let mut l = list();
+        assert_eq!(choose(&l, None), Ok(2));
+        l.remove(2);
+        assert_eq!(choose(&l, None), Ok(1));
+        l.remove(1);
+        assert_eq!(choose(&l, None), Ok(1));
+        l.remove(1);
+        assert_eq!(choose(&l, None), Ok(0));
+        assert!(choose(&[], None).is_err());
+    }
+
+    #[test]
+    fn env_override_matches_name_substring() {
+        let l = list();
+        assert_eq!(choose(&l, Some("LLVMPIPE")), Ok(0));
+        assert_eq!(choose(&l, Some("uhd")), Ok(1));
+        assert_eq!(choose(&l, Some("")), Ok(2));
+        let err = choose(&l, Some("radeon")).unwrap_err();
+        assert!(
+            err.contains("PRESPLINE_GPU") && err.contains("llvmpipe"),
+            "{err}"
+        );
     }
 }

@@ -41,6 +41,12 @@ pub enum GpuError {
     /// A caller-supplied value is out of range (buffer bounds, grid shape, sizes).
     #[error("invalid argument: {0}")]
     InvalidArgument(String),
+    /// The validation layer reported errors (see [`super::Renderer::check_validation`]).
+    #[error("{0}")]
+    Validation(String),
+    /// An internal invariant did not hold (a bug in this module).
+    #[error("internal error: {0}")]
+    Internal(String),
     /// The window system could not give us a surface.
     #[error("window surface: {0}")]
     Surface(String),

@@ -255,15 +255,16 @@ impl PointRun {
     }
 
     fn check(&self, len: usize, min_count: usize) -> GpuResult<()> {
-        let last = self
+        // One past the last float read; the shader's u32 index arithmetic stays below it.
+        let end = self
             .count
             .checked_sub(1)
             .and_then(|n| n.checked_mul(self.stride))
-            .and_then(|n| n.checked_add(self.offset + 3));
-        let ok = self.count >= min_count
+            .and_then(|n| n.checked_add(self.offset))
+            .and_then(|n| n.checked_add(3));
+        let ok = self.count >= min_count.max(1)
             && self.stride >= 3
-            && last.is_some_and(|end| end <= len)
-            && u32::try_from(self.offset + self.stride * self.count).is_ok();
+            && end.is_some_and(|end| end <= len && u32::try_from(end).is_ok());
         if ok {
             Ok(())
         } else {
@@ -611,10 +612,14 @@ impl<'a> Frame<'a> {
 
     fn check_grid(mirror: &Mirror, grid: &SurfaceGrid) -> GpuResult<()> {
         grid.shape.validate()?;
-        if grid.offset + grid.floats() > mirror.len() {
+        if grid
+            .offset
+            .checked_add(grid.floats())
+            .is_none_or(|end| end > mirror.len())
+        {
             return Err(GpuError::InvalidArgument(format!(
-                "surface grid {grid:?} needs {} floats, mirror has {}",
-                grid.offset + grid.floats(),
+                "surface grid {grid:?} needs {} floats after its offset, mirror has {}",
+                grid.floats(),
                 mirror.len()
             )));
         }

@@ -81,7 +81,7 @@ impl Image {
         // SAFETY: `raw` was just created from this device.
         let requirements = unsafe { device.raw.get_image_memory_requirements(raw) };
         let allocation = {
-            let mut guard = device.allocator()?;
+            let mut guard = device.allocator();
             let result = match guard.as_mut() {
                 Some(a) => a
                     .allocate(&AllocationCreateDesc {
@@ -138,9 +138,7 @@ impl Image {
         }
         // SAFETY: as above.
         unsafe { device.raw.destroy_image(self.raw, None) };
-        if let Ok(mut guard) = device.allocator()
-            && let Some(a) = guard.as_mut()
-        {
+        if let Some(a) = device.allocator().as_mut() {
             let _ = a.free(self.allocation);
         }
     }

@@ -155,7 +155,7 @@ impl Device {
             requirements.size = requirements.size.div_ceil(atom) * atom;
         }
         let allocation = {
-            let mut guard = self.allocator()?;
+            let mut guard = self.allocator();
             let result = match guard.as_mut() {
                 Some(a) => a
                     .allocate(&AllocationCreateDesc {
@@ -211,7 +211,7 @@ impl Device {
         }
         if is_host_visible(desc.location) && buffer.mapped.is_none() {
             self.destroy_buffer(buffer);
-            return Err(GpuError::InvalidArgument(format!(
+            return Err(GpuError::Internal(format!(
                 "buffer {:?}: host-visible memory is not mapped",
                 desc.name
             )));
@@ -223,9 +223,7 @@ impl Device {
     pub fn destroy_buffer(&self, buffer: Buffer) {
         // SAFETY: the caller guarantees no pending GPU use; the buffer is destroyed once.
         unsafe { self.raw.destroy_buffer(buffer.raw, None) };
-        if let Ok(mut guard) = self.allocator()
-            && let Some(a) = guard.as_mut()
-        {
+        if let Some(a) = self.allocator().as_mut() {
             // A free only fails for a foreign allocation, which cannot happen here.
             let _ = a.free(buffer.allocation);
         }

@@ -50,7 +50,7 @@ impl MirrorBuffer {
             Some(ptr) => Ok(Self { buffer, ptr, len }),
             None => {
                 device.destroy_buffer(buffer);
-                Err(GpuError::InvalidArgument(format!(
+                Err(GpuError::Internal(format!(
                     "mirror {name:?}: mapping is missing or misaligned"
                 )))
             }
@@ -77,6 +77,10 @@ impl MirrorBuffer {
         self.buffer.address()
     }
 }
+
+// SAFETY: `ptr` points into the mapping owned by `buffer` (itself Send); moving the owner to
+// another thread moves the only handle through which the mapping is written.
+unsafe impl Send for MirrorBuffer {}
 
 /// A mirrored f32 array: one [`MirrorBuffer`] per frame in flight. Create with
 /// [`super::Renderer::create_mirror`], destroy with [`super::Renderer::destroy_mirror`].

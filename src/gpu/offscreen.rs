@@ -249,7 +249,7 @@ impl Renderer {
         }
         let src = buffer
             .mapped()
-            .ok_or_else(|| GpuError::InvalidArgument("readback buffer is not mapped".into()))?;
+            .ok_or_else(|| GpuError::Internal("readback buffer is not mapped".into()))?;
         let mut rgba = vec![0u8; len];
         // SAFETY: the buffer is mapped host-readable (GpuToCpu) memory of `len` bytes whose
         // writes completed (fence) and were made host-visible (barrier + invalidate).

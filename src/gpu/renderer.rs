@@ -177,7 +177,7 @@ impl Renderer {
             Ok(())
         } else {
             let text: Vec<String> = errors.iter().map(ToString::to_string).collect();
-            Err(GpuError::InvalidArgument(format!(
+            Err(GpuError::Validation(format!(
                 "{} validation error(s):\n{}",
                 errors.len(),
                 text.join("\n")

@@ -80,9 +80,7 @@ impl TransientBuffer {
         let (buffer, base) = match self.buffer.as_ref().and_then(|b| Some((b, b.mapped()?))) {
             Some(x) => x,
             None => {
-                return Err(GpuError::InvalidArgument(
-                    "transient buffer is not mapped".into(),
-                ));
+                return Err(GpuError::Internal("transient buffer is not mapped".into()));
             }
         };
         // SAFETY: offset + len <= capacity; the region is mapped, unaliased, and unused by

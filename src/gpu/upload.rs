@@ -79,7 +79,7 @@ impl Uploader {
     ) -> GpuResult<Buffer> {
         let base = staging
             .mapped()
-            .ok_or_else(|| GpuError::InvalidArgument("staging buffer is not mapped".into()))?;
+            .ok_or_else(|| GpuError::Internal("staging buffer is not mapped".into()))?;
         // SAFETY: the staging buffer is at least `bytes.len()` long, freshly created, mapped
         // and unaliased.
         unsafe { std::ptr::copy_nonoverlapping(bytes.as_ptr(), base.as_ptr(), bytes.len()) };
