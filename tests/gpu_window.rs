@@ -43,6 +43,7 @@ struct App {
     skipped: u32,
     resized_to: Option<[u32; 2]>,
     last_extent: [u32; 2],
+    minimised_once: bool,
     last_mode: Option<vk::PresentModeKHR>,
     error: Option<String>,
     done: bool,
@@ -130,6 +131,22 @@ impl App {
         }
         if self.presented == 8 {
             gpu.swapchain.set_vsync(false);
+        }
+        if self.presented == 6 && !self.minimised_once {
+            // A minimised window reports 0x0: no frame, no error, until a real size returns.
+            gpu.swapchain.resize(0, 0);
+            self.minimised_once = true;
+            if gpu
+                .renderer
+                .begin_swapchain(&mut gpu.swapchain)
+                .map_err(|e| e.to_string())?
+                .is_some()
+            {
+                return Err("a frame was begun on a zero-size swapchain".into());
+            }
+            self.skipped += 1;
+            let size = gpu.window.inner_size();
+            gpu.swapchain.resize(size.width, size.height);
         }
         let Some(mut frame) = gpu
             .renderer
@@ -239,6 +256,10 @@ fn swapchain_presents_resizes_and_tears_down() {
         panic!("{e}");
     }
     assert!(app.presented >= FRAMES, "presented {}", app.presented);
+    assert!(
+        app.minimised_once && app.skipped >= 1,
+        "zero-size path not taken"
+    );
     let sink = app.sink.expect("validation sink");
     let errors = sink.errors();
     assert!(
