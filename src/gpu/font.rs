@@ -4,7 +4,7 @@
 //! 7 rows of 5 bits, bit 4 being the leftmost column. Text is laid out on a 6×9 cell
 //! (one column and two rows of spacing) scaled by an integer-ish `scale` in pixels.
 
-use super::frame::OverlayVertex;
+use super::draw::OverlayVertex;
 
 /// Glyph width in font pixels.
 pub const GLYPH_WIDTH: u32 = 5;

@@ -59,6 +59,7 @@
 //! anything leaked is reported by the layer at teardown.
 
 mod device;
+mod draw;
 mod error;
 pub mod font;
 mod frame;
@@ -84,11 +85,12 @@ pub const FRAMES_IN_FLIGHT: usize = 2;
 
 pub use ash::vk;
 pub use device::{Device, DeviceCaps, GPU_ENV};
-pub use error::{GpuError, GpuResult};
-pub use frame::{
-    Camera, Frame, LineVertex, OverlayVertex, PointRun, PointStyle, PolylineStyle, SurfaceGrid,
+pub use draw::{
+    Camera, LineVertex, OverlayVertex, PointRun, PointStyle, PolylineStyle, SurfaceGrid,
     SurfaceStyle,
 };
+pub use error::{GpuError, GpuResult};
+pub use frame::Frame;
 pub use grid::{GridShape, grid_lines, grid_triangles};
 pub use instance::{ValidationMode, force_driver_files};
 pub use memory::{Buffer, BufferDesc};

@@ -9,11 +9,12 @@
 use ash::vk;
 
 use super::FRAMES_IN_FLIGHT;
+use super::draw::Camera;
 use super::error::{GpuError, GpuResult, VkResultExt};
-use super::frame::{Camera, Frame, FrameTarget, TargetView};
+use super::frame::{Frame, FrameTarget, TargetView};
 use super::image::full_range;
 use super::offscreen::OffscreenTarget;
-use super::pipeline::DEPTH_FORMAT;
+use super::pipeline::{DEPTH_FORMAT, PipelineKey};
 use super::renderer::Renderer;
 use super::swapchain::Swapchain;
 
@@ -92,6 +93,13 @@ fn begin_barriers(view: &TargetView, swapchain: bool) -> Vec<vk::ImageMemoryBarr
     barriers
 }
 
+fn pipeline_key(view: &TargetView) -> PipelineKey {
+    PipelineKey {
+        color_format: view.format,
+        samples: view.samples,
+    }
+}
+
 impl Renderer {
     /// Begins a frame rendering into `target`. Waits for the slot's previous use.
     pub fn begin_offscreen<'a>(
@@ -112,6 +120,12 @@ impl Renderer {
     ) -> GpuResult<Option<Frame<'a>>> {
         if swapchain.stale && !self.rebuild_swapchain(swapchain)? {
             return Ok(None);
+        }
+        // Build the pipelines before acquiring: once an image is acquired, the frame must be
+        // submitted, or the slot's acquire semaphore stays signalled.
+        if let Some(view) = swapchain.view(0) {
+            self.pipelines
+                .get(&self.device, &self.shaders, pipeline_key(&view))?;
         }
         let slot = self.next_slot()?;
         let Some(swapchain_fn) = self.device.swapchain_fn.as_ref() else {
@@ -165,11 +179,9 @@ impl Renderer {
         view: TargetView,
         slot: usize,
     ) -> GpuResult<Frame<'a>> {
-        let key = super::pipeline::PipelineKey {
-            color_format: view.format,
-            samples: view.samples,
-        };
-        let pipelines = *self.pipelines.get(&self.device, &self.shaders, key)?;
+        let pipelines = *self
+            .pipelines
+            .get(&self.device, &self.shaders, pipeline_key(&view))?;
         let frame_slot = &mut self.frames[slot];
         frame_slot.begin_commands(&self.device)?;
         let cmd = frame_slot.cmd;
