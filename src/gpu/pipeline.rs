@@ -6,6 +6,7 @@
 
 use std::collections::HashMap;
 use std::collections::hash_map::Entry;
+use std::mem::offset_of;
 
 use ash::vk;
 
@@ -86,8 +87,8 @@ pub(crate) struct OverlayPush {
     pub viewport: [f32; 2],
 }
 
-// SAFETY: all push structs are repr(C) with fields laid out without padding (checked by the
-// size assertions below and the unit test against the std430 offsets).
+// SAFETY: all push structs are repr(C) with fields laid out without padding (the size and
+// offset assertions below, which are also the std430 offsets of the GLSL blocks).
 unsafe impl Pod for SurfacePush {}
 // SAFETY: see above.
 unsafe impl Pod for WirePush {}
@@ -107,6 +108,17 @@ const _: () = {
     assert!(size_of::<PointsPush>() == 112);
     assert!(size_of::<Lines3dPush>() == 64);
     assert!(size_of::<OverlayPush>() == 8);
+    // std430 offsets of the blocks in surface.*, polyline.vert and points.vert.
+    assert!(offset_of!(SurfacePush, eye) == 64);
+    assert!(offset_of!(SurfacePush, back) == 112);
+    assert!(offset_of!(PolylinePush, color) == 64);
+    assert!(offset_of!(PolylinePush, points) == 80);
+    assert!(offset_of!(PolylinePush, viewport) == 88);
+    assert!(offset_of!(PolylinePush, width) == 108);
+    assert!(offset_of!(PointsPush, points) == 64);
+    assert!(offset_of!(PointsPush, viewport) == 72);
+    assert!(offset_of!(PointsPush, hovered) == 88);
+    assert!(offset_of!(PointsPush, selected_color) == 108);
 };
 
 /// Identifies a pipeline set: everything about a target that pipelines bake in.
