@@ -4,5 +4,6 @@
 #![allow(clippy::needless_range_loop)]
 pub mod cli;
 pub mod geom;
+pub mod gpu;
 pub mod sampling;
 pub mod scene;

@@ -1,0 +1,55 @@
+#version 460
+// Control points as screen-space squares, pulled from a float buffer like polyline.vert.
+// The hovered and the selected point (indices relative to the run, -1 for none) are larger
+// and have their own colours.
+#extension GL_EXT_buffer_reference : require
+
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer Floats {
+    float v[];
+};
+
+layout(push_constant) uniform Push {
+    mat4 view_proj;
+    Floats points;
+    vec2 viewport;
+    uint first;
+    uint stride;
+    int hovered;
+    int selected;
+    float size;           // pixels
+    uint color;           // packed linear RGBA8
+    uint hovered_color;
+    uint selected_color;
+} pc;
+
+layout(location = 0) flat out vec4 v_color;
+layout(location = 1) out vec2 v_uv;
+layout(location = 2) flat out float v_size;
+
+void main() {
+    int index = gl_InstanceIndex;
+    uint o = pc.first + uint(index) * pc.stride;
+    vec3 p = vec3(pc.points.v[o], pc.points.v[o + 1], pc.points.v[o + 2]);
+    vec4 c = pc.view_proj * vec4(p, 1.0);
+
+    float size = pc.size;
+    uint packed = pc.color;
+    if (index == pc.selected) {
+        size *= 1.5;
+        packed = pc.selected_color;
+    } else if (index == pc.hovered) {
+        size *= 1.35;
+        packed = pc.hovered_color;
+    }
+    const vec2 CORNER[6] = vec2[6](vec2(-1, -1), vec2(1, -1), vec2(1, 1),
+                                   vec2(-1, -1), vec2(1, 1), vec2(-1, 1));
+    vec2 uv = CORNER[gl_VertexIndex];
+    if (c.z < 0.0 || c.w <= 0.0) {
+        gl_Position = vec4(2.0, 2.0, 2.0, 1.0);
+    } else {
+        gl_Position = vec4(c.xy + uv * (size / pc.viewport) * c.w, c.z, c.w);
+    }
+    v_color = unpackUnorm4x8(packed);
+    v_uv = uv;
+    v_size = size;
+}

@@ -1,0 +1,210 @@
+//! Device-local images with one view: colour targets, MSAA colour and depth attachments.
+
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+
+use super::device::Device;
+use super::error::{GpuError, GpuResult, VkResultExt};
+use super::pipeline::DEPTH_FORMAT;
+
+/// Parameters for [`Image::new`].
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct ImageDesc<'a> {
+    pub name: &'a str,
+    pub extent: vk::Extent2D,
+    pub format: vk::Format,
+    pub samples: vk::SampleCountFlags,
+    pub usage: vk::ImageUsageFlags,
+}
+
+/// A 2D image, its memory and a view covering it. Destroy with [`Image::destroy`].
+pub(crate) struct Image {
+    pub raw: vk::Image,
+    pub view: vk::ImageView,
+    allocation: Allocation,
+}
+
+pub(crate) fn aspect_of(format: vk::Format) -> vk::ImageAspectFlags {
+    if format == DEPTH_FORMAT {
+        vk::ImageAspectFlags::DEPTH
+    } else {
+        vk::ImageAspectFlags::COLOR
+    }
+}
+
+/// A subresource range covering the single mip level and layer of an image of `format`.
+pub(crate) fn full_range(format: vk::Format) -> vk::ImageSubresourceRange {
+    vk::ImageSubresourceRange {
+        aspect_mask: aspect_of(format),
+        base_mip_level: 0,
+        level_count: 1,
+        base_array_layer: 0,
+        layer_count: 1,
+    }
+}
+
+/// A view of the whole single-level image.
+pub(crate) fn create_view(
+    device: &Device,
+    image: vk::Image,
+    format: vk::Format,
+) -> GpuResult<vk::ImageView> {
+    let info = vk::ImageViewCreateInfo::default()
+        .image(image)
+        .view_type(vk::ImageViewType::TYPE_2D)
+        .format(format)
+        .subresource_range(full_range(format));
+    // SAFETY: `image` is a live 2D image of `format` with one level and layer.
+    unsafe { device.raw.create_image_view(&info, None) }.vk("vkCreateImageView")
+}
+
+impl Image {
+    pub(crate) fn new(device: &Device, desc: &ImageDesc<'_>) -> GpuResult<Self> {
+        let info = vk::ImageCreateInfo::default()
+            .image_type(vk::ImageType::TYPE_2D)
+            .format(desc.format)
+            .extent(vk::Extent3D {
+                width: desc.extent.width,
+                height: desc.extent.height,
+                depth: 1,
+            })
+            .mip_levels(1)
+            .array_layers(1)
+            .samples(desc.samples)
+            .tiling(vk::ImageTiling::OPTIMAL)
+            .usage(desc.usage)
+            .sharing_mode(vk::SharingMode::EXCLUSIVE)
+            .initial_layout(vk::ImageLayout::UNDEFINED);
+        // SAFETY: valid device and create info (extent checked non-zero by callers).
+        let raw = unsafe { device.raw.create_image(&info, None) }.vk("vkCreateImage")?;
+        // SAFETY: `raw` was just created from this device.
+        let requirements = unsafe { device.raw.get_image_memory_requirements(raw) };
+        let allocation = {
+            let mut guard = device.allocator();
+            let result = match guard.as_mut() {
+                Some(a) => a
+                    .allocate(&AllocationCreateDesc {
+                        name: desc.name,
+                        requirements,
+                        location: MemoryLocation::GpuOnly,
+                        linear: false,
+                        allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+                    })
+                    .map_err(GpuError::from),
+                None => Err(GpuError::InvalidArgument(
+                    "device is being destroyed".into(),
+                )),
+            };
+            match result {
+                Ok(a) => a,
+                Err(e) => {
+                    // SAFETY: the image is unused and has no memory bound.
+                    unsafe { device.raw.destroy_image(raw, None) };
+                    return Err(e);
+                }
+            }
+        };
+        let mut image = Self {
+            raw,
+            view: vk::ImageView::null(),
+            allocation,
+        };
+        // SAFETY: memory type and offset satisfy `requirements`.
+        let bound = unsafe {
+            device
+                .raw
+                .bind_image_memory(raw, image.allocation.memory(), image.allocation.offset())
+        };
+        if let Err(e) = bound.vk("vkBindImageMemory") {
+            image.destroy(device);
+            return Err(e);
+        }
+        match create_view(device, raw, desc.format) {
+            Ok(view) => image.view = view,
+            Err(e) => {
+                image.destroy(device);
+                return Err(e);
+            }
+        }
+        Ok(image)
+    }
+
+    /// Destroys view, image and memory. The GPU must be done with them.
+    pub(crate) fn destroy(self, device: &Device) {
+        if self.view != vk::ImageView::null() {
+            // SAFETY: no pending GPU use (caller's guarantee); destroyed once.
+            unsafe { device.raw.destroy_image_view(self.view, None) };
+        }
+        // SAFETY: as above.
+        unsafe { device.raw.destroy_image(self.raw, None) };
+        if let Some(a) = device.allocator().as_mut() {
+            let _ = a.free(self.allocation);
+        }
+    }
+}
+
+/// The per-target attachments besides the final colour image: the multisampled colour image
+/// (resolved into the final one) when MSAA is on, and the depth buffer. Shared by both frames
+/// in flight; the layout transition at the start of each frame orders them (see `frame.rs`).
+pub(crate) struct Attachments {
+    pub msaa: Option<Image>,
+    pub depth: Image,
+    pub samples: vk::SampleCountFlags,
+}
+
+impl Attachments {
+    pub(crate) fn new(
+        device: &Device,
+        extent: vk::Extent2D,
+        color_format: vk::Format,
+        samples: vk::SampleCountFlags,
+    ) -> GpuResult<Self> {
+        let msaa = if samples != vk::SampleCountFlags::TYPE_1 {
+            Some(Image::new(
+                device,
+                &ImageDesc {
+                    name: "msaa colour",
+                    extent,
+                    format: color_format,
+                    samples,
+                    usage: vk::ImageUsageFlags::COLOR_ATTACHMENT
+                        | vk::ImageUsageFlags::TRANSIENT_ATTACHMENT,
+                },
+            )?)
+        } else {
+            None
+        };
+        let depth = Image::new(
+            device,
+            &ImageDesc {
+                name: "depth",
+                extent,
+                format: DEPTH_FORMAT,
+                samples,
+                usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT
+                    | vk::ImageUsageFlags::TRANSIENT_ATTACHMENT,
+            },
+        );
+        match depth {
+            Ok(depth) => Ok(Self {
+                msaa,
+                depth,
+                samples,
+            }),
+            Err(e) => {
+                if let Some(m) = msaa {
+                    m.destroy(device);
+                }
+                Err(e)
+            }
+        }
+    }
+
+    pub(crate) fn destroy(self, device: &Device) {
+        if let Some(m) = self.msaa {
+            m.destroy(device);
+        }
+        self.depth.destroy(device);
+    }
+}

@@ -1,0 +1,105 @@
+//! The spline-agnostic GPU layer: an ash (Vulkan 1.3) renderer with persistently mapped
+//! mirror buffers, dynamic rendering, synchronization2 and two frames in flight.
+//!
+//! Nothing here knows what a spline is: it draws grids of (position, normal) vertices,
+//! runs of points, line lists and 2D triangles from f32 buffers the caller fills.
+//!
+//! # Frame protocol
+//!
+//! ```no_run
+//! use prespline::gpu::*;
+//! # fn demo() -> Result<(), GpuError> {
+//! let mut renderer = Renderer::new(&RendererDesc::default())?;
+//! let mut target = renderer.create_offscreen(&OffscreenDesc { width: 640, height: 480, samples: 0 })?;
+//! let shape = GridShape { rows: 64, cols: 64 };
+//! let grid = SurfaceGrid { offset: 0, shape };
+//! let mut mirror = renderer.create_mirror("surface", grid.floats())?;
+//! renderer.fill_mirror(&mut mirror, 0, &vec![0.0; grid.floats()])?; // initial contents
+//!
+//! let mut frame = renderer.begin_offscreen(&mut target)?; // waits for this slot's fence
+//! {
+//!     // Bring *this slot* up to date: copy what changed since the slot was last written.
+//!     let mut w = frame.write_mirror(&mut mirror);
+//!     w.put_vertex(0, [0.0f32, 0.0, 0.0, 0.0, 0.0, 1.0]);
+//! } // dropping the writer hands its ranges to the frame (flushed before submit if needed)
+//! frame.set_camera(Camera::default());
+//! frame.draw_surface(&mirror, grid, &SurfaceStyle::default())?;
+//! frame.draw_wire(&mirror, grid, 8, [0.0, 0.0, 0.0, 1.0])?;
+//! frame.finish()?;
+//! let pixels = renderer.read_pixels(&target)?;
+//! # renderer.destroy_mirror(mirror);
+//! # renderer.destroy_offscreen(target)?;
+//! # let _ = pixels; Ok(()) }
+//! ```
+//!
+//! * [`Renderer::begin_offscreen`] / [`Renderer::begin_swapchain`] pick slot
+//!   `frame_number % FRAMES_IN_FLIGHT`, wait for its fence, read its GPU timestamps, release
+//!   its deferred resources and start its command buffer. Only after that may the caller
+//!   write that slot of its mirrors, through [`Frame::write_mirror`]; each slot must receive
+//!   every change made since *it* was last written (keep per-slot dirty ranges).
+//! * Draw calls record into the frame; rendering begins lazily with the clear.
+//! * [`Frame::finish`] ends recording, flushes non-coherent host writes (aligned to
+//!   `nonCoherentAtomSize`), submits with `vkQueueSubmit2`, presents for swapchains.
+//!
+//! Mapped memory is never read: mirrors expose only writes (it may be write-combined).
+//!
+//! # Conventions
+//!
+//! * `Camera::view_proj` is y-up with depth in `[0, 1]` (`glam::Mat4::perspective_rh`); the
+//!   viewport is flipped so images come out upright.
+//! * Colours in styles are linear RGBA `f32`; vertex colours (`LineVertex`,
+//!   `OverlayVertex`) are sRGB-encoded RGBA8. Targets are sRGB formats.
+//! * Mirror offsets/strides are in f32 elements. A surface vertex is 6 floats (position,
+//!   normal); a curve point is 3 floats.
+//!
+//! # Destruction
+//!
+//! Mirrors, targets and swapchains are destroyed explicitly through the renderer
+//! (`destroy_*`); dropping the renderer destroys everything else. With validation on,
+//! anything leaked is reported by the layer at teardown.
+
+mod device;
+mod draw;
+mod error;
+pub mod font;
+mod frame;
+mod grid;
+mod image;
+mod instance;
+mod memory;
+mod mirror;
+mod offscreen;
+mod pipeline;
+mod pod;
+mod renderer;
+mod shader;
+mod submit;
+mod swapchain;
+mod timestamp;
+mod transient;
+mod upload;
+mod validation;
+
+/// Frames the CPU may record ahead of the GPU; also the number of slots of every mirror.
+pub const FRAMES_IN_FLIGHT: usize = 2;
+
+pub use ash::vk;
+pub use device::{Device, DeviceCaps, GPU_ENV};
+pub use draw::{
+    Camera, LineVertex, OverlayVertex, PointRun, PointStyle, PolylineStyle, SurfaceGrid,
+    SurfaceStyle,
+};
+pub use error::{GpuError, GpuResult};
+pub use frame::Frame;
+pub use grid::{GridShape, grid_lines, grid_triangles};
+pub use instance::{ValidationMode, force_driver_files};
+pub use memory::{Buffer, BufferDesc};
+pub use mirror::{Mirror, MirrorBuffer, MirrorWriter};
+pub use offscreen::{OFFSCREEN_FORMAT, OffscreenDesc, OffscreenTarget, Pixels};
+pub use pipeline::DEPTH_FORMAT;
+pub use renderer::{Renderer, RendererDesc};
+pub use swapchain::{Swapchain, SwapchainDesc};
+pub use validation::{Severity, ValidationMessage, ValidationSink};
+
+/// ICD manifest of Mesa's lavapipe (software Vulkan) on Debian/Ubuntu, used by tests.
+pub const LAVAPIPE_ICD: &str = "/usr/share/vulkan/icd.d/lvp_icd.x86_64.json";

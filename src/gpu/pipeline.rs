@@ -1,0 +1,439 @@
+//! Graphics pipelines for dynamic rendering, built per (colour format, sample count).
+//!
+//! All pipelines share one layout: no descriptor sets, one 128-byte push-constant range
+//! (the guaranteed minimum) visible to both stages. Vertex data comes from vertex buffers, or
+//! for polylines/points from buffer device addresses in the push constants.
+
+use std::collections::HashMap;
+use std::collections::hash_map::Entry;
+use std::mem::offset_of;
+
+use ash::vk;
+
+use super::device::Device;
+use super::error::{GpuResult, VkResultExt};
+use super::pod::Pod;
+use super::shader::{ShaderId, Shaders};
+
+/// Depth attachment format of every target.
+pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
+/// Size of the single push-constant range.
+pub(crate) const PUSH_SIZE: u32 = 128;
+pub(crate) const PUSH_STAGES: vk::ShaderStageFlags = vk::ShaderStageFlags::from_raw(
+    vk::ShaderStageFlags::VERTEX.as_raw() | vk::ShaderStageFlags::FRAGMENT.as_raw(),
+);
+
+/// Push constants of `surface.vert`/`surface.frag` (std430 layout mirrored by `repr(C)`).
+#[repr(C)]
+#[derive(Clone, Copy)]
+pub(crate) struct SurfacePush {
+    pub view_proj: [f32; 16],
+    pub eye: [f32; 4],
+    pub light: [f32; 4],
+    pub front: [f32; 4],
+    pub back: [f32; 4],
+}
+
+/// Push constants of `wire.vert` + `flat.frag`.
+#[repr(C)]
+#[derive(Clone, Copy)]
+pub(crate) struct WirePush {
+    pub view_proj: [f32; 16],
+    pub color: [f32; 4],
+}
+
+/// Push constants of `polyline.vert` + `flat.frag`.
+#[repr(C)]
+#[derive(Clone, Copy)]
+pub(crate) struct PolylinePush {
+    pub view_proj: [f32; 16],
+    pub color: [f32; 4],
+    pub points: u64,
+    pub viewport: [f32; 2],
+    pub first: u32,
+    pub stride: u32,
+    pub count: u32,
+    pub width: f32,
+}
+
+/// Push constants of `points.vert`.
+#[repr(C)]
+#[derive(Clone, Copy)]
+pub(crate) struct PointsPush {
+    pub view_proj: [f32; 16],
+    pub points: u64,
+    pub viewport: [f32; 2],
+    pub first: u32,
+    pub stride: u32,
+    pub hovered: i32,
+    pub selected: i32,
+    pub size: f32,
+    pub color: u32,
+    pub hovered_color: u32,
+    pub selected_color: u32,
+}
+
+/// Push constants of `lines3d.vert`.
+#[repr(C)]
+#[derive(Clone, Copy)]
+pub(crate) struct Lines3dPush {
+    pub view_proj: [f32; 16],
+}
+
+/// Push constants of `overlay.vert`.
+#[repr(C)]
+#[derive(Clone, Copy)]
+pub(crate) struct OverlayPush {
+    pub viewport: [f32; 2],
+}
+
+// SAFETY: all push structs are repr(C) with fields laid out without padding (the size and
+// offset assertions below, which are also the std430 offsets of the GLSL blocks).
+unsafe impl Pod for SurfacePush {}
+// SAFETY: see above.
+unsafe impl Pod for WirePush {}
+// SAFETY: see above.
+unsafe impl Pod for PolylinePush {}
+// SAFETY: see above.
+unsafe impl Pod for PointsPush {}
+// SAFETY: see above.
+unsafe impl Pod for Lines3dPush {}
+// SAFETY: see above.
+unsafe impl Pod for OverlayPush {}
+
+const _: () = {
+    assert!(size_of::<SurfacePush>() == 128);
+    assert!(size_of::<WirePush>() == 80);
+    assert!(size_of::<PolylinePush>() == 112);
+    assert!(size_of::<PointsPush>() == 112);
+    assert!(size_of::<Lines3dPush>() == 64);
+    assert!(size_of::<OverlayPush>() == 8);
+    // std430 offsets of the blocks in surface.*, polyline.vert and points.vert.
+    assert!(offset_of!(SurfacePush, eye) == 64);
+    assert!(offset_of!(SurfacePush, back) == 112);
+    assert!(offset_of!(PolylinePush, color) == 64);
+    assert!(offset_of!(PolylinePush, points) == 80);
+    assert!(offset_of!(PolylinePush, viewport) == 88);
+    assert!(offset_of!(PolylinePush, width) == 108);
+    assert!(offset_of!(PointsPush, points) == 64);
+    assert!(offset_of!(PointsPush, viewport) == 72);
+    assert!(offset_of!(PointsPush, hovered) == 88);
+    assert!(offset_of!(PointsPush, selected_color) == 108);
+};
+
+/// Identifies a pipeline set: everything about a target that pipelines bake in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) struct PipelineKey {
+    pub color_format: vk::Format,
+    pub samples: vk::SampleCountFlags,
+}
+
+/// One pipeline per primitive kind, for one [`PipelineKey`].
+#[derive(Clone, Copy)]
+pub(crate) struct PipelineSet {
+    pub surface: vk::Pipeline,
+    pub wire: vk::Pipeline,
+    pub polyline: vk::Pipeline,
+    pub points: vk::Pipeline,
+    pub lines3d: vk::Pipeline,
+    pub overlay: vk::Pipeline,
+}
+
+/// The shared layout and the pipeline sets built so far.
+#[derive(Default)]
+pub(crate) struct Pipelines {
+    pub layout: vk::PipelineLayout,
+    sets: HashMap<PipelineKey, PipelineSet>,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Depth {
+    /// Test and write, pushed back by a depth bias so overlays on the surface win.
+    Biased,
+    /// Test (less-or-equal) and write.
+    On,
+    /// Test enable set per draw (`vkCmdSetDepthTestEnable`).
+    Dynamic,
+    Off,
+}
+
+struct Spec<'a> {
+    vs: ShaderId,
+    fs: ShaderId,
+    bindings: &'a [vk::VertexInputBindingDescription],
+    attributes: &'a [vk::VertexInputAttributeDescription],
+    topology: vk::PrimitiveTopology,
+    depth: Depth,
+    blend: bool,
+}
+
+fn binding(stride: u32) -> [vk::VertexInputBindingDescription; 1] {
+    [vk::VertexInputBindingDescription {
+        binding: 0,
+        stride,
+        input_rate: vk::VertexInputRate::VERTEX,
+    }]
+}
+
+fn attribute(
+    location: u32,
+    format: vk::Format,
+    offset: u32,
+) -> vk::VertexInputAttributeDescription {
+    vk::VertexInputAttributeDescription {
+        location,
+        binding: 0,
+        format,
+        offset,
+    }
+}
+
+impl Pipelines {
+    pub(crate) fn new(device: &Device) -> GpuResult<Self> {
+        let ranges = [vk::PushConstantRange {
+            stage_flags: PUSH_STAGES,
+            offset: 0,
+            size: PUSH_SIZE,
+        }];
+        let info = vk::PipelineLayoutCreateInfo::default().push_constant_ranges(&ranges);
+        // SAFETY: valid device and create info.
+        let layout = unsafe { device.raw.create_pipeline_layout(&info, None) }
+            .vk("vkCreatePipelineLayout")?;
+        Ok(Self {
+            layout,
+            sets: HashMap::new(),
+        })
+    }
+
+    /// The pipeline set for `key`, built on first use (a new swapchain format, say).
+    pub(crate) fn get(
+        &mut self,
+        device: &Device,
+        shaders: &Shaders,
+        key: PipelineKey,
+    ) -> GpuResult<&PipelineSet> {
+        Ok(match self.sets.entry(key) {
+            Entry::Occupied(e) => e.into_mut(),
+            Entry::Vacant(e) => e.insert(build_set(device, shaders, self.layout, key)?),
+        })
+    }
+
+    pub(crate) fn destroy(self, device: &Device) {
+        for set in self.sets.into_values() {
+            for p in [
+                set.surface,
+                set.wire,
+                set.polyline,
+                set.points,
+                set.lines3d,
+                set.overlay,
+            ] {
+                // SAFETY: the renderer waited for the GPU before destroying pipelines.
+                unsafe { device.raw.destroy_pipeline(p, None) };
+            }
+        }
+        // SAFETY: no pipeline using the layout remains.
+        unsafe { device.raw.destroy_pipeline_layout(self.layout, None) };
+    }
+}
+
+fn build_set(
+    device: &Device,
+    shaders: &Shaders,
+    layout: vk::PipelineLayout,
+    key: PipelineKey,
+) -> GpuResult<PipelineSet> {
+    use vk::Format as F;
+    let surface_binding = binding(24);
+    let surface_attrs = [
+        attribute(0, F::R32G32B32_SFLOAT, 0),
+        attribute(1, F::R32G32B32_SFLOAT, 12),
+    ];
+    let lines_binding = binding(16);
+    let lines_attrs = [
+        attribute(0, F::R32G32B32_SFLOAT, 0),
+        attribute(1, F::R8G8B8A8_UNORM, 12),
+    ];
+    let overlay_binding = binding(12);
+    let overlay_attrs = [
+        attribute(0, F::R32G32_SFLOAT, 0),
+        attribute(1, F::R8G8B8A8_UNORM, 8),
+    ];
+    let tri = vk::PrimitiveTopology::TRIANGLE_LIST;
+    let specs = [
+        Spec {
+            vs: ShaderId::SurfaceVert,
+            fs: ShaderId::SurfaceFrag,
+            bindings: &surface_binding,
+            attributes: &surface_attrs,
+            topology: tri,
+            depth: Depth::Biased,
+            blend: false,
+        },
+        Spec {
+            vs: ShaderId::WireVert,
+            fs: ShaderId::FlatFrag,
+            bindings: &surface_binding,
+            attributes: &surface_attrs[..1],
+            topology: vk::PrimitiveTopology::LINE_LIST,
+            depth: Depth::On,
+            blend: false,
+        },
+        Spec {
+            vs: ShaderId::PolylineVert,
+            fs: ShaderId::FlatFrag,
+            bindings: &[],
+            attributes: &[],
+            topology: tri,
+            depth: Depth::Dynamic,
+            blend: false,
+        },
+        Spec {
+            vs: ShaderId::PointsVert,
+            fs: ShaderId::PointsFrag,
+            bindings: &[],
+            attributes: &[],
+            topology: tri,
+            depth: Depth::Dynamic,
+            blend: false,
+        },
+        Spec {
+            vs: ShaderId::Lines3dVert,
+            fs: ShaderId::ColorFrag,
+            bindings: &lines_binding,
+            attributes: &lines_attrs,
+            topology: vk::PrimitiveTopology::LINE_LIST,
+            depth: Depth::On,
+            blend: false,
+        },
+        Spec {
+            vs: ShaderId::OverlayVert,
+            fs: ShaderId::ColorFrag,
+            bindings: &overlay_binding,
+            attributes: &overlay_attrs,
+            topology: tri,
+            depth: Depth::Off,
+            blend: true,
+        },
+    ];
+    let mut pipelines = Vec::with_capacity(specs.len());
+    for spec in &specs {
+        match build_one(device, shaders, layout, key, spec) {
+            Ok(p) => pipelines.push(p),
+            Err(e) => {
+                for p in pipelines {
+                    // SAFETY: freshly created, never used.
+                    unsafe { device.raw.destroy_pipeline(p, None) };
+                }
+                return Err(e);
+            }
+        }
+    }
+    Ok(PipelineSet {
+        surface: pipelines[0],
+        wire: pipelines[1],
+        polyline: pipelines[2],
+        points: pipelines[3],
+        lines3d: pipelines[4],
+        overlay: pipelines[5],
+    })
+}
+
+fn build_one(
+    device: &Device,
+    shaders: &Shaders,
+    layout: vk::PipelineLayout,
+    key: PipelineKey,
+    spec: &Spec<'_>,
+) -> GpuResult<vk::Pipeline> {
+    let stages = [
+        vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::VERTEX)
+            .module(shaders.get(spec.vs))
+            .name(c"main"),
+        vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::FRAGMENT)
+            .module(shaders.get(spec.fs))
+            .name(c"main"),
+    ];
+    let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
+        .vertex_binding_descriptions(spec.bindings)
+        .vertex_attribute_descriptions(spec.attributes);
+    let input_assembly =
+        vk::PipelineInputAssemblyStateCreateInfo::default().topology(spec.topology);
+    let viewport = vk::PipelineViewportStateCreateInfo::default()
+        .viewport_count(1)
+        .scissor_count(1);
+    let mut raster = vk::PipelineRasterizationStateCreateInfo::default()
+        .polygon_mode(vk::PolygonMode::FILL)
+        .cull_mode(vk::CullModeFlags::NONE)
+        .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
+        .line_width(1.0);
+    if spec.depth == Depth::Biased {
+        // Push filled surfaces back by a couple of depth units plus a slope term, so lines
+        // lying exactly on the surface (isolines, wireframe, curves on it) pass LESS_OR_EQUAL.
+        raster = raster
+            .depth_bias_enable(true)
+            .depth_bias_constant_factor(2.0)
+            .depth_bias_slope_factor(1.5);
+    }
+    let multisample =
+        vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(key.samples);
+    let depth_on = spec.depth != Depth::Off;
+    let depth = vk::PipelineDepthStencilStateCreateInfo::default()
+        .depth_test_enable(depth_on)
+        .depth_write_enable(depth_on)
+        .depth_compare_op(vk::CompareOp::LESS_OR_EQUAL);
+    let blend_attachment = if spec.blend {
+        vk::PipelineColorBlendAttachmentState::default()
+            .blend_enable(true)
+            .src_color_blend_factor(vk::BlendFactor::SRC_ALPHA)
+            .dst_color_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
+            .color_blend_op(vk::BlendOp::ADD)
+            .src_alpha_blend_factor(vk::BlendFactor::ONE)
+            .dst_alpha_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
+            .alpha_blend_op(vk::BlendOp::ADD)
+            .color_write_mask(vk::ColorComponentFlags::RGBA)
+    } else {
+        vk::PipelineColorBlendAttachmentState::default()
+            .color_write_mask(vk::ColorComponentFlags::RGBA)
+    };
+    let blend_attachments = [blend_attachment];
+    let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
+    let dynamic_states: &[vk::DynamicState] = if spec.depth == Depth::Dynamic {
+        &[
+            vk::DynamicState::VIEWPORT,
+            vk::DynamicState::SCISSOR,
+            vk::DynamicState::DEPTH_TEST_ENABLE,
+        ]
+    } else {
+        &[vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR]
+    };
+    let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(dynamic_states);
+    let color_formats = [key.color_format];
+    let mut rendering = vk::PipelineRenderingCreateInfo::default()
+        .color_attachment_formats(&color_formats)
+        .depth_attachment_format(DEPTH_FORMAT);
+    let info = vk::GraphicsPipelineCreateInfo::default()
+        .stages(&stages)
+        .vertex_input_state(&vertex_input)
+        .input_assembly_state(&input_assembly)
+        .viewport_state(&viewport)
+        .rasterization_state(&raster)
+        .multisample_state(&multisample)
+        .depth_stencil_state(&depth)
+        .color_blend_state(&blend)
+        .dynamic_state(&dynamic)
+        .layout(layout)
+        .push_next(&mut rendering);
+    // SAFETY: all state structs outlive the call; shaders match the layout's push range.
+    let result = unsafe {
+        device
+            .raw
+            .create_graphics_pipelines(vk::PipelineCache::null(), &[info], None)
+    };
+    match result {
+        Ok(p) => Ok(p[0]),
+        Err((_, e)) => Err(e).vk("vkCreateGraphicsPipelines"),
+    }
+}

@@ -1,0 +1,212 @@
+//! The [`Renderer`]: owns the instance, device, pipelines, frame slots and caches.
+
+use std::mem::ManuallyDrop;
+
+use raw_window_handle::RawDisplayHandle;
+
+use super::FRAMES_IN_FLIGHT;
+use super::device::{Device, DeviceCaps};
+use super::error::{GpuError, GpuResult};
+use super::frame::FrameSlot;
+use super::grid::GridCache;
+use super::instance::{Instance, InstanceDesc, ValidationMode};
+use super::mirror::Mirror;
+use super::pipeline::Pipelines;
+use super::shader::Shaders;
+use super::upload::Uploader;
+use super::validation::ValidationSink;
+
+/// Parameters for [`Renderer::new`].
+#[derive(Clone, Debug, Default)]
+pub struct RendererDesc {
+    /// Application name reported to the driver.
+    pub app_name: String,
+    /// Validation layer policy (tests use [`ValidationMode::Required`]).
+    pub validation: ValidationMode,
+    /// Also enable synchronization validation (slow; for tests).
+    pub sync_validation: bool,
+    /// Display that swapchains will be created for; `None` for offscreen-only use.
+    pub display: Option<RawDisplayHandle>,
+    /// Flush host writes even when memory is coherent. Only useful to exercise the
+    /// non-coherent path (under validation) on drivers whose memory is all coherent.
+    pub always_flush: bool,
+}
+
+/// The GPU renderer. See the [module docs](super) for the frame protocol.
+///
+/// Resources it hands out (mirrors, targets, swapchains) must be given back through the
+/// matching `destroy_*` method before the renderer is dropped; the validation layer reports
+/// anything left over as a leak.
+pub struct Renderer {
+    pub(crate) frames: Vec<FrameSlot>,
+    pub(crate) frame_number: u64,
+    pub(crate) pipelines: Pipelines,
+    pub(crate) shaders: Shaders,
+    pub(crate) grids: GridCache,
+    pub(crate) uploader: Uploader,
+    pub(crate) always_flush: bool,
+    // Dropped by hand, in order, after everything above (see `Drop`).
+    pub(crate) device: ManuallyDrop<Device>,
+    pub(crate) instance: ManuallyDrop<Instance>,
+}
+
+impl Renderer {
+    /// Creates instance, device, pipelines layout, shaders and frame slots.
+    pub fn new(desc: &RendererDesc) -> GpuResult<Self> {
+        let instance = Instance::new(&InstanceDesc {
+            app_name: if desc.app_name.is_empty() {
+                "prespline".into()
+            } else {
+                desc.app_name.clone()
+            },
+            validation: desc.validation,
+            sync_validation: desc.sync_validation,
+            display: desc.display,
+        })?;
+        let device = match Device::new(&instance) {
+            Ok(d) => d,
+            Err(e) => {
+                instance.destroy();
+                return Err(e);
+            }
+        };
+        // From here on, Drop cleans up whatever was created.
+        let mut renderer = Self {
+            frames: Vec::new(),
+            frame_number: 0,
+            pipelines: Pipelines::default(),
+            shaders: Shaders::default(),
+            grids: GridCache::default(),
+            uploader: Uploader::default(),
+            always_flush: desc.always_flush,
+            device: ManuallyDrop::new(device),
+            instance: ManuallyDrop::new(instance),
+        };
+        renderer.shaders = Shaders::new(&renderer.device)?;
+        renderer.pipelines = Pipelines::new(&renderer.device)?;
+        renderer.uploader = Uploader::new(&renderer.device)?;
+        for _ in 0..FRAMES_IN_FLIGHT {
+            let slot = FrameSlot::new(&renderer.device, desc.always_flush)?;
+            renderer.frames.push(slot);
+        }
+        Ok(renderer)
+    }
+
+    /// What the chosen device can do (name, timestamps, MSAA, ...).
+    pub fn caps(&self) -> &DeviceCaps {
+        self.device.caps()
+    }
+
+    /// The device, for callers that need raw Vulkan access.
+    pub fn device(&self) -> &Device {
+        &self.device
+    }
+
+    /// The validation message sink, when validation is on. Keep a clone to inspect messages
+    /// emitted during teardown (leak reports) after the renderer is dropped.
+    pub fn validation_sink(&self) -> Option<ValidationSink> {
+        self.instance.validation_sink()
+    }
+
+    /// Number of frames begun so far (the next frame's number).
+    pub fn frame_number(&self) -> u64 {
+        self.frame_number
+    }
+
+    /// GPU time (ms) of the most recent frame whose timing is known.
+    pub fn last_gpu_time_ms(&self) -> Option<f64> {
+        let prev = (self.frame_number + FRAMES_IN_FLIGHT as u64 - 1) as usize % FRAMES_IN_FLIGHT;
+        self.frames
+            .get(prev)
+            .and_then(|f| f.gpu_ms)
+            .or_else(|| self.frames.iter().find_map(|f| f.gpu_ms))
+    }
+
+    /// Blocks until the GPU has finished all submitted work.
+    pub fn wait_idle(&self) -> GpuResult<()> {
+        self.device.wait_idle()
+    }
+
+    /// Creates a mirrored array of `len` f32s (one buffer per frame in flight). Its contents
+    /// are undefined until written: use [`Renderer::fill_mirror`] or per-frame writes.
+    pub fn create_mirror(&mut self, name: &str, len: usize) -> GpuResult<Mirror> {
+        Mirror::new(&self.device, name, len)
+    }
+
+    /// Writes `data` at `offset` into **every** slot of `mirror`, waiting first for all
+    /// frames in flight. For initial contents and wholesale replacement; per-frame updates
+    /// should use [`super::Frame::write_mirror`] instead, which never waits.
+    pub fn fill_mirror(
+        &mut self,
+        mirror: &mut Mirror,
+        offset: usize,
+        data: &[f32],
+    ) -> GpuResult<()> {
+        for f in &mut self.frames {
+            f.wait_and_recycle(&self.device)?;
+        }
+        let atom = self.device.caps.non_coherent_atom_size;
+        let mut flushes = Vec::new();
+        for slot in 0..FRAMES_IN_FLIGHT {
+            let track = self.always_flush || mirror.slot(slot).buffer.needs_flush();
+            let mut w = mirror.writer(slot, atom, track, &mut flushes);
+            w.write(offset, data)?;
+        }
+        self.device.flush_ranges(&flushes)
+    }
+
+    /// Destroys a mirror. Each slot's buffer is released when that slot's fence next
+    /// signals, so this never waits.
+    pub fn destroy_mirror(&mut self, mirror: Mirror) {
+        for (i, b) in mirror.slots.into_iter().enumerate() {
+            match self.frames.get_mut(i) {
+                Some(f) => f.release.push(b.buffer),
+                None => self.device.destroy_buffer(b.buffer),
+            }
+        }
+    }
+
+    /// Fails with a clear message when the validation layer recorded errors (handy in tests
+    /// before teardown; leak reports arrive only during drop).
+    pub fn check_validation(&self) -> GpuResult<()> {
+        let Some(sink) = self.validation_sink() else {
+            return Ok(());
+        };
+        let errors = sink.errors();
+        if errors.is_empty() {
+            Ok(())
+        } else {
+            let text: Vec<String> = errors.iter().map(ToString::to_string).collect();
+            Err(GpuError::Validation(format!(
+                "{} validation error(s):\n{}",
+                errors.len(),
+                text.join("\n")
+            )))
+        }
+    }
+}
+
+impl Drop for Renderer {
+    fn drop(&mut self) {
+        // Even if the device is lost there is nothing better to do than destroy everything.
+        let _ = self.device.wait_idle();
+        let device = &*self.device;
+        for f in std::mem::take(&mut self.frames) {
+            f.destroy(device);
+        }
+        std::mem::take(&mut self.grids).destroy(device);
+        std::mem::take(&mut self.uploader).destroy(device);
+        std::mem::take(&mut self.pipelines).destroy(device);
+        std::mem::take(&mut self.shaders).destroy(device);
+        // SAFETY: `device` and `instance` are taken exactly once, here, and never used again;
+        // every child object was destroyed above (or by the caller via destroy_*).
+        let (device, instance) = unsafe {
+            (
+                ManuallyDrop::take(&mut self.device),
+                ManuallyDrop::take(&mut self.instance),
+            )
+        };
+        device.destroy();
+        instance.destroy();
+    }
+}

@@ -1,0 +1,382 @@
+//! Window surface and swapchain: creation from a raw-window-handle window, present-mode
+//! choice, recreation on resize / out-of-date / suboptimal, and minimised (zero-size) windows.
+
+use ash::vk;
+use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
+
+use super::device::Device;
+use super::error::{GpuError, GpuResult, VkResultExt};
+use super::frame::TargetView;
+use super::image::{Attachments, create_view};
+use super::renderer::Renderer;
+
+/// Parameters for [`Renderer::create_swapchain`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SwapchainDesc {
+    /// Window inner width in physical pixels (used when the surface does not dictate it).
+    pub width: u32,
+    /// Window inner height in physical pixels.
+    pub height: u32,
+    /// `true`: FIFO (vsync). `false`: MAILBOX, else IMMEDIATE, else FIFO.
+    pub vsync: bool,
+    /// MSAA sample count; 0 picks [`Renderer::default_samples`].
+    pub samples: u32,
+}
+
+/// A surface and its swapchain. Destroy with [`Renderer::destroy_swapchain`].
+pub struct Swapchain {
+    surface: vk::SurfaceKHR,
+    pub(crate) raw: vk::SwapchainKHR,
+    images: Vec<vk::Image>,
+    views: Vec<vk::ImageView>,
+    /// One per image: a present waits on the semaphore of the image it shows, so reuse is
+    /// safe once that image is acquired again.
+    pub(crate) render_finished: Vec<vk::Semaphore>,
+    attachments: Option<Attachments>,
+    format: vk::SurfaceFormatKHR,
+    extent: vk::Extent2D,
+    wanted: vk::Extent2D,
+    vsync: bool,
+    samples: vk::SampleCountFlags,
+    present_mode: vk::PresentModeKHR,
+    /// Set on resize, out-of-date or suboptimal; the next begin recreates.
+    pub(crate) stale: bool,
+}
+
+impl Swapchain {
+    /// Records a new window size; the swapchain is rebuilt at the next frame. A zero size
+    /// (minimised window) makes `begin_swapchain` return `None` until a real size arrives.
+    pub fn resize(&mut self, width: u32, height: u32) {
+        let wanted = vk::Extent2D { width, height };
+        if wanted != self.wanted {
+            self.wanted = wanted;
+            self.stale = true;
+        }
+    }
+
+    /// Switches between FIFO and the low-latency modes at the next frame.
+    pub fn set_vsync(&mut self, vsync: bool) {
+        if vsync != self.vsync {
+            self.vsync = vsync;
+            self.stale = true;
+        }
+    }
+
+    /// Current image size (0×0 before the first successful build).
+    pub fn extent(&self) -> [u32; 2] {
+        [self.extent.width, self.extent.height]
+    }
+
+    /// Colour format of the swapchain images.
+    pub fn format(&self) -> vk::Format {
+        self.format.format
+    }
+
+    /// Present mode in use.
+    pub fn present_mode(&self) -> vk::PresentModeKHR {
+        self.present_mode
+    }
+
+    pub(crate) fn view(&self, image_index: u32) -> Option<TargetView> {
+        let a = self.attachments.as_ref()?;
+        let i = image_index as usize;
+        Some(TargetView {
+            image: *self.images.get(i)?,
+            view: *self.views.get(i)?,
+            msaa: a.msaa.as_ref().map(|m| (m.raw, m.view)),
+            depth: (a.depth.raw, a.depth.view),
+            extent: self.extent,
+            format: self.format.format,
+            samples: self.samples,
+        })
+    }
+
+    /// Destroys views and attachments (not the swapchain, surface or semaphores).
+    fn destroy_images(&mut self, device: &Device) {
+        for v in self.views.drain(..) {
+            // SAFETY: the caller made the device idle.
+            unsafe { device.raw.destroy_image_view(v, None) };
+        }
+        self.images.clear();
+        if let Some(a) = self.attachments.take() {
+            a.destroy(device);
+        }
+    }
+}
+
+/// Prefers an 8-bit sRGB format so that linear shader output is encoded for display.
+pub(crate) fn choose_format(formats: &[vk::SurfaceFormatKHR]) -> Option<vk::SurfaceFormatKHR> {
+    let srgb = |f: vk::Format| {
+        formats
+            .iter()
+            .copied()
+            .find(|s| s.format == f && s.color_space == vk::ColorSpaceKHR::SRGB_NONLINEAR)
+    };
+    srgb(vk::Format::B8G8R8A8_SRGB)
+        .or_else(|| srgb(vk::Format::R8G8B8A8_SRGB))
+        .or_else(|| formats.first().copied())
+}
+
+/// FIFO for vsync (always supported); otherwise MAILBOX, IMMEDIATE, FIFO in that order.
+pub(crate) fn choose_present_mode(modes: &[vk::PresentModeKHR], vsync: bool) -> vk::PresentModeKHR {
+    if vsync {
+        return vk::PresentModeKHR::FIFO;
+    }
+    [vk::PresentModeKHR::MAILBOX, vk::PresentModeKHR::IMMEDIATE]
+        .into_iter()
+        .find(|m| modes.contains(m))
+        .unwrap_or(vk::PresentModeKHR::FIFO)
+}
+
+impl Renderer {
+    /// Creates a surface for `window` and its swapchain. The renderer must have been created
+    /// with `RendererDesc::display` set to the window's display.
+    pub fn create_swapchain<W>(&mut self, window: &W, desc: &SwapchainDesc) -> GpuResult<Swapchain>
+    where
+        W: HasDisplayHandle + HasWindowHandle + ?Sized,
+    {
+        let surface_fn = self.instance.surface_fn.as_ref().ok_or_else(|| {
+            GpuError::Surface(
+                "renderer was created without a display (RendererDesc::display)".into(),
+            )
+        })?;
+        if self.device.swapchain_fn.is_none() {
+            return Err(GpuError::Surface("device has no VK_KHR_swapchain".into()));
+        }
+        let display = window
+            .display_handle()
+            .map_err(|e| GpuError::Surface(e.to_string()))?
+            .as_raw();
+        let handle = window
+            .window_handle()
+            .map_err(|e| GpuError::Surface(e.to_string()))?
+            .as_raw();
+        // SAFETY: the handles come from a live window that outlives the swapchain (caller's
+        // contract: destroy the swapchain before the window).
+        let surface = unsafe {
+            ash_window::create_surface(
+                &self.instance.entry,
+                &self.instance.raw,
+                display,
+                handle,
+                None,
+            )
+        }
+        .vk("vkCreate*SurfaceKHR")?;
+        // SAFETY: valid physical device, queue family and surface.
+        let supported = unsafe {
+            surface_fn.get_physical_device_surface_support(
+                self.device.physical,
+                self.device.queue_family,
+                surface,
+            )
+        };
+        if !matches!(supported, Ok(true)) {
+            // SAFETY: the surface is unused.
+            unsafe { surface_fn.destroy_surface(surface, None) };
+            return Err(GpuError::Surface(format!(
+                "{} cannot present to this window",
+                self.device.caps.name
+            )));
+        }
+        let samples = match self.resolve_samples(desc.samples) {
+            Ok(s) => s,
+            Err(e) => {
+                // SAFETY: the surface is unused.
+                unsafe { surface_fn.destroy_surface(surface, None) };
+                return Err(e);
+            }
+        };
+        let mut swapchain = Swapchain {
+            surface,
+            raw: vk::SwapchainKHR::null(),
+            images: Vec::new(),
+            views: Vec::new(),
+            render_finished: Vec::new(),
+            attachments: None,
+            format: vk::SurfaceFormatKHR::default(),
+            extent: vk::Extent2D::default(),
+            wanted: vk::Extent2D {
+                width: desc.width,
+                height: desc.height,
+            },
+            vsync: desc.vsync,
+            samples,
+            present_mode: vk::PresentModeKHR::FIFO,
+            stale: true,
+        };
+        if let Err(e) = self.rebuild_swapchain(&mut swapchain) {
+            self.destroy_swapchain_now(swapchain);
+            return Err(e);
+        }
+        Ok(swapchain)
+    }
+
+    /// Rebuilds the swapchain for the current surface size. Returns `false` (and leaves no
+    /// images) when the surface has zero area, i.e. the window is minimised.
+    pub(crate) fn rebuild_swapchain(&mut self, sc: &mut Swapchain) -> GpuResult<bool> {
+        self.wait_idle()?;
+        let device = &*self.device;
+        let (Some(surface_fn), Some(swapchain_fn)) = (
+            self.instance.surface_fn.as_ref(),
+            device.swapchain_fn.as_ref(),
+        ) else {
+            return Err(GpuError::Surface("no surface support".into()));
+        };
+        sc.destroy_images(device);
+        // SAFETY: valid physical device and surface for all three queries.
+        let (caps, formats, modes) = unsafe {
+            (
+                surface_fn
+                    .get_physical_device_surface_capabilities(device.physical, sc.surface)
+                    .vk("vkGetPhysicalDeviceSurfaceCapabilitiesKHR")?,
+                surface_fn
+                    .get_physical_device_surface_formats(device.physical, sc.surface)
+                    .vk("vkGetPhysicalDeviceSurfaceFormatsKHR")?,
+                surface_fn
+                    .get_physical_device_surface_present_modes(device.physical, sc.surface)
+                    .vk("vkGetPhysicalDeviceSurfacePresentModesKHR")?,
+            )
+        };
+        // u32::MAX means "the swapchain decides"; otherwise the surface dictates the size.
+        let extent = if caps.current_extent.width != u32::MAX {
+            caps.current_extent
+        } else {
+            vk::Extent2D {
+                width: sc
+                    .wanted
+                    .width
+                    .clamp(caps.min_image_extent.width, caps.max_image_extent.width),
+                height: sc
+                    .wanted
+                    .height
+                    .clamp(caps.min_image_extent.height, caps.max_image_extent.height),
+            }
+        };
+        if extent.width == 0 || extent.height == 0 || sc.wanted.width == 0 || sc.wanted.height == 0
+        {
+            sc.extent = vk::Extent2D::default();
+            return Ok(false);
+        }
+        let format = choose_format(&formats)
+            .ok_or_else(|| GpuError::Surface("surface reports no formats".into()))?;
+        let present_mode = choose_present_mode(&modes, sc.vsync);
+        let mut image_count = caps.min_image_count + 1;
+        if caps.max_image_count > 0 {
+            image_count = image_count.min(caps.max_image_count);
+        }
+        let composite = [
+            vk::CompositeAlphaFlagsKHR::OPAQUE,
+            vk::CompositeAlphaFlagsKHR::INHERIT,
+            vk::CompositeAlphaFlagsKHR::PRE_MULTIPLIED,
+            vk::CompositeAlphaFlagsKHR::POST_MULTIPLIED,
+        ]
+        .into_iter()
+        .find(|c| caps.supported_composite_alpha.contains(*c))
+        .unwrap_or(vk::CompositeAlphaFlagsKHR::OPAQUE);
+        let old = sc.raw;
+        let info = vk::SwapchainCreateInfoKHR::default()
+            .surface(sc.surface)
+            .min_image_count(image_count)
+            .image_format(format.format)
+            .image_color_space(format.color_space)
+            .image_extent(extent)
+            .image_array_layers(1)
+            .image_usage(vk::ImageUsageFlags::COLOR_ATTACHMENT)
+            .image_sharing_mode(vk::SharingMode::EXCLUSIVE)
+            .pre_transform(caps.current_transform)
+            .composite_alpha(composite)
+            .present_mode(present_mode)
+            .clipped(true)
+            .old_swapchain(old);
+        // SAFETY: parameters were validated against the surface capabilities above.
+        let raw = unsafe { swapchain_fn.create_swapchain(&info, None) }.vk("vkCreateSwapchainKHR");
+        if old != vk::SwapchainKHR::null() {
+            // SAFETY: the device is idle, so no image of the old swapchain is in use; it was
+            // retired by passing it as old_swapchain.
+            unsafe { swapchain_fn.destroy_swapchain(old, None) };
+            sc.raw = vk::SwapchainKHR::null();
+        }
+        sc.raw = raw?;
+        sc.format = format;
+        sc.present_mode = present_mode;
+        sc.extent = extent;
+        // SAFETY: valid swapchain.
+        sc.images =
+            unsafe { swapchain_fn.get_swapchain_images(sc.raw) }.vk("vkGetSwapchainImagesKHR")?;
+        for &image in &sc.images {
+            sc.views.push(create_view(device, image, format.format)?);
+        }
+        while sc.render_finished.len() < sc.images.len() {
+            // SAFETY: valid device.
+            let s = unsafe {
+                device
+                    .raw
+                    .create_semaphore(&vk::SemaphoreCreateInfo::default(), None)
+            }
+            .vk("vkCreateSemaphore")?;
+            sc.render_finished.push(s);
+        }
+        sc.attachments = Some(Attachments::new(device, extent, format.format, sc.samples)?);
+        sc.stale = false;
+        Ok(true)
+    }
+
+    /// Destroys the swapchain and its surface (waits for the GPU first).
+    pub fn destroy_swapchain(&mut self, swapchain: Swapchain) -> GpuResult<()> {
+        let waited = self.wait_idle();
+        self.destroy_swapchain_now(swapchain);
+        waited
+    }
+
+    fn destroy_swapchain_now(&mut self, mut sc: Swapchain) {
+        let device = &*self.device;
+        sc.destroy_images(device);
+        for s in sc.render_finished.drain(..) {
+            // SAFETY: the device is idle; presents waiting on it have been processed.
+            unsafe { device.raw.destroy_semaphore(s, None) };
+        }
+        if let Some(f) = device.swapchain_fn.as_ref()
+            && sc.raw != vk::SwapchainKHR::null()
+        {
+            // SAFETY: idle device, swapchain destroyed once.
+            unsafe { f.destroy_swapchain(sc.raw, None) };
+        }
+        if let Some(f) = self.instance.surface_fn.as_ref() {
+            // SAFETY: the swapchain using the surface is gone.
+            unsafe { f.destroy_surface(sc.surface, None) };
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn present_mode_preferences() {
+        use vk::PresentModeKHR as P;
+        assert_eq!(choose_present_mode(&[P::FIFO, P::MAILBOX], true), P::FIFO);
+        assert_eq!(
+            choose_present_mode(&[P::FIFO, P::MAILBOX, P::IMMEDIATE], false),
+            P::MAILBOX
+        );
+        assert_eq!(
+            choose_present_mode(&[P::IMMEDIATE, P::FIFO], false),
+            P::IMMEDIATE
+        );
+        assert_eq!(choose_present_mode(&[P::FIFO], false), P::FIFO);
+    }
+
+    #[test]
+    fn format_prefers_srgb() {
+        let f = |format| vk::SurfaceFormatKHR {
+            format,
+            color_space: vk::ColorSpaceKHR::SRGB_NONLINEAR,
+        };
+        let formats = [f(vk::Format::B8G8R8A8_UNORM), f(vk::Format::B8G8R8A8_SRGB)];
+        assert_eq!(choose_format(&formats), Some(f(vk::Format::B8G8R8A8_SRGB)));
+        assert_eq!(choose_format(&formats[..1]), Some(formats[0]));
+        assert_eq!(choose_format(&[]), None);
+    }
+}
