@@ -21,4 +21,4 @@ pub mod spline_surface;
 pub use axis::HermiteTable;
 pub use dirty::{DirtyRegion, DirtySet};
 pub use grid::{PartialSet, SampleGrid};
-pub use object::{SampleMode, SampledObject};
+pub use object::{ModelRef, SampleMode, SampledObject};

@@ -6,7 +6,17 @@ use super::erbs_surface::ErbsSurfaceSampler;
 use super::grid::{PartialSet, SampleGrid};
 use super::spline_curve::SplineCurveSampler;
 use super::spline_surface::SplineSurfaceSampler;
+use crate::geom::{BSplineCurve, ErbsCurve, ErbsSurface, TensorSurface};
 use crate::scene::{EditOp, Index2, Samples, Shape};
+
+/// A borrowed view of an object's model.
+#[derive(Debug, Clone, Copy)]
+pub enum ModelRef<'a> {
+    Curve(&'a BSplineCurve),
+    ErbsCurve(&'a ErbsCurve),
+    Surface(&'a TensorSurface),
+    ErbsSurface(&'a ErbsSurface),
+}
 
 /// What to keep per sample.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -116,6 +126,16 @@ impl SampledObject {
             }
             Sampler::SplineSurface(s) => Shape::BSplineSurface(s.surface().clone()),
             Sampler::ErbsSurface(s) => Shape::ErbsSurface(s.surface().clone()),
+        }
+    }
+
+    /// The current model by reference (no copy), for drawing control structures and overlays.
+    pub fn model(&self) -> ModelRef<'_> {
+        match &self.sampler {
+            Sampler::SplineCurve(s) => ModelRef::Curve(s.curve()),
+            Sampler::ErbsCurve(s) => ModelRef::ErbsCurve(s.curve()),
+            Sampler::SplineSurface(s) => ModelRef::Surface(s.surface()),
+            Sampler::ErbsSurface(s) => ModelRef::ErbsSurface(s.surface()),
         }
     }
 

@@ -1,0 +1,210 @@
+//! The orbit camera: a target point, a distance and two angles, z up.
+
+use glam::{DMat4, DVec3, DVec4, Mat4, Vec3};
+
+/// A camera orbiting `target` (z up): `yaw` around z, `pitch` above the xy-plane.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OrbitCamera {
+    pub target: DVec3,
+    pub distance: f64,
+    /// Radians around +z, 0 = looking along +y from −y.
+    pub yaw: f64,
+    /// Radians above the horizon, clamped short of the poles.
+    pub pitch: f64,
+    /// Vertical field of view in radians.
+    pub fov_y: f64,
+}
+
+impl Default for OrbitCamera {
+    fn default() -> Self {
+        Self { target: DVec3::ZERO, distance: 10.0, yaw: -0.6, pitch: 0.45, fov_y: 40f64.to_radians() }
+    }
+}
+
+/// Axis-aligned bounds of the scene (for framing and clip planes).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bounds {
+    pub min: DVec3,
+    pub max: DVec3,
+}
+
+impl Bounds {
+    pub const EMPTY: Bounds = Bounds { min: DVec3::splat(f64::INFINITY), max: DVec3::splat(f64::NEG_INFINITY) };
+
+    pub fn include(&mut self, p: DVec3) {
+        self.min = self.min.min(p);
+        self.max = self.max.max(p);
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.min.x > self.max.x
+    }
+
+    pub fn centre(&self) -> DVec3 {
+        if self.is_empty() { DVec3::ZERO } else { 0.5 * (self.min + self.max) }
+    }
+
+    /// Radius of the bounding sphere around the centre (at least a tiny positive value).
+    pub fn radius(&self) -> f64 {
+        if self.is_empty() { 1.0 } else { (0.5 * (self.max - self.min).length()).max(1e-9) }
+    }
+}
+
+impl OrbitCamera {
+    /// Limit keeping the up vector well-defined.
+    pub const MAX_PITCH: f64 = 1.55;
+
+    pub fn eye(&self) -> DVec3 {
+        self.target + self.direction() * self.distance
+    }
+
+    /// Unit vector from the target to the eye.
+    pub fn direction(&self) -> DVec3 {
+        let (sy, cy) = self.yaw.sin_cos();
+        let (sp, cp) = self.pitch.sin_cos();
+        DVec3::new(sy * cp, -cy * cp, sp)
+    }
+
+    pub fn view(&self) -> DMat4 {
+        DMat4::look_at_rh(self.eye(), self.target, DVec3::Z)
+    }
+
+    /// Near and far planes that contain a sphere of `radius` around `centre`.
+    pub fn clip_planes(&self, bounds: &Bounds) -> (f64, f64) {
+        let d = (self.eye() - bounds.centre()).length();
+        let r = bounds.radius();
+        let far = (d + r) * 1.05;
+        let near = (d - r).max(far * 1e-4).max(1e-6);
+        (near, far)
+    }
+
+    /// Projection × view for an image of `aspect` = width / height, depth in [0, 1], y up.
+    pub fn view_proj(&self, aspect: f64, bounds: &Bounds) -> DMat4 {
+        let (near, far) = self.clip_planes(bounds);
+        DMat4::perspective_rh(self.fov_y, aspect, near, far) * self.view()
+    }
+
+    /// The f32 camera the GPU layer takes.
+    pub fn gpu(&self, aspect: f64, bounds: &Bounds) -> crate::gpu::Camera {
+        crate::gpu::Camera { view_proj: to_f32(&self.view_proj(aspect, bounds)), eye: self.eye().as_vec3() }
+    }
+
+    /// Places the target at the bounds' centre and backs off until the bounding sphere fits
+    /// the narrower field of view.
+    pub fn frame(&mut self, bounds: &Bounds, aspect: f64) {
+        self.target = bounds.centre();
+        let half = 0.5 * self.fov_y;
+        let half_h = (half.tan() * aspect.min(1.0)).atan();
+        self.distance = bounds.radius() / half_h.min(half).sin() * 1.05;
+    }
+
+    /// Turns by pixel drags: `dx`, `dy` in radians.
+    pub fn orbit(&mut self, dyaw: f64, dpitch: f64) {
+        self.yaw += dyaw;
+        self.pitch = (self.pitch + dpitch).clamp(-Self::MAX_PITCH, Self::MAX_PITCH);
+    }
+
+    /// Moves target and eye together in the view plane by a world-space offset.
+    pub fn pan(&mut self, offset: DVec3) {
+        self.target += offset;
+    }
+
+    /// Camera right and up vectors in world space.
+    pub fn basis(&self) -> (DVec3, DVec3) {
+        let forward = -self.direction();
+        let right = forward.cross(DVec3::Z).try_normalize().unwrap_or(DVec3::X);
+        (right, right.cross(forward))
+    }
+
+    /// World-space ray through a pixel (origin top-left) of a `width × height` image.
+    pub fn ray(&self, px: f64, py: f64, width: f64, height: f64, bounds: &Bounds) -> (DVec3, DVec3) {
+        let inv = self.view_proj(width / height, bounds).inverse();
+        let ndc_x = 2.0 * px / width - 1.0;
+        let ndc_y = 1.0 - 2.0 * py / height;
+        let near = inv * DVec4::new(ndc_x, ndc_y, 0.0, 1.0);
+        let far = inv * DVec4::new(ndc_x, ndc_y, 1.0, 1.0);
+        let (a, b) = (near.truncate() / near.w, far.truncate() / far.w);
+        (a, (b - a).normalize())
+    }
+
+    /// Pixel position (origin top-left) and depth in [0, 1] of a world point; `None` behind the
+    /// eye.
+    pub fn project(&self, p: DVec3, width: f64, height: f64, bounds: &Bounds) -> Option<(f64, f64, f64)> {
+        let c = self.view_proj(width / height, bounds) * p.extend(1.0);
+        if c.w <= 0.0 {
+            return None;
+        }
+        let n = c.truncate() / c.w;
+        Some(((n.x + 1.0) * 0.5 * width, (1.0 - n.y) * 0.5 * height, n.z))
+    }
+
+    /// Parses `EX,EY,EZ,TX,TY,TZ[,FOV_DEGREES]` (eye, target, vertical field of view).
+    pub fn parse(spec: &str) -> Result<Self, String> {
+        let v: Vec<f64> = spec
+            .split(',')
+            .map(|s| s.trim().parse::<f64>().map_err(|_| format!("'{s}' is not a number")))
+            .collect::<Result<_, _>>()?;
+        if !(v.len() == 6 || v.len() == 7) || v.iter().any(|x| !x.is_finite()) {
+            return Err("expected EX,EY,EZ,TX,TY,TZ[,FOV] (eye, target, field of view in degrees)".into());
+        }
+        let eye = DVec3::new(v[0], v[1], v[2]);
+        let target = DVec3::new(v[3], v[4], v[5]);
+        let d = eye - target;
+        let distance = d.length();
+        if distance == 0.0 {
+            return Err("eye and target coincide".into());
+        }
+        let fov = v.get(6).copied().unwrap_or(40.0);
+        if !(1.0..=170.0).contains(&fov) {
+            return Err(format!("field of view {fov}° is outside 1..170"));
+        }
+        let dir = d / distance;
+        let pitch = dir.z.clamp(-1.0, 1.0).asin().clamp(-Self::MAX_PITCH, Self::MAX_PITCH);
+        let yaw = dir.x.atan2(-dir.y);
+        Ok(Self { target, distance, yaw, pitch, fov_y: fov.to_radians() })
+    }
+}
+
+fn to_f32(m: &DMat4) -> Mat4 {
+    Mat4::from_cols_array(&m.to_cols_array().map(|x| x as f32))
+}
+
+/// Vec3 from f64 world coordinates.
+pub fn v32(p: DVec3) -> Vec3 {
+    p.as_vec3()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parse_round_trips_eye_and_target() {
+        let c = OrbitCamera::parse("3,-4,5, 1,1,1, 35").unwrap();
+        assert!((c.eye() - DVec3::new(3.0, -4.0, 5.0)).length() < 1e-12);
+        assert!((c.target - DVec3::ONE).length() < 1e-12);
+        assert!(OrbitCamera::parse("1,2,3").is_err());
+        assert!(OrbitCamera::parse("1,2,3,1,2,3").is_err());
+    }
+
+    #[test]
+    fn project_and_ray_agree() {
+        let mut b = Bounds::EMPTY;
+        b.include(DVec3::splat(-1.0));
+        b.include(DVec3::splat(1.0));
+        let mut c = OrbitCamera::default();
+        c.frame(&b, 1.5);
+        let p = DVec3::new(0.3, -0.2, 0.5);
+        let (x, y, z) = c.project(p, 1200.0, 800.0, &b).unwrap();
+        assert!((0.0..1.0).contains(&z));
+        let (o, d) = c.ray(x, y, 1200.0, 800.0, &b);
+        let closest = o + d * (p - o).dot(d);
+        assert!((closest - p).length() < 1e-9);
+        // Framing keeps every corner inside the image.
+        for i in 0..8 {
+            let q = DVec3::new(if i & 1 == 0 { -1.0 } else { 1.0 }, if i & 2 == 0 { -1.0 } else { 1.0 }, if i & 4 == 0 { -1.0 } else { 1.0 });
+            let (x, y, _) = c.project(q, 1200.0, 800.0, &b).unwrap();
+            assert!((0.0..1200.0).contains(&x) && (0.0..800.0).contains(&y), "{q:?} → {x}, {y}");
+        }
+    }
+}
