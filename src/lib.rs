@@ -5,5 +5,6 @@
 pub mod cli;
 pub mod geom;
 pub mod gpu;
+pub mod render;
 pub mod sampling;
 pub mod scene;

@@ -1,7 +1,8 @@
 //! The `prespline` command line.
 
-use clap::{Parser, Subcommand};
+use clap::{Args, Parser, Subcommand};
 use prespline::cli::{self, CliError};
+use prespline::render::{OrbitCamera, ViewOptions, Wire};
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -33,6 +34,70 @@ enum Command {
         #[arg(long)]
         full: bool,
     },
+    /// Render a scene headless (no display needed) into a PNG image.
+    Render {
+        /// Scene file (JSON).
+        scene: PathBuf,
+        /// Output image (PNG).
+        #[arg(long, short = 'o', value_name = "IMAGE.png")]
+        out: PathBuf,
+        /// Image size.
+        #[arg(long, default_value = "1280x720", value_parser = cli::render::parse_size, value_name = "WxH")]
+        size: (u32, u32),
+        /// Camera as eye and target, optionally the vertical field of view in degrees:
+        /// EX,EY,EZ,TX,TY,TZ[,FOV]. Default: frames the whole scene.
+        #[arg(long, value_parser = OrbitCamera::parse, value_name = "EYE,TARGET[,FOV]", allow_hyphen_values = true)]
+        camera: Option<OrbitCamera>,
+        /// Edits (JSON list) applied before rendering.
+        #[arg(long, value_name = "EDITS.json")]
+        edits: Option<PathBuf>,
+        /// MSAA samples (1, 2, 4, 8); 0 picks 4 where supported.
+        #[arg(long, default_value_t = 0)]
+        msaa: u32,
+        #[command(flatten)]
+        display: DisplayArgs,
+    },
+}
+
+/// What to draw besides curves and shaded surfaces.
+#[derive(Args, Clone, Copy)]
+struct DisplayArgs {
+    /// Draw control polygons, control nets and control points.
+    #[arg(long)]
+    net: bool,
+    /// Hide ERBS local curves and patches.
+    #[arg(long)]
+    no_local: bool,
+    /// Isoparametric lines every N samples on surfaces (1 = full wireframe).
+    #[arg(long, value_name = "N")]
+    wire: Option<u32>,
+    /// Draw surface normals.
+    #[arg(long)]
+    normals: bool,
+    /// Draw Frenet frames along curves.
+    #[arg(long)]
+    frenet: bool,
+    /// Draw curvature combs along curves.
+    #[arg(long)]
+    comb: bool,
+}
+
+impl DisplayArgs {
+    fn options(self) -> ViewOptions {
+        ViewOptions {
+            control_nets: self.net,
+            local_curves: !self.no_local,
+            wire: match self.wire {
+                None | Some(0) => Wire::Off,
+                Some(1) => Wire::Full,
+                Some(n) => Wire::Isolines(n),
+            },
+            normals: self.normals,
+            frenet: self.frenet,
+            curvature_comb: self.comb,
+            ..ViewOptions::default()
+        }
+    }
 }
 
 fn main() -> ExitCode {
@@ -52,6 +117,19 @@ fn main() -> ExitCode {
             };
             cli::sample::run(&args).and_then(|text| print(&text))
         }
+        Command::Render {
+            scene,
+            out,
+            size,
+            camera,
+            edits,
+            msaa,
+            display,
+        } => cli::render::load_document(&scene, edits.as_deref())
+            .and_then(|doc| {
+                cli::render::run(&doc, &out, size.0, size.1, camera, display.options(), msaa)
+            })
+            .map(|line| eprintln!("{line}")),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,5 +1,6 @@
 //! Command implementations behind `src/main.rs`, kept in the library so tests can call them.
 
+pub mod render;
 pub mod sample;
 
 /// A command failure: one line for stderr; the process exits non-zero.

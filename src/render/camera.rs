@@ -17,7 +17,13 @@ pub struct OrbitCamera {
 
 impl Default for OrbitCamera {
     fn default() -> Self {
-        Self { target: DVec3::ZERO, distance: 10.0, yaw: -0.6, pitch: 0.45, fov_y: 40f64.to_radians() }
+        Self {
+            target: DVec3::ZERO,
+            distance: 10.0,
+            yaw: -0.6,
+            pitch: 0.45,
+            fov_y: 40f64.to_radians(),
+        }
     }
 }
 
@@ -29,7 +35,10 @@ pub struct Bounds {
 }
 
 impl Bounds {
-    pub const EMPTY: Bounds = Bounds { min: DVec3::splat(f64::INFINITY), max: DVec3::splat(f64::NEG_INFINITY) };
+    pub const EMPTY: Bounds = Bounds {
+        min: DVec3::splat(f64::INFINITY),
+        max: DVec3::splat(f64::NEG_INFINITY),
+    };
 
     pub fn include(&mut self, p: DVec3) {
         self.min = self.min.min(p);
@@ -41,12 +50,20 @@ impl Bounds {
     }
 
     pub fn centre(&self) -> DVec3 {
-        if self.is_empty() { DVec3::ZERO } else { 0.5 * (self.min + self.max) }
+        if self.is_empty() {
+            DVec3::ZERO
+        } else {
+            0.5 * (self.min + self.max)
+        }
     }
 
     /// Radius of the bounding sphere around the centre (at least a tiny positive value).
     pub fn radius(&self) -> f64 {
-        if self.is_empty() { 1.0 } else { (0.5 * (self.max - self.min).length()).max(1e-9) }
+        if self.is_empty() {
+            1.0
+        } else {
+            (0.5 * (self.max - self.min).length()).max(1e-9)
+        }
     }
 }
 
@@ -86,16 +103,79 @@ impl OrbitCamera {
 
     /// The f32 camera the GPU layer takes.
     pub fn gpu(&self, aspect: f64, bounds: &Bounds) -> crate::gpu::Camera {
-        crate::gpu::Camera { view_proj: to_f32(&self.view_proj(aspect, bounds)), eye: self.eye().as_vec3() }
+        crate::gpu::Camera {
+            view_proj: to_f32(&self.view_proj(aspect, bounds)),
+            eye: self.eye().as_vec3(),
+        }
     }
 
-    /// Places the target at the bounds' centre and backs off until the bounding sphere fits
-    /// the narrower field of view.
+    /// Places the target at the bounds' centre and picks the smallest distance at which all
+    /// eight corners of the box project inside 90 % of the image (bisection; the sphere-fit
+    /// distance is the safe upper bound).
     pub fn frame(&mut self, bounds: &Bounds, aspect: f64) {
         self.target = bounds.centre();
         let half = 0.5 * self.fov_y;
         let half_h = (half.tan() * aspect.min(1.0)).atan();
-        self.distance = bounds.radius() / half_h.min(half).sin() * 1.05;
+        let safe = bounds.radius() / half_h.min(half).sin() * 1.05;
+        if bounds.is_empty() {
+            self.distance = safe;
+            return;
+        }
+        let corners: Vec<DVec3> = (0..8)
+            .map(|i| {
+                DVec3::new(
+                    if i & 1 == 0 {
+                        bounds.min.x
+                    } else {
+                        bounds.max.x
+                    },
+                    if i & 2 == 0 {
+                        bounds.min.y
+                    } else {
+                        bounds.max.y
+                    },
+                    if i & 4 == 0 {
+                        bounds.min.z
+                    } else {
+                        bounds.max.z
+                    },
+                )
+            })
+            .collect();
+        let fits = |cam: &OrbitCamera| {
+            let (near, far) = cam.clip_planes(bounds);
+            let vp = DMat4::perspective_rh(cam.fov_y, aspect, near, far) * cam.view();
+            corners.iter().all(|&p| {
+                let c = vp * p.extend(1.0);
+                c.w > 0.0 && (c.x / c.w).abs() <= 0.9 && (c.y / c.w).abs() <= 0.9
+            })
+        };
+        let (mut lo, mut hi) = (0.0, safe);
+        for _ in 0..40 {
+            let mid = 0.5 * (lo + hi);
+            let probe = OrbitCamera {
+                distance: mid,
+                ..*self
+            };
+            if fits(&probe) { hi = mid } else { lo = mid }
+        }
+        self.distance = hi;
+    }
+
+    /// The default viewing direction for a scene: oblique, or from above for flat (xy-planar)
+    /// scenes where an oblique view would squash everything into a band.
+    pub fn default_for(bounds: &Bounds) -> Self {
+        let size = bounds.max - bounds.min;
+        let flat = !bounds.is_empty() && size.z <= 0.02 * size.x.max(size.y);
+        if flat {
+            Self {
+                yaw: -0.25,
+                pitch: 1.2,
+                ..Self::default()
+            }
+        } else {
+            Self::default()
+        }
     }
 
     /// Turns by pixel drags: `dx`, `dy` in radians.
@@ -117,7 +197,14 @@ impl OrbitCamera {
     }
 
     /// World-space ray through a pixel (origin top-left) of a `width × height` image.
-    pub fn ray(&self, px: f64, py: f64, width: f64, height: f64, bounds: &Bounds) -> (DVec3, DVec3) {
+    pub fn ray(
+        &self,
+        px: f64,
+        py: f64,
+        width: f64,
+        height: f64,
+        bounds: &Bounds,
+    ) -> (DVec3, DVec3) {
         let inv = self.view_proj(width / height, bounds).inverse();
         let ndc_x = 2.0 * px / width - 1.0;
         let ndc_y = 1.0 - 2.0 * py / height;
@@ -129,7 +216,13 @@ impl OrbitCamera {
 
     /// Pixel position (origin top-left) and depth in [0, 1] of a world point; `None` behind the
     /// eye.
-    pub fn project(&self, p: DVec3, width: f64, height: f64, bounds: &Bounds) -> Option<(f64, f64, f64)> {
+    pub fn project(
+        &self,
+        p: DVec3,
+        width: f64,
+        height: f64,
+        bounds: &Bounds,
+    ) -> Option<(f64, f64, f64)> {
         let c = self.view_proj(width / height, bounds) * p.extend(1.0);
         if c.w <= 0.0 {
             return None;
@@ -142,10 +235,16 @@ impl OrbitCamera {
     pub fn parse(spec: &str) -> Result<Self, String> {
         let v: Vec<f64> = spec
             .split(',')
-            .map(|s| s.trim().parse::<f64>().map_err(|_| format!("'{s}' is not a number")))
+            .map(|s| {
+                s.trim()
+                    .parse::<f64>()
+                    .map_err(|_| format!("'{s}' is not a number"))
+            })
             .collect::<Result<_, _>>()?;
         if !(v.len() == 6 || v.len() == 7) || v.iter().any(|x| !x.is_finite()) {
-            return Err("expected EX,EY,EZ,TX,TY,TZ[,FOV] (eye, target, field of view in degrees)".into());
+            return Err(
+                "expected EX,EY,EZ,TX,TY,TZ[,FOV] (eye, target, field of view in degrees)".into(),
+            );
         }
         let eye = DVec3::new(v[0], v[1], v[2]);
         let target = DVec3::new(v[3], v[4], v[5]);
@@ -159,9 +258,19 @@ impl OrbitCamera {
             return Err(format!("field of view {fov}° is outside 1..170"));
         }
         let dir = d / distance;
-        let pitch = dir.z.clamp(-1.0, 1.0).asin().clamp(-Self::MAX_PITCH, Self::MAX_PITCH);
+        let pitch = dir
+            .z
+            .clamp(-1.0, 1.0)
+            .asin()
+            .clamp(-Self::MAX_PITCH, Self::MAX_PITCH);
         let yaw = dir.x.atan2(-dir.y);
-        Ok(Self { target, distance, yaw, pitch, fov_y: fov.to_radians() })
+        Ok(Self {
+            target,
+            distance,
+            yaw,
+            pitch,
+            fov_y: fov.to_radians(),
+        })
     }
 }
 
@@ -202,9 +311,16 @@ mod tests {
         assert!((closest - p).length() < 1e-9);
         // Framing keeps every corner inside the image.
         for i in 0..8 {
-            let q = DVec3::new(if i & 1 == 0 { -1.0 } else { 1.0 }, if i & 2 == 0 { -1.0 } else { 1.0 }, if i & 4 == 0 { -1.0 } else { 1.0 });
+            let q = DVec3::new(
+                if i & 1 == 0 { -1.0 } else { 1.0 },
+                if i & 2 == 0 { -1.0 } else { 1.0 },
+                if i & 4 == 0 { -1.0 } else { 1.0 },
+            );
             let (x, y, _) = c.project(q, 1200.0, 800.0, &b).unwrap();
-            assert!((0.0..1200.0).contains(&x) && (0.0..800.0).contains(&y), "{q:?} → {x}, {y}");
+            assert!(
+                (0.0..1200.0).contains(&x) && (0.0..800.0).contains(&y),
+                "{q:?} → {x}, {y}"
+            );
         }
     }
 }

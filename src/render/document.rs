@@ -1,0 +1,288 @@
+//! The scene being viewed and edited: every object pre-evaluated for drawing, plus the control
+//! structures (polygons, nets, ERBS local curves and patches) that are drawn and picked.
+
+use super::camera::Bounds;
+use crate::geom::BezierCurve;
+use crate::geom::knots::uniform_params;
+use crate::sampling::{DirtyRegion, ModelRef, SampleMode, SampledObject};
+use crate::scene::{Edit, EditOp, Index2, Samples, Scene, SceneObject};
+use glam::DVec3;
+
+/// Samples per ERBS local curve drawn in its own colour.
+pub const LOCAL_CURVE_SAMPLES: usize = 48;
+/// Samples per direction of an ERBS local patch drawn as a wire grid.
+pub const LOCAL_PATCH_SAMPLES: usize = 9;
+
+/// One object of the document.
+#[derive(Debug, Clone)]
+pub struct DocObject {
+    pub name: String,
+    pub samples: Samples,
+    pub color: Option<[f64; 3]>,
+    pub sampled: SampledObject,
+}
+
+/// The scene as the viewer holds it.
+#[derive(Debug, Clone, Default)]
+pub struct Document {
+    pub objects: Vec<DocObject>,
+}
+
+/// A control point as it can be picked: which object and which point (of a local curve/patch
+/// for ERBS objects).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Handle {
+    Point {
+        object: usize,
+        point: Index2,
+    },
+    LocalPoint {
+        object: usize,
+        local: Index2,
+        point: Index2,
+    },
+}
+
+impl Handle {
+    pub fn object(&self) -> usize {
+        match *self {
+            Handle::Point { object, .. } | Handle::LocalPoint { object, .. } => object,
+        }
+    }
+}
+
+/// Control structures of one object, in f64 world coordinates.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Controls {
+    /// Control polygon of a Bézier/B-spline curve.
+    Polygon(Vec<DVec3>),
+    /// Control net of a tensor surface, row-major.
+    Net {
+        rows: usize,
+        cols: usize,
+        points: Vec<DVec3>,
+    },
+    /// ERBS curve: each local curve's control points and samples over its support.
+    LocalCurves(Vec<LocalCurve>),
+    /// ERBS surface: each local patch's control net and a small grid of samples, row-major.
+    LocalPatches {
+        rows: usize,
+        cols: usize,
+        patches: Vec<LocalPatch>,
+    },
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct LocalCurve {
+    pub points: Vec<DVec3>,
+    pub samples: Vec<DVec3>,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct LocalPatch {
+    pub net_rows: usize,
+    pub net_cols: usize,
+    pub points: Vec<DVec3>,
+    /// LOCAL_PATCH_SAMPLES² (position, normal) pairs, row-major.
+    pub grid: Vec<(DVec3, DVec3)>,
+}
+
+impl Document {
+    /// Pre-evaluates every object of `scene` for drawing.
+    pub fn new(scene: &Scene) -> Self {
+        let objects = scene
+            .objects
+            .iter()
+            .map(|o| DocObject {
+                name: o.name.clone(),
+                samples: o.samples,
+                color: o.color,
+                sampled: SampledObject::new(&o.shape, o.samples, SampleMode::Render),
+            })
+            .collect();
+        Self { objects }
+    }
+
+    /// The current scene (what Ctrl+S writes).
+    pub fn to_scene(&self) -> Scene {
+        Scene {
+            objects: self
+                .objects
+                .iter()
+                .map(|o| SceneObject {
+                    name: o.name.clone(),
+                    shape: o.sampled.shape(),
+                    samples: o.samples,
+                    color: o.color,
+                })
+                .collect(),
+        }
+    }
+
+    /// Applies a validated edit through the delta path.
+    pub fn apply(&mut self, edit: &Edit) -> DirtyRegion {
+        self.objects[edit.object].sampled.apply(&edit.op)
+    }
+
+    /// Bounds of every sample and control point.
+    pub fn bounds(&self) -> Bounds {
+        let mut b = Bounds::EMPTY;
+        for (i, o) in self.objects.iter().enumerate() {
+            let g = o.sampled.grid();
+            for p in g.data.iter().step_by(g.stride()) {
+                b.include(*p);
+            }
+            for h in self.handles(i) {
+                b.include(h.1);
+            }
+        }
+        b
+    }
+
+    /// Control structures of object `i`.
+    pub fn controls(&self, i: usize) -> Controls {
+        match self.objects[i].sampled.model() {
+            ModelRef::Curve(c) => Controls::Polygon(c.points().to_vec()),
+            ModelRef::Surface(s) => {
+                let [rows, cols] = s.count();
+                Controls::Net {
+                    rows,
+                    cols,
+                    points: s.points().to_vec(),
+                }
+            }
+            ModelRef::ErbsCurve(c) => {
+                Controls::LocalCurves(c.local_curves().iter().map(local_curve).collect())
+            }
+            ModelRef::ErbsSurface(s) => {
+                let [rows, cols] = s.count();
+                let patches = s
+                    .local_patches()
+                    .iter()
+                    .map(|p| {
+                        let [nr, nc] = p.count();
+                        let [(u0, u1), (v0, v1)] = p.domain();
+                        let us = uniform_params(u0, u1, LOCAL_PATCH_SAMPLES);
+                        let vs = uniform_params(v0, v1, LOCAL_PATCH_SAMPLES);
+                        let grid = us
+                            .iter()
+                            .flat_map(|&u| vs.iter().map(move |&v| (u, v)))
+                            .map(|(u, v)| (p.eval(u, v), p.normal(u, v)))
+                            .collect();
+                        LocalPatch {
+                            net_rows: nr,
+                            net_cols: nc,
+                            points: p.points().to_vec(),
+                            grid,
+                        }
+                    })
+                    .collect();
+                Controls::LocalPatches {
+                    rows,
+                    cols,
+                    patches,
+                }
+            }
+        }
+    }
+
+    /// Every pickable control point of object `i` with its position.
+    pub fn handles(&self, i: usize) -> Vec<(Handle, DVec3)> {
+        let object = i;
+        match self.controls(i) {
+            Controls::Polygon(p) => p
+                .into_iter()
+                .enumerate()
+                .map(|(k, q)| {
+                    (
+                        Handle::Point {
+                            object,
+                            point: Index2::One(k),
+                        },
+                        q,
+                    )
+                })
+                .collect(),
+            Controls::Net { cols, points, .. } => points
+                .into_iter()
+                .enumerate()
+                .map(|(k, q)| {
+                    (
+                        Handle::Point {
+                            object,
+                            point: Index2::Two(k / cols, k % cols),
+                        },
+                        q,
+                    )
+                })
+                .collect(),
+            Controls::LocalCurves(locals) => locals
+                .into_iter()
+                .enumerate()
+                .flat_map(|(l, c)| {
+                    c.points.into_iter().enumerate().map(move |(q, p)| {
+                        (
+                            Handle::LocalPoint {
+                                object,
+                                local: Index2::One(l),
+                                point: Index2::One(q),
+                            },
+                            p,
+                        )
+                    })
+                })
+                .collect(),
+            Controls::LocalPatches { cols, patches, .. } => patches
+                .into_iter()
+                .enumerate()
+                .flat_map(|(idx, p)| {
+                    let nc = p.net_cols;
+                    p.points.into_iter().enumerate().map(move |(q, pos)| {
+                        (
+                            Handle::LocalPoint {
+                                object,
+                                local: Index2::Two(idx / cols, idx % cols),
+                                point: Index2::Two(q / nc, q % nc),
+                            },
+                            pos,
+                        )
+                    })
+                })
+                .collect(),
+        }
+    }
+
+    /// The edit that moves a handle by `delta`.
+    pub fn move_handle(handle: Handle, delta: DVec3) -> Edit {
+        match handle {
+            Handle::Point { object, point } => Edit {
+                object,
+                op: EditOp::TranslatePoint { point, delta },
+            },
+            Handle::LocalPoint {
+                object,
+                local,
+                point,
+            } => Edit {
+                object,
+                op: EditOp::TranslateLocalPoint {
+                    local,
+                    point,
+                    delta,
+                },
+            },
+        }
+    }
+}
+
+fn local_curve(c: &BezierCurve) -> LocalCurve {
+    let (a, b) = c.interval();
+    let samples = uniform_params(a, b, LOCAL_CURVE_SAMPLES)
+        .into_iter()
+        .map(|t| c.eval(t))
+        .collect();
+    LocalCurve {
+        points: c.points().to_vec(),
+        samples,
+    }
+}

@@ -1,0 +1,459 @@
+//! The document on the GPU: one mirror per object for its samples and one for its control
+//! structures, with per-frame-slot dirty tracking so each slot receives exactly the rows changed
+//! since it was last written.
+
+use super::document::{Controls, Document, Handle, LOCAL_CURVE_SAMPLES, LOCAL_PATCH_SAMPLES};
+use super::style::{Palette, ViewOptions, Wire};
+use crate::gpu::{
+    FRAMES_IN_FLIGHT, Frame, GpuResult, GridShape, Mirror, PointRun, PointStyle, PolylineStyle,
+    Renderer, SurfaceGrid, SurfaceStyle,
+};
+use crate::sampling::{DirtyRegion, DirtySet};
+use crate::scene::Index2;
+use glam::DVec3;
+
+/// Where an object's control structures sit in its control mirror (offsets in floats).
+#[derive(Debug, Clone, PartialEq)]
+enum ControlLayout {
+    Polygon {
+        count: usize,
+    },
+    Net {
+        rows: usize,
+        cols: usize,
+    },
+    /// Per local curve: (sample offset, control-point offset, control-point count).
+    LocalCurves(Vec<(usize, usize, usize)>),
+    /// Per local patch: (grid offset, control-point offset, net rows, net cols); local patches
+    /// form a `cols`-wide grid.
+    LocalPatches {
+        cols: usize,
+        patches: Vec<(usize, usize, usize, usize)>,
+    },
+}
+
+struct ObjectGpu {
+    samples: Mirror,
+    /// Sample rows (surfaces) or samples (curves) each slot has not seen yet.
+    dirty: [DirtySet; FRAMES_IN_FLIGHT],
+    controls: Mirror,
+    controls_dirty: [bool; FRAMES_IN_FLIGHT],
+    layout: ControlLayout,
+}
+
+/// What one frame's upload copied.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct UploadStats {
+    /// Bytes written into mapped memory.
+    pub bytes: usize,
+    /// Sample rows (surfaces) and samples (curves) copied.
+    pub rows: usize,
+}
+
+/// Which handle the cursor is over and which one is selected (for highlighting).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Highlight {
+    pub hovered: Option<Handle>,
+    pub selected: Option<Handle>,
+    /// A selected ERBS local curve/patch (drawn emphasised).
+    pub selected_local: Option<(usize, Index2)>,
+}
+
+pub struct GpuScene {
+    objects: Vec<ObjectGpu>,
+    scratch: Vec<f32>,
+}
+
+impl GpuScene {
+    /// Creates and fills every mirror (all slots).
+    pub fn new(renderer: &mut Renderer, doc: &Document) -> GpuResult<Self> {
+        let mut objects = Vec::with_capacity(doc.objects.len());
+        let mut scratch = Vec::new();
+        for (i, o) in doc.objects.iter().enumerate() {
+            let [rows, cols] = o.sampled.grid().dims;
+            let is_surface = o.sampled.grid().normals.is_some();
+            let len = rows * cols * if is_surface { 6 } else { 3 };
+            let mut samples = renderer.create_mirror(&o.name, len)?;
+            sample_floats(doc, i, 0..rows, &mut scratch);
+            renderer.fill_mirror(&mut samples, 0, &scratch)?;
+            let (layout, data) = control_floats(&doc.controls(i));
+            let mut controls =
+                renderer.create_mirror(&format!("{} controls", o.name), data.len().max(3))?;
+            renderer.fill_mirror(&mut controls, 0, &data)?;
+            objects.push(ObjectGpu {
+                samples,
+                dirty: Default::default(),
+                controls,
+                controls_dirty: [false; FRAMES_IN_FLIGHT],
+                layout,
+            });
+        }
+        Ok(Self { objects, scratch })
+    }
+
+    /// Records that an edit of `object` changed `region` (and its control structures).
+    pub fn note(&mut self, object: usize, region: &DirtyRegion) {
+        let o = &mut self.objects[object];
+        for d in &mut o.dirty {
+            d.insert(region.rows());
+        }
+        o.controls_dirty = [true; FRAMES_IN_FLIGHT];
+    }
+
+    /// Copies into this frame's slot exactly what changed since the slot was last written:
+    /// whole sample rows of touched rectangles (surfaces), touched spans (curves), and the control
+    /// structures of edited objects.
+    pub fn upload(&mut self, frame: &mut Frame<'_>, doc: &Document) -> GpuResult<UploadStats> {
+        let slot = frame.slot();
+        let mut stats = UploadStats::default();
+        for (i, o) in self.objects.iter_mut().enumerate() {
+            let ranges = o.dirty[slot].take();
+            if !ranges.is_empty() {
+                let cols = doc.objects[i].sampled.grid().dims[1];
+                let per = if doc.objects[i].sampled.grid().normals.is_some() {
+                    6
+                } else {
+                    3
+                };
+                let mut w = frame.write_mirror(&mut o.samples);
+                for r in ranges {
+                    stats.rows += r.len();
+                    sample_floats(doc, i, r.clone(), &mut self.scratch);
+                    w.write(r.start * cols * per, &self.scratch)?;
+                    stats.bytes += self.scratch.len() * 4;
+                }
+            }
+            if o.controls_dirty[slot] {
+                o.controls_dirty[slot] = false;
+                let (_, data) = control_floats(&doc.controls(i));
+                frame.write_mirror(&mut o.controls).write(0, &data)?;
+                stats.bytes += data.len() * 4;
+            }
+        }
+        Ok(stats)
+    }
+
+    /// Records the draws of every object.
+    pub fn draw(
+        &self,
+        frame: &mut Frame<'_>,
+        doc: &Document,
+        opts: &ViewOptions,
+        hl: &Highlight,
+    ) -> GpuResult<()> {
+        let palette = Palette::default();
+        // Opaque surfaces first, then lines and points on top of them.
+        for (i, o) in self.objects.iter().enumerate() {
+            let grid = doc.objects[i].sampled.grid();
+            if grid.normals.is_none() {
+                continue;
+            }
+            let color = palette.surface(doc.objects[i].color);
+            let shape = GridShape {
+                rows: grid.dims[0] as u32,
+                cols: grid.dims[1] as u32,
+            };
+            let sg = SurfaceGrid { offset: 0, shape };
+            let style = SurfaceStyle {
+                front: color,
+                back: palette.back_of(color),
+                ..SurfaceStyle::default()
+            };
+            frame.draw_surface(&o.samples, sg, &style)?;
+            match opts.wire {
+                Wire::Off => {}
+                Wire::Isolines(every) => {
+                    frame.draw_wire(&o.samples, sg, every.max(1), palette.wire)?
+                }
+                Wire::Full => frame.draw_wire(&o.samples, sg, 1, palette.wire)?,
+            }
+        }
+        for (i, o) in self.objects.iter().enumerate() {
+            let grid = doc.objects[i].sampled.grid();
+            if grid.normals.is_none() && grid.dims[0] >= 2 {
+                let color = palette.object(i, doc.objects[i].color);
+                let style = PolylineStyle {
+                    color,
+                    width: opts.curve_width,
+                    depth_test: true,
+                };
+                frame.draw_polyline(&o.samples, PointRun::packed(0, grid.dims[0]), &style)?;
+            }
+            self.draw_controls(frame, i, o, opts, hl, &palette)?;
+        }
+        Ok(())
+    }
+
+    fn draw_controls(
+        &self,
+        frame: &mut Frame<'_>,
+        i: usize,
+        o: &ObjectGpu,
+        opts: &ViewOptions,
+        hl: &Highlight,
+        palette: &Palette,
+    ) -> GpuResult<()> {
+        let net = PolylineStyle {
+            color: palette.net,
+            width: 1.0,
+            depth_test: true,
+        };
+        let index_in = |h: Option<Handle>, f: &dyn Fn(Handle) -> Option<u32>| {
+            h.filter(|h| h.object() == i).and_then(f)
+        };
+        let points = |hov: Option<u32>, sel: Option<u32>| PointStyle {
+            color: palette.point,
+            size: opts.point_size,
+            hovered: hov,
+            selected: sel,
+            ..PointStyle::default()
+        };
+        match &o.layout {
+            ControlLayout::Polygon { count } if opts.control_nets => {
+                let run = PointRun::packed(0, *count);
+                polyline(frame, &o.controls, run, &net)?;
+                let pick = |h: Handle| match h {
+                    Handle::Point {
+                        point: Index2::One(k),
+                        ..
+                    } => Some(k as u32),
+                    _ => None,
+                };
+                frame.draw_points(
+                    &o.controls,
+                    run,
+                    &points(index_in(hl.hovered, &pick), index_in(hl.selected, &pick)),
+                )?;
+            }
+            ControlLayout::Net { rows, cols } if opts.control_nets => {
+                for r in 0..*rows {
+                    polyline(frame, &o.controls, PointRun::grid_row(0, *cols, 3, r), &net)?;
+                }
+                for c in 0..*cols {
+                    polyline(
+                        frame,
+                        &o.controls,
+                        PointRun::grid_column(0, *rows, *cols, 3, c),
+                        &net,
+                    )?;
+                }
+                let pick = |h: Handle| match h {
+                    Handle::Point {
+                        point: Index2::Two(a, b),
+                        ..
+                    } => Some((a * cols + b) as u32),
+                    _ => None,
+                };
+                let run = PointRun::packed(0, rows * cols);
+                frame.draw_points(
+                    &o.controls,
+                    run,
+                    &points(index_in(hl.hovered, &pick), index_in(hl.selected, &pick)),
+                )?;
+            }
+            ControlLayout::LocalCurves(locals) => {
+                for (l, &(so, po, count)) in locals.iter().enumerate() {
+                    let chosen = hl.selected_local == Some((i, Index2::One(l)));
+                    if opts.local_curves || chosen {
+                        let color = if chosen {
+                            palette.selected_local
+                        } else {
+                            palette.local
+                        };
+                        let style = PolylineStyle {
+                            color,
+                            width: if chosen { 2.5 } else { 1.5 },
+                            depth_test: true,
+                        };
+                        polyline(
+                            frame,
+                            &o.controls,
+                            PointRun {
+                                offset: so,
+                                stride: 3,
+                                count: LOCAL_CURVE_SAMPLES,
+                            },
+                            &style,
+                        )?;
+                    }
+                    if opts.control_nets || chosen {
+                        let run = PointRun {
+                            offset: po,
+                            stride: 3,
+                            count,
+                        };
+                        polyline(frame, &o.controls, run, &net)?;
+                        let pick = |h: Handle| match h {
+                            Handle::LocalPoint {
+                                local: Index2::One(x),
+                                point: Index2::One(q),
+                                ..
+                            } if x == l => Some(q as u32),
+                            _ => None,
+                        };
+                        frame.draw_points(
+                            &o.controls,
+                            run,
+                            &points(index_in(hl.hovered, &pick), index_in(hl.selected, &pick)),
+                        )?;
+                    }
+                }
+            }
+            ControlLayout::LocalPatches { cols, patches } => {
+                let k = LOCAL_PATCH_SAMPLES as u32;
+                for (idx, &(go, po, nr, nc)) in patches.iter().enumerate() {
+                    let local = Index2::Two(idx / cols, idx % cols);
+                    let chosen = hl.selected_local == Some((i, local));
+                    if opts.local_curves || chosen {
+                        let color = if chosen {
+                            palette.selected_local
+                        } else {
+                            palette.local
+                        };
+                        let sg = SurfaceGrid {
+                            offset: go,
+                            shape: GridShape { rows: k, cols: k },
+                        };
+                        frame.draw_wire(&o.controls, sg, 1, color)?;
+                    }
+                    if opts.control_nets || chosen {
+                        for r in 0..nr {
+                            polyline(frame, &o.controls, PointRun::grid_row(po, nc, 3, r), &net)?;
+                        }
+                        for c in 0..nc {
+                            polyline(
+                                frame,
+                                &o.controls,
+                                PointRun::grid_column(po, nr, nc, 3, c),
+                                &net,
+                            )?;
+                        }
+                        let pick = |h: Handle| match h {
+                            Handle::LocalPoint {
+                                local: l,
+                                point: Index2::Two(a, b),
+                                ..
+                            } if l == local => Some((a * nc + b) as u32),
+                            _ => None,
+                        };
+                        let run = PointRun {
+                            offset: po,
+                            stride: 3,
+                            count: nr * nc,
+                        };
+                        frame.draw_points(
+                            &o.controls,
+                            run,
+                            &points(index_in(hl.hovered, &pick), index_in(hl.selected, &pick)),
+                        )?;
+                    }
+                }
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// Gives every mirror back to the renderer.
+    pub fn destroy(self, renderer: &mut Renderer) {
+        for o in self.objects {
+            renderer.destroy_mirror(o.samples);
+            renderer.destroy_mirror(o.controls);
+        }
+    }
+}
+
+/// Polylines need two points; degree-0 local curves have one.
+fn polyline(
+    frame: &mut Frame<'_>,
+    m: &Mirror,
+    run: PointRun,
+    style: &PolylineStyle,
+) -> GpuResult<()> {
+    if run.count >= 2 {
+        frame.draw_polyline(m, run, style)
+    } else {
+        Ok(())
+    }
+}
+
+/// f32 vertices of sample rows `rows` of object `i`: (position, normal) for surfaces, position
+/// for curves — the only place canonical f64 samples become GPU data.
+fn sample_floats(doc: &Document, i: usize, rows: std::ops::Range<usize>, out: &mut Vec<f32>) {
+    let grid = doc.objects[i].sampled.grid();
+    let [_, cols] = grid.dims;
+    let stride = grid.stride();
+    out.clear();
+    match &grid.normals {
+        Some(n) => {
+            out.reserve(rows.len() * cols * 6);
+            for idx in rows.start * cols..rows.end * cols {
+                let p = grid.data[idx * stride];
+                let q = n[idx];
+                out.extend_from_slice(&[
+                    p.x as f32, p.y as f32, p.z as f32, q.x as f32, q.y as f32, q.z as f32,
+                ]);
+            }
+        }
+        None => {
+            out.reserve(rows.len() * 3);
+            for j in rows {
+                let p = grid.data[j * stride];
+                out.extend_from_slice(&[p.x as f32, p.y as f32, p.z as f32]);
+            }
+        }
+    }
+}
+
+fn push3(out: &mut Vec<f32>, p: DVec3) {
+    out.extend_from_slice(&[p.x as f32, p.y as f32, p.z as f32]);
+}
+
+/// The control mirror's contents and layout.
+fn control_floats(c: &Controls) -> (ControlLayout, Vec<f32>) {
+    let mut out = Vec::new();
+    let layout = match c {
+        Controls::Polygon(p) => {
+            p.iter().for_each(|&q| push3(&mut out, q));
+            ControlLayout::Polygon { count: p.len() }
+        }
+        Controls::Net { rows, cols, points } => {
+            points.iter().for_each(|&q| push3(&mut out, q));
+            ControlLayout::Net {
+                rows: *rows,
+                cols: *cols,
+            }
+        }
+        Controls::LocalCurves(locals) => {
+            let mut offs = Vec::new();
+            for l in locals {
+                offs.push((out.len(), 0, l.points.len()));
+                l.samples.iter().for_each(|&q| push3(&mut out, q));
+            }
+            for (l, o) in locals.iter().zip(offs.iter_mut()) {
+                o.1 = out.len();
+                l.points.iter().for_each(|&q| push3(&mut out, q));
+            }
+            ControlLayout::LocalCurves(offs)
+        }
+        Controls::LocalPatches { cols, patches, .. } => {
+            let mut offs = Vec::new();
+            for p in patches {
+                offs.push((out.len(), 0, p.net_rows, p.net_cols));
+                for &(pos, n) in &p.grid {
+                    push3(&mut out, pos);
+                    push3(&mut out, n);
+                }
+            }
+            for (p, o) in patches.iter().zip(offs.iter_mut()) {
+                o.1 = out.len();
+                p.points.iter().for_each(|&q| push3(&mut out, q));
+            }
+            ControlLayout::LocalPatches {
+                cols: *cols,
+                patches: offs,
+            }
+        }
+    };
+    (layout, out)
+}

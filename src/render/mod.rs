@@ -1,0 +1,15 @@
+//! Scene → GPU: the document being viewed, the orbit camera, per-object mirrors with per-slot
+//! dirty tracking, display options and overlays. Used by `prespline render` (offscreen) and the
+//! viewer (swapchain).
+
+pub mod camera;
+pub mod document;
+pub mod gpu_scene;
+pub mod offscreen;
+pub mod overlays;
+pub mod style;
+
+pub use camera::{Bounds, OrbitCamera};
+pub use document::{Controls, DocObject, Document, Handle};
+pub use gpu_scene::{GpuScene, Highlight, UploadStats};
+pub use style::{Palette, ViewOptions, Wire};

@@ -1,0 +1,100 @@
+//! Analysis overlays drawn as coloured line lists: surface normals, Frenet frames and curvature
+//! combs along curves. Computed from the model and the canonical samples each frame they are
+//! shown (a few hundred evaluations).
+
+use super::document::Document;
+use super::style::ViewOptions;
+use crate::geom::differential::frenet_frame;
+use crate::geom::knots::uniform_params;
+use crate::gpu::LineVertex;
+use crate::sampling::ModelRef;
+use glam::DVec3;
+
+/// Frames drawn per curve.
+const FRAMES_PER_CURVE: usize = 24;
+/// Teeth of a curvature comb.
+const COMB_TEETH: usize = 160;
+/// Normals per surface direction (at most).
+const NORMALS_PER_DIRECTION: usize = 32;
+
+/// All enabled overlays; `scale` is the scene radius (sets line lengths).
+pub fn overlay_lines(doc: &Document, opts: &ViewOptions, scale: f64) -> Vec<LineVertex> {
+    let mut out = Vec::new();
+    for o in &doc.objects {
+        let grid = o.sampled.grid();
+        if let (true, Some(normals)) = (opts.normals, &grid.normals) {
+            let [rows, cols] = grid.dims;
+            let (si, sj) = (
+                rows.div_ceil(NORMALS_PER_DIRECTION).max(1),
+                cols.div_ceil(NORMALS_PER_DIRECTION).max(1),
+            );
+            for i in (0..rows).step_by(si) {
+                for j in (0..cols).step_by(sj) {
+                    let p = grid.position(i, j);
+                    line(
+                        &mut out,
+                        p,
+                        p + normals[i * cols + j] * (0.04 * scale),
+                        [40, 220, 230, 255],
+                    );
+                }
+            }
+        }
+        let derivs: Box<dyn Fn(f64) -> Vec<DVec3>> = match o.sampled.model() {
+            ModelRef::Curve(c) => Box::new(move |t| c.derivatives(t, 3)),
+            ModelRef::ErbsCurve(c) => Box::new(move |t| c.derivatives(t, 3)),
+            _ => continue,
+        };
+        let (a, b) = match o.sampled.model() {
+            ModelRef::Curve(c) => c.domain(),
+            ModelRef::ErbsCurve(c) => c.domain(),
+            _ => unreachable!("curves only"),
+        };
+        if opts.frenet {
+            let len = 0.05 * scale;
+            for t in uniform_params(a, b, FRAMES_PER_CURVE) {
+                let d = derivs(t);
+                if let Some(f) = frenet_frame(d[1], d[2], d[3]) {
+                    line(&mut out, d[0], d[0] + f.tangent * len, [230, 60, 50, 255]);
+                    line(&mut out, d[0], d[0] + f.normal * len, [60, 210, 80, 255]);
+                    line(&mut out, d[0], d[0] + f.binormal * len, [70, 120, 240, 255]);
+                }
+            }
+        }
+        if opts.curvature_comb {
+            let ts = uniform_params(a, b, COMB_TEETH);
+            let teeth: Vec<(DVec3, DVec3)> = ts
+                .iter()
+                .map(|&t| {
+                    let d = derivs(t);
+                    let dir = frenet_frame(d[1], d[2], d[3])
+                        .map_or(DVec3::ZERO, |f| -f.normal * f.curvature);
+                    (d[0], dir)
+                })
+                .collect();
+            let max = teeth.iter().map(|(_, v)| v.length()).fold(0.0, f64::max);
+            if max > 0.0 {
+                let k = 0.15 * scale / max;
+                let color = [220, 80, 220, 255];
+                for (p, v) in &teeth {
+                    line(&mut out, *p, *p + *v * k, color);
+                }
+                for w in teeth.windows(2) {
+                    line(&mut out, w[0].0 + w[0].1 * k, w[1].0 + w[1].1 * k, color);
+                }
+            }
+        }
+    }
+    out
+}
+
+fn line(out: &mut Vec<LineVertex>, a: DVec3, b: DVec3, color: [u8; 4]) {
+    out.push(LineVertex {
+        pos: a.as_vec3().to_array(),
+        color,
+    });
+    out.push(LineVertex {
+        pos: b.as_vec3().to_array(),
+        color,
+    });
+}
