@@ -2,7 +2,7 @@
 
 use clap::{Args, Parser, Subcommand};
 use prespline::cli::{self, CliError};
-use prespline::render::{OrbitCamera, ViewOptions, Wire};
+use prespline::render::{NetMode, OrbitCamera, ViewOptions, Wire};
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -33,6 +33,24 @@ enum Command {
         /// Apply the edits to the model and re-sample from scratch instead of the delta path.
         #[arg(long)]
         full: bool,
+    },
+    /// Open the interactive viewer on a scene (the built-in demo scene without SCENE).
+    View {
+        /// Scene file (JSON); without it, the demo: B-spline surface, ERBS surface and curve,
+        /// NURBS circle, Utah teapot.
+        scene: Option<PathBuf>,
+        /// Window size.
+        #[arg(long, default_value = "1280x720", value_parser = cli::render::parse_size, value_name = "WxH")]
+        size: (u32, u32),
+        /// Present without vsync (MAILBOX or IMMEDIATE) to measure frame times.
+        #[arg(long)]
+        no_vsync: bool,
+        /// Replay timed input events from a JSON script (see README "Scripts").
+        #[arg(long, value_name = "SCRIPT.json")]
+        script: Option<PathBuf>,
+        /// Where Ctrl+S writes (default: the scene file, or prespline-demo.json for the demo).
+        #[arg(long, value_name = "PATH")]
+        save_as: Option<PathBuf>,
     },
     /// Render a scene headless (no display needed) into a PNG image.
     Render {
@@ -85,7 +103,7 @@ struct DisplayArgs {
 impl DisplayArgs {
     fn options(self) -> ViewOptions {
         ViewOptions {
-            control_nets: self.net,
+            control_nets: if self.net { NetMode::All } else { NetMode::Off },
             local_curves: !self.no_local,
             wire: match self.wire {
                 None | Some(0) => Wire::Off,
@@ -117,6 +135,19 @@ fn main() -> ExitCode {
             };
             cli::sample::run(&args).and_then(|text| print(&text))
         }
+        Command::View {
+            scene,
+            size,
+            no_vsync,
+            script,
+            save_as,
+        } => cli::view::run(&cli::view::ViewOptions {
+            scene: scene.as_deref(),
+            size,
+            vsync: !no_vsync,
+            script: script.as_deref(),
+            save_as: save_as.as_deref(),
+        }),
         Command::Render {
             scene,
             out,

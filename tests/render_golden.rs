@@ -6,7 +6,7 @@
 mod common;
 
 use prespline::render::offscreen::{Shot, render_document};
-use prespline::render::{Document, ViewOptions, Wire};
+use prespline::render::{Document, NetMode, ViewOptions, Wire};
 use prespline::scene::Scene;
 use std::path::Path;
 
@@ -44,7 +44,7 @@ fn bspline_surface_with_control_net() {
     let px = render(
         "bspline_surface.json",
         ViewOptions {
-            control_nets: true,
+            control_nets: NetMode::All,
             wire: Wire::Isolines(8),
             ..ViewOptions::default()
         },
@@ -57,7 +57,7 @@ fn erbs_curve_with_local_curves() {
     let px = render(
         "erbs_curve.json",
         ViewOptions {
-            control_nets: true,
+            control_nets: NetMode::All,
             local_curves: true,
             ..ViewOptions::default()
         },
@@ -70,7 +70,7 @@ fn nurbs_circle() {
     let px = render(
         "nurbs_circle.json",
         ViewOptions {
-            control_nets: true,
+            control_nets: NetMode::All,
             curvature_comb: true,
             ..ViewOptions::default()
         },

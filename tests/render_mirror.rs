@@ -7,7 +7,7 @@ mod common;
 use glam::{DMat4, DVec3};
 use prespline::gpu::{OffscreenDesc, Pixels, Renderer};
 use prespline::render::offscreen::{Shot, shot_camera};
-use prespline::render::{Document, GpuScene, Highlight, ViewOptions, Wire};
+use prespline::render::{Document, GpuScene, Highlight, NetMode, ViewOptions, Wire};
 use prespline::scene::demo::demo_scene;
 use prespline::scene::{Edit, EditOp, Index2, Scene};
 
@@ -65,7 +65,7 @@ fn random_edit(doc: &Document, rng: &mut Lcg) -> Edit {
 
 fn options() -> ViewOptions {
     ViewOptions {
-        control_nets: true,
+        control_nets: NetMode::All,
         local_curves: true,
         wire: Wire::Isolines(6),
         ..ViewOptions::default()

@@ -2,6 +2,7 @@
 
 pub mod render;
 pub mod sample;
+pub mod view;
 
 /// A command failure: one line for stderr; the process exits non-zero.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]

@@ -76,6 +76,16 @@ impl BezierCurve {
         self.points[i] += delta;
     }
 
+    /// Replaces all control points (same count), exactly.
+    pub fn set_points(&mut self, points: &[DVec3]) {
+        assert_eq!(
+            points.len(),
+            self.points.len(),
+            "set_points keeps the degree"
+        );
+        self.points.copy_from_slice(points);
+    }
+
     /// Replaces every control point by `f(point)` (weights unchanged), e.g. an affine map.
     pub fn map_points(&mut self, f: impl Fn(DVec3) -> DVec3) {
         for p in &mut self.points {

@@ -90,6 +90,11 @@ impl BSplineCurve {
         self.points[i] += delta;
     }
 
+    /// Sets control point `i` exactly (undo restores values bit for bit).
+    pub fn set_point(&mut self, i: usize, p: DVec3) {
+        self.points[i] = p;
+    }
+
     /// Sets weight `i`, making the curve rational (other weights 1) if it was not.
     pub fn set_weight(&mut self, i: usize, w: f64) {
         let n = self.points.len();

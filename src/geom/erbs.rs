@@ -171,6 +171,11 @@ impl ErbsCurve {
         self.local[l].map_points(|p| a.transform_point3(p));
     }
 
+    /// Sets every control point of local curve l exactly.
+    pub fn set_local_points(&mut self, l: usize, points: &[DVec3]) {
+        self.local[l].set_points(points);
+    }
+
     /// Translates control point q of local curve l.
     pub fn translate_local_point(&mut self, l: usize, q: usize, delta: DVec3) {
         self.local[l].translate_point(q, delta);
@@ -273,6 +278,12 @@ impl ErbsSurface {
     pub fn transform_local(&mut self, k: usize, l: usize, a: &DMat4) {
         let nv = self.count[1];
         self.local[k * nv + l].map_points(|p| a.transform_point3(p));
+    }
+
+    /// Sets every control point of local patch (k, l) exactly (row-major).
+    pub fn set_local_points(&mut self, k: usize, l: usize, points: &[DVec3]) {
+        let nv = self.count[1];
+        self.local[k * nv + l].set_points(points);
     }
 
     /// Translates control point (a, b) of local patch (k, l).

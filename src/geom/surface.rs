@@ -148,6 +148,21 @@ impl TensorSurface {
         self.points[i * self.count[1] + j] += delta;
     }
 
+    /// Sets control point (i, j) exactly.
+    pub fn set_point(&mut self, i: usize, j: usize, p: DVec3) {
+        self.points[i * self.count[1] + j] = p;
+    }
+
+    /// Replaces all control points (same count), exactly.
+    pub fn set_points(&mut self, points: &[DVec3]) {
+        assert_eq!(
+            points.len(),
+            self.points.len(),
+            "set_points keeps the net size"
+        );
+        self.points.copy_from_slice(points);
+    }
+
     /// Replaces every control point by `f(point)` (weights unchanged), e.g. an affine map.
     pub fn map_points(&mut self, f: impl Fn(DVec3) -> DVec3) {
         for p in &mut self.points {

@@ -186,14 +186,15 @@ impl Document {
         }
     }
 
-    /// Every pickable control point of object `i` with its position.
+    /// Every pickable control point of object `i` with its position (no sampling: cheap).
     pub fn handles(&self, i: usize) -> Vec<(Handle, DVec3)> {
         let object = i;
-        match self.controls(i) {
-            Controls::Polygon(p) => p
-                .into_iter()
+        match self.objects[i].sampled.model() {
+            ModelRef::Curve(c) => c
+                .points()
+                .iter()
                 .enumerate()
-                .map(|(k, q)| {
+                .map(|(k, &q)| {
                     (
                         Handle::Point {
                             object,
@@ -203,24 +204,28 @@ impl Document {
                     )
                 })
                 .collect(),
-            Controls::Net { cols, points, .. } => points
-                .into_iter()
+            ModelRef::Surface(s) => {
+                let cols = s.count()[1];
+                s.points()
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &q)| {
+                        (
+                            Handle::Point {
+                                object,
+                                point: Index2::Two(k / cols, k % cols),
+                            },
+                            q,
+                        )
+                    })
+                    .collect()
+            }
+            ModelRef::ErbsCurve(c) => c
+                .local_curves()
+                .iter()
                 .enumerate()
-                .map(|(k, q)| {
-                    (
-                        Handle::Point {
-                            object,
-                            point: Index2::Two(k / cols, k % cols),
-                        },
-                        q,
-                    )
-                })
-                .collect(),
-            Controls::LocalCurves(locals) => locals
-                .into_iter()
-                .enumerate()
-                .flat_map(|(l, c)| {
-                    c.points.into_iter().enumerate().map(move |(q, p)| {
+                .flat_map(|(l, lc)| {
+                    lc.points().iter().enumerate().map(move |(q, &p)| {
                         (
                             Handle::LocalPoint {
                                 object,
@@ -232,24 +237,35 @@ impl Document {
                     })
                 })
                 .collect(),
-            Controls::LocalPatches { cols, patches, .. } => patches
-                .into_iter()
-                .enumerate()
-                .flat_map(|(idx, p)| {
-                    let nc = p.net_cols;
-                    p.points.into_iter().enumerate().map(move |(q, pos)| {
-                        (
-                            Handle::LocalPoint {
-                                object,
-                                local: Index2::Two(idx / cols, idx % cols),
-                                point: Index2::Two(q / nc, q % nc),
-                            },
-                            pos,
-                        )
+            ModelRef::ErbsSurface(s) => {
+                let cols = s.count()[1];
+                s.local_patches()
+                    .iter()
+                    .enumerate()
+                    .flat_map(|(idx, p)| {
+                        let nc = p.count()[1];
+                        p.points().iter().enumerate().map(move |(q, &pos)| {
+                            let local = Index2::Two(idx / cols, idx % cols);
+                            (
+                                Handle::LocalPoint {
+                                    object,
+                                    local,
+                                    point: Index2::Two(q / nc, q % nc),
+                                },
+                                pos,
+                            )
+                        })
                     })
-                })
-                .collect(),
+                    .collect()
+            }
         }
+    }
+
+    /// Every pickable control point of the document.
+    pub fn all_handles(&self) -> Vec<(Handle, DVec3)> {
+        (0..self.objects.len())
+            .flat_map(|i| self.handles(i))
+            .collect()
     }
 
     /// The edit that moves a handle by `delta`.

@@ -3,7 +3,7 @@
 //! since it was last written.
 
 use super::document::{Controls, Document, Handle, LOCAL_CURVE_SAMPLES, LOCAL_PATCH_SAMPLES};
-use super::style::{Palette, ViewOptions, Wire};
+use super::style::{NetMode, Palette, ViewOptions, Wire};
 use crate::gpu::{
     FRAMES_IN_FLIGHT, Frame, GpuResult, GridShape, Mirror, PointRun, PointStyle, PolylineStyle,
     Renderer, SurfaceGrid, SurfaceStyle,
@@ -57,6 +57,18 @@ pub struct Highlight {
     pub selected: Option<Handle>,
     /// A selected ERBS local curve/patch (drawn emphasised).
     pub selected_local: Option<(usize, Index2)>,
+    /// The object under the cursor (its controls show in [`NetMode::Focused`]).
+    pub hovered_object: Option<usize>,
+}
+
+impl Highlight {
+    /// Whether object `i` is selected or under the cursor.
+    pub fn focuses(&self, i: usize) -> bool {
+        self.hovered.is_some_and(|h| h.object() == i)
+            || self.selected.is_some_and(|h| h.object() == i)
+            || self.selected_local.is_some_and(|(o, _)| o == i)
+            || self.hovered_object == Some(i)
+    }
 }
 
 pub struct GpuScene {
@@ -198,6 +210,11 @@ impl GpuScene {
             width: 1.0,
             depth_test: true,
         };
+        let nets = match opts.control_nets {
+            NetMode::All => true,
+            NetMode::Focused => hl.focuses(i),
+            NetMode::Off => false,
+        };
         let index_in = |h: Option<Handle>, f: &dyn Fn(Handle) -> Option<u32>| {
             h.filter(|h| h.object() == i).and_then(f)
         };
@@ -209,7 +226,7 @@ impl GpuScene {
             ..PointStyle::default()
         };
         match &o.layout {
-            ControlLayout::Polygon { count } if opts.control_nets => {
+            ControlLayout::Polygon { count } if nets => {
                 let run = PointRun::packed(0, *count);
                 polyline(frame, &o.controls, run, &net)?;
                 let pick = |h: Handle| match h {
@@ -225,7 +242,7 @@ impl GpuScene {
                     &points(index_in(hl.hovered, &pick), index_in(hl.selected, &pick)),
                 )?;
             }
-            ControlLayout::Net { rows, cols } if opts.control_nets => {
+            ControlLayout::Net { rows, cols } if nets => {
                 for r in 0..*rows {
                     polyline(frame, &o.controls, PointRun::grid_row(0, *cols, 3, r), &net)?;
                 }
@@ -276,7 +293,7 @@ impl GpuScene {
                             &style,
                         )?;
                     }
-                    if opts.control_nets || chosen {
+                    if nets || chosen {
                         let run = PointRun {
                             offset: po,
                             stride: 3,
@@ -316,7 +333,7 @@ impl GpuScene {
                         };
                         frame.draw_wire(&o.controls, sg, 1, color)?;
                     }
-                    if opts.control_nets || chosen {
+                    if nets || chosen {
                         for r in 0..nr {
                             polyline(frame, &o.controls, PointRun::grid_row(po, nc, 3, r), &net)?;
                         }

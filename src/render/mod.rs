@@ -12,4 +12,4 @@ pub mod style;
 pub use camera::{Bounds, OrbitCamera};
 pub use document::{Controls, DocObject, Document, Handle};
 pub use gpu_scene::{GpuScene, Highlight, UploadStats};
-pub use style::{Palette, ViewOptions, Wire};
+pub use style::{NetMode, Palette, ViewOptions, Wire};

@@ -10,11 +10,31 @@ pub enum Wire {
     Full,
 }
 
+/// Which objects show their control polygons, nets and points.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NetMode {
+    Off,
+    /// The selected object and the one under the cursor.
+    Focused,
+    All,
+}
+
+impl NetMode {
+    /// Next mode for the toggle key: All → Focused → Off → All.
+    pub fn next(self) -> Self {
+        match self {
+            NetMode::All => NetMode::Focused,
+            NetMode::Focused => NetMode::Off,
+            NetMode::Off => NetMode::All,
+        }
+    }
+}
+
 /// The display toggles of the viewer and `prespline render`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ViewOptions {
     /// Control polygons, control nets and control points.
-    pub control_nets: bool,
+    pub control_nets: NetMode,
     /// ERBS local curves and patches in their own colour.
     pub local_curves: bool,
     pub wire: Wire,
@@ -33,7 +53,7 @@ pub struct ViewOptions {
 impl Default for ViewOptions {
     fn default() -> Self {
         Self {
-            control_nets: false,
+            control_nets: NetMode::Off,
             local_curves: true,
             wire: Wire::Off,
             normals: false,

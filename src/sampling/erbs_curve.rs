@@ -133,6 +133,19 @@ impl ErbsCurveSampler {
         self.blend_in(l, &d)
     }
 
+    /// Sets every control point of local curve l exactly (samples move by the differences).
+    pub fn set_local_points(&mut self, l: usize, points: &[DVec3]) -> DirtyRegion {
+        let current = self.curve.local_curves()[l].points().to_vec();
+        let mut region = DirtyRegion::Nothing;
+        for (q, (&new, &old)) in points.iter().zip(&current).enumerate() {
+            if new != old {
+                region = region.union(self.translate_local_point(l, q, new - old));
+            }
+        }
+        self.curve.set_local_points(l, points);
+        region
+    }
+
     /// P^(r) += Σ_k C(r,k) W_l^(r−k) Δc_l^(k) over the support of local curve l.
     fn blend_in(&mut self, l: usize, delta: &[DVec3]) -> DirtyRegion {
         let g1 = self.grid.stride();

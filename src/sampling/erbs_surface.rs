@@ -212,6 +212,21 @@ impl ErbsSurfaceSampler {
         self.finish(idx, &d)
     }
 
+    /// Sets every control point of local patch (k, l) exactly (samples move by the differences).
+    pub fn set_local_points(&mut self, k: usize, l: usize, points: &[DVec3]) -> DirtyRegion {
+        let patch = self.surface.local_patch(k, l);
+        let nb = patch.count()[1];
+        let current = patch.points().to_vec();
+        let mut region = DirtyRegion::Nothing;
+        for (q, (&new, &old)) in points.iter().zip(&current).enumerate() {
+            if new != old {
+                region = region.union(self.translate_local_point(k, l, q / nb, q % nb, new - old));
+            }
+        }
+        self.surface.set_local_points(k, l, points);
+        region
+    }
+
     /// Exact re-evaluation of the whole object (drift control; ERBS updates are local anyway).
     pub fn rebuild(&mut self) -> DirtyRegion {
         self.full()

@@ -200,6 +200,34 @@ impl SampledObject {
                     delta,
                 },
             ) => s.translate_local_point(*k, *l, *a, *b, *delta),
+            (
+                Sampler::SplineCurve(s),
+                EditOp::SetPoint {
+                    point: Index2::One(k),
+                    position,
+                },
+            ) => s.set_point(*k, *position),
+            (
+                Sampler::SplineSurface(s),
+                EditOp::SetPoint {
+                    point: Index2::Two(k, l),
+                    position,
+                },
+            ) => s.set_point(*k, *l, *position),
+            (
+                Sampler::ErbsCurve(s),
+                EditOp::SetLocalPoints {
+                    local: Index2::One(l),
+                    points,
+                },
+            ) => s.set_local_points(*l, points),
+            (
+                Sampler::ErbsSurface(s),
+                EditOp::SetLocalPoints {
+                    local: Index2::Two(k, l),
+                    points,
+                },
+            ) => s.set_local_points(*k, *l, points),
             (_, op) => panic!(
                 "edit {op:?} does not fit a {} (validate first)",
                 self.type_name

@@ -124,6 +124,14 @@ impl SplineCurveSampler {
         self.add_homogeneous(k, dh)
     }
 
+    /// Sets control point k exactly: the samples move by the difference, the model takes the
+    /// exact value (so undo restores it bit for bit).
+    pub fn set_point(&mut self, k: usize, p: DVec3) -> DirtyRegion {
+        let region = self.translate_point(k, p - self.curve.points()[k]);
+        self.curve.set_point(k, p);
+        region
+    }
+
     fn add_polynomial(&mut self, k: usize, delta: DVec3) {
         let g = self.grid.stride();
         let rows = g.min(self.table.degree() + 1);

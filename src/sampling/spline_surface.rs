@@ -160,6 +160,13 @@ impl SplineSurfaceSampler {
         }
     }
 
+    /// Sets control point (k, l) exactly (samples move by the difference).
+    pub fn set_point(&mut self, k: usize, l: usize, p: DVec3) -> DirtyRegion {
+        let region = self.translate_point(k, l, p - self.surface.point(k, l));
+        self.surface.set_point(k, l, p);
+        region
+    }
+
     /// Sets weight (k, l): Δ(w P, w) = (Δw P_kl, Δw) on the touched samples, then re-projects.
     pub fn set_weight(&mut self, k: usize, l: usize, w: f64) -> DirtyRegion {
         let nv = self.surface.count()[1];

@@ -34,6 +34,12 @@ pub enum EditOp {
         point: Index2,
         delta: DVec3,
     },
+    /// Set a control point to an exact position (undo restores the model bit for bit). Not part
+    /// of the edits file format.
+    SetPoint { point: Index2, position: DVec3 },
+    /// Set every control point of an ERBS local curve/patch exactly (undo). Not part of the
+    /// edits file format.
+    SetLocalPoints { local: Index2, points: Vec<DVec3> },
 }
 
 impl EditOp {
@@ -98,6 +104,34 @@ impl EditOp {
                 },
                 Shape::ErbsSurface(s),
             ) => s.translate_local_point(*k, *l, *a, *b, *delta),
+            (
+                EditOp::SetPoint {
+                    point: Index2::One(i),
+                    position,
+                },
+                Shape::BezierCurve(c) | Shape::BSplineCurve(c),
+            ) => c.set_point(*i, *position),
+            (
+                EditOp::SetPoint {
+                    point: Index2::Two(i, j),
+                    position,
+                },
+                Shape::BezierSurface(s) | Shape::BSplineSurface(s),
+            ) => s.set_point(*i, *j, *position),
+            (
+                EditOp::SetLocalPoints {
+                    local: Index2::One(l),
+                    points,
+                },
+                Shape::ErbsCurve(c),
+            ) => c.set_local_points(*l, points),
+            (
+                EditOp::SetLocalPoints {
+                    local: Index2::Two(k, l),
+                    points,
+                },
+                Shape::ErbsSurface(s),
+            ) => s.set_local_points(*k, *l, points),
             (op, shape) => panic!(
                 "edit {op:?} does not fit a {} (validate first)",
                 shape.type_name()
@@ -327,12 +361,14 @@ enum Target {
 }
 
 fn target(e: &Edit) -> Target {
-    match e.op {
-        EditOp::TranslatePoint { point, .. } => Target::Point(e.object, point),
-        EditOp::SetWeight { point, .. } => Target::Weight(e.object, point),
-        EditOp::TransformLocal { local, .. } | EditOp::TranslateLocalPoint { local, .. } => {
-            Target::Local(e.object, local)
+    match &e.op {
+        EditOp::TranslatePoint { point, .. } | EditOp::SetPoint { point, .. } => {
+            Target::Point(e.object, *point)
         }
+        EditOp::SetWeight { point, .. } => Target::Weight(e.object, *point),
+        EditOp::TransformLocal { local, .. }
+        | EditOp::TranslateLocalPoint { local, .. }
+        | EditOp::SetLocalPoints { local, .. } => Target::Local(e.object, *local),
     }
 }
 

@@ -1,0 +1,379 @@
+//! The winit 0.30 application: window, swapchain (resize, minimise, out-of-date), input
+//! translation, the frame loop, scripted input and screenshots.
+
+use super::input::{InputEvent, Key, Modifiers, MouseButton};
+use super::script::ScriptPlayer;
+use super::session::Session;
+use crate::cli::render::validation_mode;
+use crate::gpu::{OffscreenDesc, Renderer, RendererDesc, Swapchain, SwapchainDesc, ValidationSink};
+use crate::scene::Scene;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+use winit::application::ApplicationHandler;
+use winit::dpi::PhysicalSize;
+use winit::event::{ElementState, MouseScrollDelta, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::keyboard::{Key as WKey, NamedKey};
+use winit::raw_window_handle::HasDisplayHandle;
+use winit::window::{Window, WindowId};
+
+/// Options of `prespline view`.
+#[derive(Debug, Clone)]
+pub struct ViewArgs {
+    pub scene: Scene,
+    /// Shown in the title bar.
+    pub title: String,
+    pub save_path: PathBuf,
+    pub size: (u32, u32),
+    pub vsync: bool,
+    pub script: Option<Vec<super::script::ScriptEvent>>,
+}
+
+/// Per-frame wall-clock phases measured by the loop, in milliseconds.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct FrameTimes {
+    pub index: u64,
+    pub input: f64,
+    pub delta: f64,
+    pub upload: f64,
+    pub record: f64,
+    pub submit: f64,
+    pub frame: f64,
+    pub gpu: Option<f64>,
+    pub bytes: usize,
+    pub samples: usize,
+}
+
+struct Running {
+    session: Session,
+    swapchain: Swapchain,
+    renderer: Renderer,
+    // Last: the swapchain and renderer must be destroyed before the window.
+    window: Window,
+}
+
+struct App {
+    args: ViewArgs,
+    running: Option<Running>,
+    sink: Option<ValidationSink>,
+    script: Option<ScriptPlayer>,
+    frame: u64,
+    start: Option<Instant>,
+    last: Option<Instant>,
+    error: Option<String>,
+    input_ms: f64,
+    times: Vec<FrameTimes>,
+}
+
+/// Whether an X11 display is reachable (this build's winit backend is X11; Wayland sessions
+/// run it through XWayland).
+pub fn display_available() -> bool {
+    std::env::var_os("DISPLAY").is_some_and(|d| !d.is_empty())
+}
+
+/// Opens the viewer and runs until the window closes. Returns the frame timings.
+pub fn run(args: ViewArgs) -> Result<Vec<FrameTimes>, String> {
+    if !display_available() {
+        return Err("no display: DISPLAY is not set (prespline view needs X11 or XWayland; for headless use try `prespline render` or `prespline bench`)".into());
+    }
+    let event_loop = EventLoop::new().map_err(|e| format!("cannot open the display: {e}"))?;
+    event_loop.set_control_flow(ControlFlow::Poll);
+    let script = args.script.clone().map(ScriptPlayer::new);
+    let mut app = App {
+        args,
+        running: None,
+        sink: None,
+        script,
+        frame: 0,
+        start: None,
+        last: None,
+        error: None,
+        input_ms: 0.0,
+        times: Vec::new(),
+    };
+    event_loop
+        .run_app(&mut app)
+        .map_err(|e| format!("event loop failed: {e}"))?;
+    if let Some(errors) = app
+        .sink
+        .as_ref()
+        .map(|s| s.errors())
+        .filter(|e| !e.is_empty())
+    {
+        let first = errors[0].to_string();
+        app.error.get_or_insert(format!(
+            "Vulkan validation reported {} error(s), first: {}",
+            errors.len(),
+            first.lines().next().unwrap_or("")
+        ));
+    }
+    match app.error {
+        Some(e) => Err(e),
+        None => Ok(app.times),
+    }
+}
+
+impl App {
+    fn create(&mut self, event_loop: &ActiveEventLoop) -> Result<(), String> {
+        let (w, h) = self.args.size;
+        let attrs = Window::default_attributes()
+            .with_title(format!("prespline — {}", self.args.title))
+            .with_inner_size(PhysicalSize::new(w, h));
+        let window = event_loop
+            .create_window(attrs)
+            .map_err(|e| format!("cannot create a window: {e}"))?;
+        let display = window.display_handle().map_err(|e| e.to_string())?.as_raw();
+        let mut renderer = Renderer::new(&RendererDesc {
+            app_name: "prespline view".into(),
+            validation: validation_mode(),
+            display: Some(display),
+            ..RendererDesc::default()
+        })
+        .map_err(|e| e.to_string())?;
+        self.sink = renderer.validation_sink();
+        let size = window.inner_size();
+        let swapchain = renderer
+            .create_swapchain(
+                &window,
+                &SwapchainDesc {
+                    width: size.width,
+                    height: size.height,
+                    vsync: self.args.vsync,
+                    samples: 0,
+                },
+            )
+            .map_err(|e| e.to_string())?;
+        let session = Session::new(
+            &mut renderer,
+            &self.args.scene,
+            self.args.save_path.clone(),
+            [size.width, size.height],
+        )
+        .map_err(|e| e.to_string())?;
+        window.request_redraw();
+        self.running = Some(Running {
+            session,
+            swapchain,
+            renderer,
+            window,
+        });
+        Ok(())
+    }
+
+    fn shutdown(&mut self, event_loop: &ActiveEventLoop) {
+        if let Some(r) = self.running.take() {
+            let Running {
+                session,
+                swapchain,
+                mut renderer,
+                window,
+            } = r;
+            let _ = renderer.wait_idle();
+            session.destroy(&mut renderer);
+            if let Err(e) = renderer.destroy_swapchain(swapchain) {
+                self.error.get_or_insert(e.to_string());
+            }
+            drop(renderer);
+            drop(window);
+        }
+        event_loop.exit();
+    }
+
+    fn fail(&mut self, event_loop: &ActiveEventLoop, e: impl ToString) {
+        self.error.get_or_insert(e.to_string());
+        self.shutdown(event_loop);
+    }
+
+    fn input(&mut self, e: InputEvent) {
+        let t = Instant::now();
+        if let Some(r) = self.running.as_mut() {
+            r.session.handle(e);
+        }
+        self.input_ms += t.elapsed().as_secs_f64() * 1e3;
+    }
+
+    fn redraw(&mut self) -> Result<(), String> {
+        let Some(r) = self.running.as_mut() else {
+            return Ok(());
+        };
+        let frame_start = Instant::now();
+        let start = *self.start.get_or_insert(frame_start);
+        let mut shots = Vec::new();
+        if let Some(script) = self.script.as_mut() {
+            for action in script.due(self.frame, start.elapsed().as_secs_f64()) {
+                if let Some(path) = r.session.perform(action) {
+                    shots.push(path);
+                }
+            }
+        }
+        let input = self.input_ms + frame_start.elapsed().as_secs_f64() * 1e3;
+        self.input_ms = 0.0;
+        let t = Instant::now();
+        let applied = r.session.apply_pending();
+        let delta = t.elapsed().as_secs_f64() * 1e3;
+        let mut times = FrameTimes {
+            index: self.frame,
+            input,
+            delta,
+            samples: applied.samples,
+            ..FrameTimes::default()
+        };
+        match r
+            .renderer
+            .begin_swapchain(&mut r.swapchain)
+            .map_err(|e| e.to_string())?
+        {
+            None => {}
+            Some(mut frame) => {
+                let t = Instant::now();
+                let stats = r.session.upload(&mut frame).map_err(|e| e.to_string())?;
+                times.upload = t.elapsed().as_secs_f64() * 1e3;
+                times.bytes = stats.bytes;
+                let t = Instant::now();
+                r.session
+                    .record(&mut frame, true)
+                    .map_err(|e| e.to_string())?;
+                times.record = t.elapsed().as_secs_f64() * 1e3;
+                let t = Instant::now();
+                frame.finish().map_err(|e| e.to_string())?;
+                times.submit = t.elapsed().as_secs_f64() * 1e3;
+            }
+        }
+        for path in shots {
+            screenshot(r, &path)?;
+            r.session
+                .set_status(format!("screenshot {}", path.display()));
+        }
+        times.gpu = r.renderer.last_gpu_time_ms();
+        r.session.hud.gpu_ms = times.gpu;
+        let now = Instant::now();
+        if let Some(last) = self.last {
+            let ms = (now - last).as_secs_f64() * 1e3;
+            r.session.hud.push_frame(ms);
+            times.frame = ms;
+        }
+        self.last = Some(now);
+        self.times.push(times);
+        self.frame += 1;
+        Ok(())
+    }
+}
+
+/// Renders what the window shows (without the HUD) offscreen at the window size into a PNG.
+fn screenshot(r: &mut Running, path: &Path) -> Result<(), String> {
+    let [w, h] = r.session.size();
+    let mut target = r
+        .renderer
+        .create_offscreen(&OffscreenDesc {
+            width: w as u32,
+            height: h as u32,
+            samples: 0,
+        })
+        .map_err(|e| e.to_string())?;
+    let result = (|| {
+        let mut frame = r.renderer.begin_offscreen(&mut target)?;
+        r.session.upload(&mut frame)?;
+        r.session.record(&mut frame, false)?;
+        frame.finish()?;
+        r.renderer.read_pixels(&target)
+    })();
+    r.renderer
+        .destroy_offscreen(target)
+        .map_err(|e| e.to_string())?;
+    let pixels = result.map_err(|e| e.to_string())?;
+    pixels
+        .write_png(path)
+        .map_err(|e| format!("cannot write {}: {e}", path.display()))
+}
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.running.is_none()
+            && let Err(e) = self.create(event_loop)
+        {
+            self.fail(event_loop, e);
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        match event {
+            WindowEvent::CloseRequested => self.shutdown(event_loop),
+            WindowEvent::Resized(size) => {
+                if let Some(r) = self.running.as_mut() {
+                    r.swapchain.resize(size.width, size.height);
+                    r.session.resize(size.width, size.height);
+                }
+            }
+            WindowEvent::ModifiersChanged(m) => {
+                let s = m.state();
+                self.input(InputEvent::Modifiers(Modifiers {
+                    ctrl: s.control_key(),
+                    shift: s.shift_key(),
+                    alt: s.alt_key(),
+                }));
+            }
+            WindowEvent::KeyboardInput { event, .. } => {
+                let key = match &event.logical_key {
+                    WKey::Named(NamedKey::Enter) => Key::Enter,
+                    WKey::Named(NamedKey::Escape) => Key::Escape,
+                    WKey::Named(NamedKey::Backspace) => Key::Backspace,
+                    WKey::Named(NamedKey::Home) => Key::Home,
+                    WKey::Named(NamedKey::F1) => Key::F1,
+                    WKey::Character(s) => match s.chars().next() {
+                        // Ctrl+letter can arrive as a control character.
+                        Some(c) if (c as u32) < 0x20 => {
+                            Key::Char(char::from(b'a' + (c as u8).saturating_sub(1)))
+                        }
+                        Some(c) => Key::Char(c.to_ascii_lowercase()),
+                        None => Key::Other,
+                    },
+                    _ => Key::Other,
+                };
+                self.input(InputEvent::Key {
+                    key,
+                    pressed: event.state == ElementState::Pressed,
+                });
+            }
+            WindowEvent::CursorMoved { position, .. } => self.input(InputEvent::CursorMoved {
+                x: position.x,
+                y: position.y,
+            }),
+            WindowEvent::MouseInput { state, button, .. } => {
+                let button = match button {
+                    winit::event::MouseButton::Left => MouseButton::Left,
+                    winit::event::MouseButton::Middle => MouseButton::Middle,
+                    winit::event::MouseButton::Right => MouseButton::Right,
+                    _ => return,
+                };
+                self.input(InputEvent::Button {
+                    button,
+                    pressed: state == ElementState::Pressed,
+                });
+            }
+            WindowEvent::MouseWheel { delta, .. } => {
+                let d = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => y as f64,
+                    MouseScrollDelta::PixelDelta(p) => p.y / 40.0,
+                };
+                self.input(InputEvent::Wheel { delta: d });
+            }
+            WindowEvent::RedrawRequested => {
+                if let Err(e) = self.redraw() {
+                    return self.fail(event_loop, e);
+                }
+                if self.running.as_ref().is_some_and(|r| r.session.quit) {
+                    self.shutdown(event_loop);
+                }
+            }
+            _ => {}
+        }
+    }
+
+    fn about_to_wait(&mut self, _event_loop: &ActiveEventLoop) {
+        // Continuous redraw: the frame-time graph and profiling want a steady stream of frames;
+        // FIFO presentation paces it to the display.
+        if let Some(r) = self.running.as_ref() {
+            r.window.request_redraw();
+        }
+    }
+}

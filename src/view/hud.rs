@@ -1,0 +1,175 @@
+//! The on-screen overlay: frame-time graph, edit cost, samples touched, bytes copied to the GPU,
+//! GPU time; the status line; and the key help.
+
+use crate::gpu::OverlayVertex;
+use crate::gpu::font::{LINE_HEIGHT, push_rect, push_text};
+use std::collections::VecDeque;
+
+/// Frames kept in the graph.
+const HISTORY: usize = 240;
+const TEXT: [u8; 4] = [230, 232, 238, 255];
+const DIM: [u8; 4] = [150, 155, 165, 255];
+const PANEL: [u8; 4] = [10, 12, 16, 190];
+
+/// Every key binding, as shown by the help overlay (H or F1) and the README.
+pub const KEY_HELP: &[(&str, &str)] = &[
+    (
+        "left drag on a point",
+        "move it in the view plane (X/Y/Z while dragging: along an axis)",
+    ),
+    ("left drag elsewhere", "orbit"),
+    (
+        "middle drag / right drag / shift+left drag",
+        "orbit / pan / pan",
+    ),
+    ("wheel", "zoom to the cursor"),
+    (
+        "click a point",
+        "select it (ERBS: selects its local curve/patch too)",
+    ),
+    (
+        "G / R / S",
+        "grab / rotate / scale the selected local curve or patch (G also a point)",
+    ),
+    (
+        "  X / Y / Z, digits, Enter",
+        "axis constraint, typed value (distance, degrees, factor), confirm",
+    ),
+    ("  Esc / right click", "cancel the transform"),
+    ("Ctrl+Z / Ctrl+Shift+Z (Ctrl+Y)", "undo / redo"),
+    ("Ctrl+S", "save the scene file"),
+    ("F / A / Home", "frame selection / frame all / reset camera"),
+    (
+        "C / L / W",
+        "control nets / local curves / wireframe (off, isolines, full)",
+    ),
+    ("N / T / K", "normals / Frenet frames / curvature combs"),
+    ("P", "performance overlay"),
+    ("H or F1", "this help"),
+    ("Esc", "deselect"),
+    ("Ctrl+Q or close the window", "quit"),
+];
+
+/// Numbers shown in the overlay.
+#[derive(Debug, Clone, Default)]
+pub struct Hud {
+    frames: VecDeque<f32>,
+    pub edit_us: f64,
+    pub samples_touched: usize,
+    pub bytes: usize,
+    pub gpu_ms: Option<f64>,
+    pub visible: bool,
+}
+
+impl Hud {
+    pub fn new() -> Self {
+        Self {
+            visible: true,
+            ..Self::default()
+        }
+    }
+
+    pub fn push_frame(&mut self, ms: f64) {
+        if self.frames.len() == HISTORY {
+            self.frames.pop_front();
+        }
+        self.frames.push_back(ms as f32);
+    }
+
+    fn mean(&self) -> f64 {
+        let n = self.frames.len().min(60);
+        if n == 0 {
+            return 0.0;
+        }
+        self.frames
+            .iter()
+            .rev()
+            .take(n)
+            .map(|&x| x as f64)
+            .sum::<f64>()
+            / n as f64
+    }
+
+    /// Overlay vertices for a `width × height` image.
+    pub fn build(&self, width: f32, height: f32, status: &str, help: bool) -> Vec<OverlayVertex> {
+        let mut v = Vec::new();
+        let scale = 2.0;
+        let line = LINE_HEIGHT as f32 * scale + 2.0;
+        if self.visible {
+            let mean = self.mean();
+            let fps = if mean > 0.0 { 1000.0 / mean } else { 0.0 };
+            let gpu = self
+                .gpu_ms
+                .map_or("n/a".to_string(), |g| format!("{g:.2} ms"));
+            let lines = [
+                format!("frame {mean:.2} ms ({fps:.0} fps)   GPU {gpu}"),
+                format!(
+                    "edit {:.1} us   {} samples   {:.1} KB to GPU",
+                    self.edit_us,
+                    self.samples_touched,
+                    self.bytes as f64 / 1024.0
+                ),
+            ];
+            let (gw, gh) = (HISTORY as f32 * 2.0, 60.0);
+            push_rect(
+                &mut v,
+                8.0,
+                8.0,
+                gw.max(560.0) + 16.0,
+                2.0 * line + gh + 24.0,
+                PANEL,
+            );
+            for (k, l) in lines.iter().enumerate() {
+                push_text(&mut v, l, 16.0, 14.0 + k as f32 * line, scale, TEXT);
+            }
+            // Frame-time graph: one bar per frame, 33 ms full scale (lines at 16.7 and 33.3 ms).
+            let (gx, gy) = (16.0, 16.0 + 2.0 * line);
+            for ms in [16.7f32, 33.3] {
+                push_rect(
+                    &mut v,
+                    gx,
+                    gy + gh - gh * ms / 33.3,
+                    gw,
+                    1.0,
+                    [90, 90, 100, 255],
+                );
+            }
+            for (k, &ms) in self.frames.iter().enumerate() {
+                let h = (gh * ms / 33.3).min(gh);
+                let c = if ms > 33.3 {
+                    [235, 80, 70, 255]
+                } else if ms > 16.7 {
+                    [235, 190, 60, 255]
+                } else {
+                    [90, 200, 120, 255]
+                };
+                push_rect(&mut v, gx + k as f32 * 2.0, gy + gh - h, 2.0, h, c);
+            }
+        }
+        if !status.is_empty() {
+            let y = height - line - 10.0;
+            push_rect(&mut v, 0.0, y - 6.0, width, line + 12.0, PANEL);
+            push_text(&mut v, status, 12.0, y, scale, TEXT);
+        }
+        if help {
+            let rows = KEY_HELP.len() as f32 + 2.0;
+            let (w, h) = (width.min(1180.0) - 40.0, rows * line + 20.0);
+            let (x, y) = (20.0, (height - h).max(0.0) * 0.5);
+            push_rect(&mut v, x, y, w, h, [8, 10, 14, 225]);
+            push_text(
+                &mut v,
+                "prespline keys (H or F1 closes)",
+                x + 12.0,
+                y + 10.0,
+                scale,
+                TEXT,
+            );
+            for (k, (key, what)) in KEY_HELP.iter().enumerate() {
+                let ty = y + 10.0 + (k as f32 + 1.5) * line;
+                push_text(&mut v, key, x + 12.0, ty, scale, DIM);
+                push_text(&mut v, what, x + 12.0 + 44.0 * 6.0 * scale, ty, scale, TEXT);
+            }
+        }
+        v
+    }
+}

@@ -1,0 +1,14 @@
+//! The interactive viewer: a winit window over the [`session::Session`] core (camera, picking,
+//! dragging, ERBS local transforms, undo/redo, save, overlays), scripted input for demos and
+//! tests, and the HUD.
+
+pub mod app;
+pub mod hud;
+pub mod input;
+pub mod picking;
+pub mod script;
+pub mod session;
+pub mod tools;
+pub mod undo;
+
+pub use session::Session;

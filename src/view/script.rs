@@ -1,0 +1,212 @@
+//! `--script FILE`: timed input events replayed as if typed.
+//!
+//! A script is a JSON list; each entry has a time (`"frame": n` — the frame number, which makes
+//! replays independent of speed — or `"t": seconds` since the first frame) and one action:
+//!
+//! ```json
+//! [{"frame": 2, "move": [640, 360]},
+//!  {"frame": 3, "move_to": {"object": "bspline_surface", "point": [3, 4]}},
+//!  {"frame": 4, "press": "left"}, {"frame": 5, "move_by": [0, -40]}, {"frame": 6, "release": "left"},
+//!  {"frame": 7, "key": "r"}, {"frame": 8, "type": "30"}, {"frame": 9, "key": "enter"},
+//!  {"frame": 10, "key": "z", "ctrl": true}, {"frame": 11, "wheel": 2},
+//!  {"frame": 12, "screenshot": "shot.png"}, {"frame": 13, "quit": true}]
+//! ```
+//!
+//! `move_to` aims the cursor at a control point (`"local"` too for ERBS objects), so scripts
+//! keep working when the window size or framing changes.
+
+use super::input::{InputEvent, Key, Modifiers, MouseButton};
+use crate::render::{Document, Handle};
+use crate::scene::Index2;
+use serde_json::Value;
+use std::path::PathBuf;
+
+/// When an action happens.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum When {
+    Frame(u64),
+    Seconds(f64),
+}
+
+/// One scripted action.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Action {
+    Input(InputEvent),
+    /// Key press and release with modifiers held.
+    Key {
+        key: Key,
+        mods: Modifiers,
+    },
+    MoveTo(Handle),
+    MoveBy(f64, f64),
+    Type(String),
+    Screenshot(PathBuf),
+    Quit,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScriptEvent {
+    pub when: When,
+    pub action: Action,
+}
+
+/// Parses a script against the document (object names and indices are checked up front).
+pub fn parse_script(text: &str, doc: &Document) -> Result<Vec<ScriptEvent>, String> {
+    let v: Value = serde_json::from_str(text).map_err(|e| format!("invalid JSON: {e}"))?;
+    let list = v.as_array().ok_or("a script is a JSON list of events")?;
+    list.iter()
+        .enumerate()
+        .map(|(i, e)| parse_event(e, doc).map_err(|m| format!("event {i}: {m}")))
+        .collect()
+}
+
+fn parse_event(v: &Value, doc: &Document) -> Result<ScriptEvent, String> {
+    let obj = v.as_object().ok_or("expected an object")?;
+    let when = match (obj.get("frame"), obj.get("t")) {
+        (Some(f), None) => When::Frame(f.as_u64().ok_or("'frame' must be a non-negative integer")?),
+        (None, Some(t)) => When::Seconds(
+            t.as_f64()
+                .filter(|t| *t >= 0.0)
+                .ok_or("'t' must be a non-negative number")?,
+        ),
+        _ => return Err("give exactly one of 'frame' and 't'".into()),
+    };
+    let flag = |k: &str| obj.get(k).and_then(Value::as_bool).unwrap_or(false);
+    let mods = Modifiers {
+        ctrl: flag("ctrl"),
+        shift: flag("shift"),
+        alt: flag("alt"),
+    };
+    let known = [
+        "frame", "t", "ctrl", "shift", "alt", "object", "local", "point",
+    ];
+    let actions: Vec<&String> = obj
+        .keys()
+        .filter(|k| !known.contains(&k.as_str()))
+        .collect();
+    let [name] = actions.as_slice() else {
+        return Err(format!("expected exactly one action, found {:?}", actions));
+    };
+    let arg = &obj[name.as_str()];
+    let pair = |a: &Value| -> Result<(f64, f64), String> {
+        match a
+            .as_array()
+            .map(|x| x.iter().filter_map(Value::as_f64).collect::<Vec<_>>())
+        {
+            Some(p) if p.len() == 2 => Ok((p[0], p[1])),
+            _ => Err(format!("'{name}' expects [x, y]")),
+        }
+    };
+    let button = |a: &Value| -> Result<MouseButton, String> {
+        serde_json::from_value(a.clone())
+            .map_err(|_| format!("'{name}' expects \"left\", \"middle\" or \"right\""))
+    };
+    let action = match name.as_str() {
+        "move" => {
+            let (x, y) = pair(arg)?;
+            Action::Input(InputEvent::CursorMoved { x, y })
+        }
+        "move_by" => {
+            let (x, y) = pair(arg)?;
+            Action::MoveBy(x, y)
+        }
+        "move_to" => Action::MoveTo(handle(arg, doc)?),
+        "press" => Action::Input(InputEvent::Button {
+            button: button(arg)?,
+            pressed: true,
+        }),
+        "release" => Action::Input(InputEvent::Button {
+            button: button(arg)?,
+            pressed: false,
+        }),
+        "wheel" => Action::Input(InputEvent::Wheel {
+            delta: arg.as_f64().ok_or("'wheel' expects a number")?,
+        }),
+        "key" => {
+            let k = arg.as_str().and_then(Key::parse).ok_or(
+                "'key' expects a key name (a character, enter, escape, backspace, home, f1)",
+            )?;
+            Action::Key { key: k, mods }
+        }
+        "type" => Action::Type(arg.as_str().ok_or("'type' expects a string")?.to_string()),
+        "screenshot" => Action::Screenshot(PathBuf::from(
+            arg.as_str().ok_or("'screenshot' expects a file name")?,
+        )),
+        "quit" => Action::Quit,
+        other => return Err(format!("unknown action '{other}'")),
+    };
+    Ok(ScriptEvent { when, action })
+}
+
+/// `{"object": name, "point": i | [i, j]}` or with `"local"` for ERBS objects.
+fn handle(v: &Value, doc: &Document) -> Result<Handle, String> {
+    let name = v
+        .get("object")
+        .and_then(Value::as_str)
+        .ok_or("'move_to' needs \"object\"")?;
+    let object = doc
+        .objects
+        .iter()
+        .position(|o| o.name == name)
+        .ok_or(format!("unknown object '{name}'"))?;
+    let index = |k: &str| -> Result<Option<Index2>, String> {
+        match v.get(k) {
+            None => Ok(None),
+            Some(Value::Number(n)) => Ok(Some(Index2::One(
+                n.as_u64().ok_or(format!("bad '{k}'"))? as usize,
+            ))),
+            Some(Value::Array(a)) if a.len() == 2 => {
+                let i = |x: &Value| x.as_u64().map(|u| u as usize).ok_or(format!("bad '{k}'"));
+                Ok(Some(Index2::Two(i(&a[0])?, i(&a[1])?)))
+            }
+            Some(_) => Err(format!("bad '{k}'")),
+        }
+    };
+    let point = index("point")?.ok_or("'move_to' needs \"point\"")?;
+    let h = match index("local")? {
+        Some(local) => Handle::LocalPoint {
+            object,
+            local,
+            point,
+        },
+        None => Handle::Point { object, point },
+    };
+    if !doc.handles(object).iter().any(|(x, _)| *x == h) {
+        return Err(format!("object '{name}' has no such control point"));
+    }
+    Ok(h)
+}
+
+/// Hands out script events as their time comes.
+#[derive(Debug, Clone)]
+pub struct ScriptPlayer {
+    events: Vec<ScriptEvent>,
+    next: usize,
+}
+
+impl ScriptPlayer {
+    pub fn new(events: Vec<ScriptEvent>) -> Self {
+        Self { events, next: 0 }
+    }
+
+    /// Events due at `frame` / `seconds`, in file order (an event waits for its predecessors).
+    pub fn due(&mut self, frame: u64, seconds: f64) -> Vec<Action> {
+        let mut out = Vec::new();
+        while let Some(e) = self.events.get(self.next) {
+            let ready = match e.when {
+                When::Frame(f) => frame >= f,
+                When::Seconds(t) => seconds >= t,
+            };
+            if !ready {
+                break;
+            }
+            out.push(e.action.clone());
+            self.next += 1;
+        }
+        out
+    }
+
+    pub fn finished(&self) -> bool {
+        self.next >= self.events.len()
+    }
+}

@@ -1,0 +1,738 @@
+//! An interactive editing session, independent of the window system: the document, its GPU
+//! mirrors, camera, selection, tools, undo, and the per-frame work (apply edits through the
+//! delta path, copy dirty rows, record draws and the overlay). The winit viewer, `--script`
+//! replays and `prespline bench` all drive this same type.
+
+use super::hud::Hud;
+use super::input::{InputEvent, Key, Modifiers, MouseButton};
+use super::picking::{PICK_RADIUS, Projected, pick, project_all};
+use super::script::Action;
+use super::tools::{Axis, Drag, Transform, TransformKind, View};
+use super::undo::{UndoStack, local_points};
+use crate::gpu::{Frame, GpuResult, Renderer};
+use crate::render::overlays::overlay_lines;
+use crate::render::{
+    Bounds, Document, GpuScene, Handle, Highlight, NetMode, OrbitCamera, Palette, UploadStats,
+    ViewOptions, Wire,
+};
+use crate::scene::edit::merge_edits;
+use crate::scene::{Edit, EditOp, Index2, Scene};
+use glam::{DMat4, DVec3};
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// What a transform acts on.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Target {
+    Point(Handle),
+    Local(usize, Index2),
+}
+
+#[derive(Debug, Clone)]
+enum Mode {
+    Idle,
+    Orbit { moved: bool },
+    Pan,
+    Drag { handle: Handle, drag: Drag },
+    Transform { target: Target, t: Box<Transform> },
+}
+
+/// Cost of applying one frame's edits.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ApplyStats {
+    pub edits: usize,
+    pub samples: usize,
+    pub micros: f64,
+}
+
+pub struct Session {
+    pub doc: Document,
+    gpu: GpuScene,
+    pub camera: OrbitCamera,
+    home: OrbitCamera,
+    pub options: ViewOptions,
+    size: [f64; 2],
+    bounds: Bounds,
+    cursor: (f64, f64),
+    mods: Modifiers,
+    hovered: Option<Projected>,
+    hovered_object: Option<usize>,
+    selected: Option<Handle>,
+    selected_local: Option<(usize, Index2)>,
+    mode: Mode,
+    pending: Vec<Edit>,
+    undo: UndoStack,
+    save_path: PathBuf,
+    status: String,
+    status_since: Option<Instant>,
+    pub hud: Hud,
+    pub show_help: bool,
+    pub quit: bool,
+    /// Projected handles, recomputed when the camera or the model changes.
+    projected: Option<Vec<Projected>>,
+    /// Apply every edit as it comes instead of merging a frame's edits (`--naive` comparisons).
+    pub merge: bool,
+}
+
+impl Session {
+    /// Pre-evaluates `scene`, uploads it, and frames it for a `size` image. Ctrl+S writes to
+    /// `save_path`.
+    pub fn new(
+        renderer: &mut Renderer,
+        scene: &Scene,
+        save_path: PathBuf,
+        size: [u32; 2],
+    ) -> GpuResult<Self> {
+        let doc = Document::new(scene);
+        let nets = default_nets(&doc);
+        let gpu = GpuScene::new(renderer, &doc)?;
+        let bounds = doc.bounds();
+        let size = [size[0].max(1) as f64, size[1].max(1) as f64];
+        let mut camera = OrbitCamera::default_for(&bounds);
+        camera.frame(&bounds, size[0] / size[1]);
+        Ok(Self {
+            doc,
+            gpu,
+            camera,
+            home: camera,
+            options: ViewOptions {
+                control_nets: nets,
+                ..ViewOptions::default()
+            },
+            size,
+            bounds,
+            cursor: (size[0] * 0.5, size[1] * 0.5),
+            mods: Modifiers::default(),
+            hovered: None,
+            hovered_object: None,
+            selected: None,
+            selected_local: None,
+            mode: Mode::Idle,
+            pending: Vec::new(),
+            undo: UndoStack::default(),
+            save_path,
+            status: "H or F1: keys".into(),
+            status_since: Some(Instant::now()),
+            hud: Hud::new(),
+            show_help: false,
+            quit: false,
+            projected: None,
+            merge: true,
+        })
+    }
+
+    /// Gives the GPU resources back.
+    pub fn destroy(self, renderer: &mut Renderer) {
+        self.gpu.destroy(renderer);
+    }
+
+    pub fn size(&self) -> [f64; 2] {
+        self.size
+    }
+
+    pub fn resize(&mut self, width: u32, height: u32) {
+        if width > 0 && height > 0 {
+            self.size = [width as f64, height as f64];
+            self.projected = None;
+        }
+    }
+
+    pub fn cursor(&self) -> (f64, f64) {
+        self.cursor
+    }
+
+    pub fn bounds(&self) -> &Bounds {
+        &self.bounds
+    }
+
+    pub fn selected(&self) -> Option<Handle> {
+        self.selected
+    }
+
+    pub fn selected_local(&self) -> Option<(usize, Index2)> {
+        self.selected_local
+    }
+
+    pub fn undo_depth(&self) -> (usize, usize) {
+        self.undo.depth()
+    }
+
+    pub fn set_status(&mut self, s: impl Into<String>) {
+        self.status = s.into();
+        self.status_since = Some(Instant::now());
+    }
+
+    fn view(&self) -> View<'_> {
+        View {
+            camera: &self.camera,
+            bounds: &self.bounds,
+            size: self.size,
+        }
+    }
+
+    /// Screen position of a handle (for scripts that aim at a control point).
+    pub fn handle_position(&self, handle: Handle) -> Option<(f64, f64)> {
+        let (_, world) = self
+            .doc
+            .handles(handle.object())
+            .into_iter()
+            .find(|(h, _)| *h == handle)?;
+        self.view().project(world)
+    }
+
+    /// Queues an edit for this frame, recording it for undo.
+    pub fn queue(&mut self, edit: Edit) {
+        self.undo.record(&self.doc, &edit);
+        self.pending.push(edit);
+    }
+
+    /// Applies this frame's queued edits (merged per control point) through the delta path and
+    /// marks the touched rows dirty for every frame slot's mirrors.
+    pub fn apply_pending(&mut self) -> ApplyStats {
+        if self.pending.is_empty() {
+            return ApplyStats::default();
+        }
+        let start = Instant::now();
+        let edits = if self.merge {
+            merge_edits(&self.pending)
+        } else {
+            self.pending.clone()
+        };
+        self.pending.clear();
+        let mut samples = 0;
+        for e in &edits {
+            let region = self.doc.apply(e);
+            samples += region.samples();
+            self.gpu.note(e.object, &region);
+        }
+        let micros = start.elapsed().as_secs_f64() * 1e6;
+        self.projected = None;
+        self.hud.edit_us = micros;
+        self.hud.samples_touched = samples;
+        ApplyStats {
+            edits: edits.len(),
+            samples,
+            micros,
+        }
+    }
+
+    /// Copies this slot's dirty rows into the mirrors.
+    pub fn upload(&mut self, frame: &mut Frame<'_>) -> GpuResult<UploadStats> {
+        let stats = self.gpu.upload(frame, &self.doc)?;
+        self.hud.bytes = stats.bytes;
+        Ok(stats)
+    }
+
+    /// Performs a scripted action as if typed; returns the path of a requested screenshot.
+    pub fn perform(&mut self, action: Action) -> Option<PathBuf> {
+        match action {
+            Action::Input(e) => self.handle(e),
+            Action::Key { key, mods } => {
+                let before = self.mods;
+                self.handle(InputEvent::Modifiers(mods));
+                self.handle(InputEvent::Key { key, pressed: true });
+                self.handle(InputEvent::Key {
+                    key,
+                    pressed: false,
+                });
+                self.handle(InputEvent::Modifiers(before));
+            }
+            Action::MoveTo(h) => {
+                if let Some((x, y)) = self.handle_position(h) {
+                    self.handle(InputEvent::CursorMoved { x, y });
+                }
+            }
+            Action::MoveBy(dx, dy) => {
+                let (x, y) = self.cursor;
+                self.handle(InputEvent::CursorMoved {
+                    x: x + dx,
+                    y: y + dy,
+                });
+            }
+            Action::Type(text) => {
+                for c in text.chars() {
+                    self.handle(InputEvent::Key {
+                        key: Key::Char(c),
+                        pressed: true,
+                    });
+                }
+            }
+            Action::Screenshot(path) => return Some(path),
+            Action::Quit => self.quit = true,
+        }
+        None
+    }
+
+    /// Records the scene, overlays and (with `hud`) the overlay text and graph into the frame.
+    pub fn record(&mut self, frame: &mut Frame<'_>, hud: bool) -> GpuResult<()> {
+        frame.set_clear_color(Palette::default().background);
+        frame.set_camera(self.camera.gpu(self.size[0] / self.size[1], &self.bounds));
+        let hl = Highlight {
+            hovered: self.hovered.map(|p| p.handle),
+            selected: self.selected,
+            selected_local: self.selected_local,
+            hovered_object: self.hovered_object,
+        };
+        self.gpu.draw(frame, &self.doc, &self.options, &hl)?;
+        let lines = overlay_lines(&self.doc, &self.options, self.bounds.radius());
+        if !lines.is_empty() {
+            frame.draw_lines3d(&lines)?;
+        }
+        if let Some(t) = self.status_since
+            && t.elapsed().as_secs_f64() > 6.0
+            && !matches!(self.mode, Mode::Transform { .. })
+        {
+            self.status.clear();
+            self.status_since = None;
+        }
+        let status = match &self.mode {
+            Mode::Transform { t, .. } => t.describe(),
+            _ => self.status.clone(),
+        };
+        if hud {
+            let hud = self.hud.build(
+                self.size[0] as f32,
+                self.size[1] as f32,
+                &status,
+                self.show_help,
+            );
+            if !hud.is_empty() {
+                frame.draw_overlay(&hud)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Handles one input event.
+    pub fn handle(&mut self, event: InputEvent) {
+        match event {
+            InputEvent::Modifiers(m) => self.mods = m,
+            InputEvent::CursorMoved { x, y } => self.cursor_moved(x, y),
+            InputEvent::Button { button, pressed } => self.button(button, pressed),
+            InputEvent::Wheel { delta } => self.zoom(delta),
+            InputEvent::Key { key, pressed: true } => self.key(key),
+            InputEvent::Key { .. } => {}
+        }
+    }
+
+    fn projected(&mut self) -> &[Projected] {
+        if self.projected.is_none() {
+            let handles = self.doc.all_handles();
+            self.projected = Some(project_all(&handles, &self.camera, &self.bounds, self.size));
+        }
+        self.projected.as_deref().unwrap_or(&[])
+    }
+
+    fn cursor_moved(&mut self, x: f64, y: f64) {
+        let (dx, dy) = (x - self.cursor.0, y - self.cursor.1);
+        self.cursor = (x, y);
+        match std::mem::replace(&mut self.mode, Mode::Idle) {
+            Mode::Idle => {
+                let cursor = self.cursor;
+                self.hovered = pick(self.projected(), cursor, PICK_RADIUS);
+                self.hovered_object = self
+                    .hovered
+                    .map(|p| p.handle.object())
+                    .or_else(|| self.object_near_cursor());
+            }
+            Mode::Orbit { .. } => {
+                self.camera.orbit(-dx * 0.008, dy * 0.008);
+                self.projected = None;
+                self.mode = Mode::Orbit { moved: true };
+            }
+            Mode::Pan => {
+                let per_pixel =
+                    2.0 * self.camera.distance * (0.5 * self.camera.fov_y).tan() / self.size[1];
+                let (right, up) = self.camera.basis();
+                self.camera.pan((-right * dx + up * dy) * per_pixel);
+                self.projected = None;
+                self.mode = Mode::Pan;
+            }
+            Mode::Drag { handle, mut drag } => {
+                if let Some(inc) = drag.update(&self.view(), self.cursor) {
+                    self.queue(Document::move_handle(handle, inc));
+                }
+                self.mode = Mode::Drag { handle, drag };
+            }
+            Mode::Transform { target, mut t } => {
+                t.set_cursor(self.cursor);
+                self.mode = Mode::Transform { target, t };
+                self.update_transform();
+            }
+        }
+    }
+
+    fn button(&mut self, button: MouseButton, pressed: bool) {
+        let mode = std::mem::replace(&mut self.mode, Mode::Idle);
+        self.mode = match (mode, button, pressed) {
+            (Mode::Transform { target, t }, MouseButton::Left, true) => {
+                self.mode = Mode::Transform { target, t };
+                self.confirm_transform();
+                return;
+            }
+            (Mode::Transform { target, t }, MouseButton::Right, true) => {
+                self.mode = Mode::Transform { target, t };
+                self.cancel_transform();
+                return;
+            }
+            (m @ Mode::Transform { .. }, _, _) => m,
+            (Mode::Idle, MouseButton::Left, true) if !self.mods.shift => {
+                let cursor = self.cursor;
+                match pick(self.projected(), cursor, PICK_RADIUS) {
+                    Some(p) => {
+                        self.select(p.handle);
+                        let mut drag = Drag::new(p.world);
+                        drag.grab(&self.view(), self.cursor);
+                        self.undo.begin("move point");
+                        Mode::Drag {
+                            handle: p.handle,
+                            drag,
+                        }
+                    }
+                    None => Mode::Orbit { moved: false },
+                }
+            }
+            (Mode::Idle, MouseButton::Left, true) | (Mode::Idle, MouseButton::Right, true) => {
+                Mode::Pan
+            }
+            (Mode::Idle, MouseButton::Middle, true) => {
+                if self.mods.shift {
+                    Mode::Pan
+                } else {
+                    Mode::Orbit { moved: false }
+                }
+            }
+            (Mode::Drag { .. }, MouseButton::Left, false) => {
+                self.undo.end();
+                self.refresh_bounds();
+                Mode::Idle
+            }
+            (Mode::Orbit { moved: false }, MouseButton::Left, false) => {
+                // A click on empty space (no drag) clears the selection.
+                self.selected = None;
+                self.selected_local = None;
+                Mode::Idle
+            }
+            (Mode::Orbit { .. } | Mode::Pan, _, false) => Mode::Idle,
+            (m, _, _) => m,
+        };
+    }
+
+    /// The object with a sample projecting within 24 pixels of the cursor (every 4th sample per
+    /// direction is enough to find an object), nearest in depth.
+    fn object_near_cursor(&self) -> Option<usize> {
+        let view = self.view();
+        let mut best: Option<(f64, usize)> = None;
+        for (i, o) in self.doc.objects.iter().enumerate() {
+            let g = o.sampled.grid();
+            let [rows, cols] = g.dims;
+            for r in (0..rows).step_by(4) {
+                for c in (0..cols).step_by(4) {
+                    let p = g.position(r, c);
+                    let Some((x, y, depth)) =
+                        view.camera
+                            .project(p, view.size[0], view.size[1], view.bounds)
+                    else {
+                        continue;
+                    };
+                    if (x - self.cursor.0).hypot(y - self.cursor.1) <= 24.0
+                        && best.is_none_or(|(d, _)| depth < d)
+                    {
+                        best = Some((depth, i));
+                    }
+                }
+            }
+        }
+        best.map(|(_, i)| i)
+    }
+
+    fn select(&mut self, handle: Handle) {
+        self.selected = Some(handle);
+        self.selected_local = match handle {
+            Handle::LocalPoint { object, local, .. } => Some((object, local)),
+            Handle::Point { .. } => None,
+        };
+        let name = &self.doc.objects[handle.object()].name;
+        let what = match handle {
+            Handle::Point { point, .. } => format!("{name}: point {}", index_text(point)),
+            Handle::LocalPoint { local, point, .. } => {
+                format!(
+                    "{name}: local {} point {} (G/R/S transform the local)",
+                    index_text(local),
+                    index_text(point)
+                )
+            }
+        };
+        self.set_status(what);
+    }
+
+    /// Zoom towards the point under the cursor (on the plane through the target).
+    fn zoom(&mut self, delta: f64) {
+        let f = 0.85f64.powf(delta);
+        let (o, d) = self.view().ray(self.cursor);
+        let n = self.camera.direction();
+        let denom = d.dot(n);
+        let p = if denom.abs() > 1e-9 {
+            o + d * ((self.camera.target - o).dot(n) / denom)
+        } else {
+            self.camera.target
+        };
+        self.camera.target += (p - self.camera.target) * (1.0 - f);
+        self.camera.distance *= f;
+        self.projected = None;
+    }
+
+    fn key(&mut self, key: Key) {
+        let ctrl = self.mods.ctrl;
+        if let Mode::Transform { .. } = self.mode {
+            return self.transform_key(key);
+        }
+        match (key, ctrl) {
+            (Key::Char('z'), true) if self.mods.shift => self.redo(),
+            (Key::Char('z'), true) => self.undo(),
+            (Key::Char('y'), true) => self.redo(),
+            (Key::Char('s'), true) => self.save(),
+            (Key::Char('q'), true) => self.quit = true,
+            (Key::Char(c @ ('x' | 'y' | 'z')), false) => {
+                if let Mode::Drag { drag, .. } = &mut self.mode {
+                    let axis = match c {
+                        'x' => Axis::X,
+                        'y' => Axis::Y,
+                        _ => Axis::Z,
+                    };
+                    let mut fresh = Drag::new(drag.anchor + drag.applied);
+                    fresh.axis = drag.axis.toggle(axis);
+                    fresh.grab(
+                        &View {
+                            camera: &self.camera,
+                            bounds: &self.bounds,
+                            size: self.size,
+                        },
+                        self.cursor,
+                    );
+                    *drag = fresh;
+                }
+            }
+            (Key::Char('g'), false) => self.start_transform(TransformKind::Grab),
+            (Key::Char('r'), false) => self.start_transform(TransformKind::Rotate),
+            (Key::Char('s'), false) => self.start_transform(TransformKind::Scale),
+            (Key::Char('c'), false) => {
+                self.options.control_nets = self.options.control_nets.next();
+                let what = match self.options.control_nets {
+                    NetMode::All => "control nets: all objects",
+                    NetMode::Focused => {
+                        "control nets: selected object and the one under the cursor"
+                    }
+                    NetMode::Off => "control nets: off",
+                };
+                self.set_status(what);
+            }
+            (Key::Char('l'), false) => self.options.local_curves = !self.options.local_curves,
+            (Key::Char('w'), false) => {
+                self.options.wire = match self.options.wire {
+                    Wire::Off => Wire::Isolines(8),
+                    Wire::Isolines(_) => Wire::Full,
+                    Wire::Full => Wire::Off,
+                }
+            }
+            (Key::Char('n'), false) => self.options.normals = !self.options.normals,
+            (Key::Char('t'), false) => self.options.frenet = !self.options.frenet,
+            (Key::Char('k'), false) => self.options.curvature_comb = !self.options.curvature_comb,
+            (Key::Char('p'), false) => self.hud.visible = !self.hud.visible,
+            (Key::Char('h'), false) | (Key::F1, _) => self.show_help = !self.show_help,
+            (Key::Char('f'), false) => self.frame_selection(),
+            (Key::Char('a'), false) => self.frame_all(),
+            (Key::Home, _) => {
+                self.camera = self.home;
+                self.projected = None;
+            }
+            (Key::Escape, _) => {
+                self.selected = None;
+                self.selected_local = None;
+                self.show_help = false;
+            }
+            _ => {}
+        }
+    }
+
+    fn transform_key(&mut self, key: Key) {
+        let Mode::Transform { t, .. } = &mut self.mode else {
+            return;
+        };
+        let view = View {
+            camera: &self.camera,
+            bounds: &self.bounds,
+            size: self.size,
+        };
+        match key {
+            Key::Char('x') => t.set_axis(Axis::X, &view),
+            Key::Char('y') => t.set_axis(Axis::Y, &view),
+            Key::Char('z') => t.set_axis(Axis::Z, &view),
+            Key::Char(c @ ('0'..='9' | '.' | '-')) => t.numeric.push(c),
+            Key::Backspace => {
+                t.numeric.pop();
+            }
+            Key::Enter => return self.confirm_transform(),
+            Key::Escape => return self.cancel_transform(),
+            _ => return,
+        }
+        self.update_transform();
+    }
+
+    fn start_transform(&mut self, kind: TransformKind) {
+        let target = match (self.selected_local, self.selected) {
+            (Some((o, l)), _) => Target::Local(o, l),
+            (None, Some(h)) if kind == TransformKind::Grab => Target::Point(h),
+            (None, Some(_)) => {
+                return self.set_status("rotate and scale act on ERBS local curves and patches: select a local control point");
+            }
+            (None, None) => return self.set_status("select a control point first"),
+        };
+        let pivot = match target {
+            Target::Point(h) => self
+                .doc
+                .handles(h.object())
+                .into_iter()
+                .find(|(x, _)| *x == h)
+                .map(|(_, p)| p),
+            Target::Local(o, l) => local_points(self.doc.objects[o].sampled.model(), l)
+                .map(|p| p.iter().sum::<DVec3>() / p.len() as f64),
+        };
+        let Some(pivot) = pivot else { return };
+        let t = Box::new(Transform::new(kind, pivot, &self.view(), self.cursor));
+        self.undo.begin(kind.name());
+        self.mode = Mode::Transform { target, t };
+    }
+
+    /// Queues the increment that brings the model from the transform applied so far to the
+    /// transform the gesture stands for now.
+    fn update_transform(&mut self) {
+        let view = View {
+            camera: &self.camera,
+            bounds: &self.bounds,
+            size: self.size,
+        };
+        let Mode::Transform { target, t } = &mut self.mode else {
+            return;
+        };
+        let total = t.total(&view);
+        let inc = total * t.applied.inverse();
+        if inc == DMat4::IDENTITY {
+            return;
+        }
+        t.applied = total;
+        let edit = match *target {
+            Target::Local(object, local) => Edit {
+                object,
+                op: EditOp::TransformLocal { local, matrix: inc },
+            },
+            Target::Point(h) => {
+                // A point only translates: the increment's translation part.
+                Document::move_handle(h, inc.w_axis.truncate())
+            }
+        };
+        self.queue(edit);
+    }
+
+    fn confirm_transform(&mut self) {
+        self.update_transform();
+        self.mode = Mode::Idle;
+        self.undo.end();
+        self.refresh_bounds();
+        self.set_status("transform applied (Ctrl+Z undoes)");
+    }
+
+    fn cancel_transform(&mut self) {
+        self.mode = Mode::Idle;
+        if let Some(step) = self.undo.discard() {
+            // Exact prior values: queued after any pending increments of this gesture.
+            self.pending.extend(step.restore.into_iter().rev());
+        }
+        self.set_status("transform cancelled");
+    }
+
+    pub fn undo(&mut self) {
+        match self.undo.undo() {
+            Some((label, edits)) => {
+                self.pending.extend(edits);
+                self.set_status(format!("undo: {label}"));
+                self.refresh_bounds_later();
+            }
+            None => self.set_status("nothing to undo"),
+        }
+    }
+
+    pub fn redo(&mut self) {
+        match self.undo.redo() {
+            Some((label, edits)) => {
+                self.pending.extend(edits);
+                self.set_status(format!("redo: {label}"));
+                self.refresh_bounds_later();
+            }
+            None => self.set_status("nothing to redo"),
+        }
+    }
+
+    /// Writes the scene (exact control data) to the save path.
+    pub fn save(&mut self) {
+        self.apply_pending();
+        let scene = self.doc.to_scene();
+        match scene.save(&self.save_path) {
+            Ok(()) => self.set_status(format!("saved {}", self.save_path.display())),
+            Err(e) => self.set_status(format!("save failed: {e}")),
+        }
+    }
+
+    fn refresh_bounds(&mut self) {
+        self.bounds = self.doc.bounds();
+        self.projected = None;
+    }
+
+    fn refresh_bounds_later(&mut self) {
+        // Undo edits are applied next frame; the bounds follow then.
+        self.apply_pending();
+        self.refresh_bounds();
+    }
+
+    pub fn frame_all(&mut self) {
+        self.refresh_bounds();
+        self.camera.frame(&self.bounds, self.size[0] / self.size[1]);
+        self.projected = None;
+    }
+
+    fn frame_selection(&mut self) {
+        let points: Vec<DVec3> = match (self.selected_local, self.selected) {
+            (Some((o, l)), _) => {
+                local_points(self.doc.objects[o].sampled.model(), l).unwrap_or_default()
+            }
+            (None, Some(h)) => self
+                .doc
+                .handles(h.object())
+                .into_iter()
+                .map(|(_, p)| p)
+                .collect(),
+            (None, None) => return self.frame_all(),
+        };
+        let mut b = Bounds::EMPTY;
+        points.iter().for_each(|&p| b.include(p));
+        self.camera.frame(&b, self.size[0] / self.size[1]);
+        self.projected = None;
+    }
+}
+
+/// All control nets for small scenes; for scenes with many control points (the demo with the
+/// teapot's 512) only the focused object's, so the picture is not buried under points.
+fn default_nets(doc: &Document) -> NetMode {
+    if doc.all_handles().len() <= 400 {
+        NetMode::All
+    } else {
+        NetMode::Focused
+    }
+}
+
+fn index_text(i: Index2) -> String {
+    match i {
+        Index2::One(k) => k.to_string(),
+        Index2::Two(a, b) => format!("[{a}, {b}]"),
+    }
+}
