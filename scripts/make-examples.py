@@ -63,3 +63,10 @@ for k in range(3):
     patches.append(row)
 dump("erbs_surface", [{"name": "domes", "type": "erbs_surface", "knots": [[0, 0, 1, 2, 2], [0, 0, 1, 2, 2]],
      "local": patches, "samples": [60, 60]}])
+
+# The benchmark surface of DESIGN.md's performance model: bicubic, clamped uniform, 100x100
+# control points, 512x512 samples.
+n = 100
+net = [[[i / 10.0, j / 10.0, 0.4 * math.sin(0.3 * i) * math.cos(0.2 * j)] for j in range(n)] for i in range(n)]
+dump("surface_100x100", [{"name": "surface", "type": "bspline_surface", "degree": [3, 3],
+     "knots": [clamped(3, n), clamped(3, n)], "points": net, "samples": [512, 512]}])
