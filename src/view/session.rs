@@ -70,8 +70,11 @@ pub struct Session {
     pub quit: bool,
     /// Projected handles, recomputed when the camera or the model changes.
     projected: Option<Vec<Projected>>,
-    /// Apply every edit as it comes instead of merging a frame's edits (`--naive` comparisons).
+    /// Apply every edit as it comes instead of merging a frame's edits.
     pub merge: bool,
+    /// What tools without pre-evaluation do on an edit: re-sample every edited object from
+    /// scratch and upload all of it (`prespline bench --naive`).
+    pub naive: bool,
 }
 
 impl Session {
@@ -118,6 +121,7 @@ impl Session {
             quit: false,
             projected: None,
             merge: true,
+            naive: false,
         })
     }
 
@@ -200,10 +204,22 @@ impl Session {
         };
         self.pending.clear();
         let mut samples = 0;
+        let mut edited = Vec::new();
         for e in &edits {
             let region = self.doc.apply(e);
+            if self.naive {
+                if !edited.contains(&e.object) {
+                    edited.push(e.object);
+                }
+            } else {
+                samples += region.samples();
+                self.gpu.note(e.object, &region);
+            }
+        }
+        for &i in &edited {
+            let region = self.doc.objects[i].sampled.rebuild_all();
             samples += region.samples();
-            self.gpu.note(e.object, &region);
+            self.gpu.note(i, &region);
         }
         let micros = start.elapsed().as_secs_f64() * 1e6;
         self.projected = None;
