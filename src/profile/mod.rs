@@ -1,0 +1,31 @@
+//! Frame-time profiling: per-frame phase timings, statistics and output files.
+//!
+//! Knows nothing about splines or Vulkan: the caller marks phases and reports byte and sample
+//! counts; this module measures wall time, computes statistics and writes the reports.
+//!
+//! # Model
+//!
+//! A run is a sequence of frames ([`FrameRecord`]). Each frame has CPU [`Phase`]s (`input`,
+//! `delta`, `upload`, `record`, `submit`, `present`), an optional GPU time that arrives later
+//! ([`Recorder::set_gpu_ms`]), a frame time (start of this frame to start of the next), byte and
+//! sample counters, and a warm-up flag. The first `warmup_frames` frames are warm-up: they are
+//! left out of the main statistics and summarised separately.
+//!
+//! # Definitions
+//!
+//! - **Percentiles** use the nearest-rank method: the p-th percentile of n sorted values is the
+//!   value at 1-based rank `ceil(p/100 · n)` (at least 1). It is always an observed value, and
+//!   at least p % of the frames took no longer than it.
+//! - **1 % low** is the mean of the slowest 1 % of the frames, in ms: the `ceil(n/100)` largest
+//!   values (so the maximum when n ≤ 100). It is the games' "1 % low FPS" turned into times,
+//!   where lower is better like every other column.
+//! - **other** is the part of a frame covered by no phase (`frame_ms` − sum of phases, at
+//!   least 0): idle time, or work the caller has not instrumented.
+
+mod phase;
+mod recorder;
+mod stats;
+
+pub use phase::{Phase, PhaseMap};
+pub use recorder::{FrameRecord, Recorder};
+pub use stats::{Stats, percentile, slowest_mean};
