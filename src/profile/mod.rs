@@ -22,10 +22,53 @@
 //! - **other** is the part of a frame covered by no phase (`frame_ms` − sum of phases, at
 //!   least 0): idle time, or work the caller has not instrumented.
 
+mod csv;
 mod phase;
 mod recorder;
 mod stats;
+mod summary;
+mod table;
 
+pub use csv::{CSV_HEADER, write_frames_csv, write_frames_csv_to};
 pub use phase::{Phase, PhaseMap};
 pub use recorder::{FrameRecord, Recorder};
 pub use stats::{Stats, percentile, slowest_mean};
+pub use summary::{
+    RunInfo, Section, Summary, SummaryFile, read_summary_json, summary_json, write_summary_json,
+};
+pub use table::compare;
+
+use std::fs::File;
+use std::io::{self, BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+/// A profile file could not be written or read; the message names the path.
+#[derive(Debug, thiserror::Error)]
+pub enum ProfileError {
+    #[error("cannot write {}: {source}", path.display())]
+    Write { path: PathBuf, source: io::Error },
+    #[error("cannot read {}: {source}", path.display())]
+    Read { path: PathBuf, source: io::Error },
+    #[error("{}: not a profile summary: {source}", path.display())]
+    Parse {
+        path: PathBuf,
+        source: serde_json::Error,
+    },
+}
+
+/// Creates `path` and fills it through a buffered writer, attaching the path to any error.
+fn write_file(
+    path: &Path,
+    body: impl FnOnce(&mut BufWriter<File>) -> io::Result<()>,
+) -> Result<(), ProfileError> {
+    let write = || -> io::Result<()> {
+        let mut w = BufWriter::new(File::create(path)?);
+        body(&mut w)?;
+        // Flush explicitly: BufWriter's drop swallows the last write error.
+        w.flush()
+    };
+    write().map_err(|source| ProfileError::Write {
+        path: path.to_owned(),
+        source,
+    })
+}
