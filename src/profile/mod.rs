@@ -28,6 +28,7 @@ mod recorder;
 mod stats;
 mod summary;
 mod table;
+mod trace;
 
 pub use csv::{CSV_HEADER, write_frames_csv, write_frames_csv_to};
 pub use phase::{Phase, PhaseMap};
@@ -37,6 +38,7 @@ pub use summary::{
     RunInfo, Section, Summary, SummaryFile, read_summary_json, summary_json, write_summary_json,
 };
 pub use table::compare;
+pub use trace::{write_trace_json, write_trace_json_to};
 
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
