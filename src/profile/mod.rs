@@ -23,15 +23,20 @@
 //!   least 0): idle time, or work the caller has not instrumented.
 
 mod csv;
+mod histogram;
 mod phase;
+mod plot;
 mod recorder;
 mod stats;
 mod summary;
+mod svg;
 mod table;
 mod trace;
 
 pub use csv::{CSV_HEADER, write_frames_csv, write_frames_csv_to};
+pub use histogram::{histogram_svg, write_histogram_svg};
 pub use phase::{Phase, PhaseMap};
+pub use plot::{frame_times_svg, write_frame_times_svg};
 pub use recorder::{FrameRecord, Recorder};
 pub use stats::{Stats, percentile, slowest_mean};
 pub use summary::{
