@@ -21,6 +21,37 @@
 //!   where lower is better like every other column.
 //! - **other** is the part of a frame covered by no phase (`frame_ms` − sum of phases, at
 //!   least 0): idle time, or work the caller has not instrumented.
+//!
+//! # Use in a frame loop
+//!
+//! ```no_run
+//! use prespline::profile::{Phase, Recorder, RunInfo, Summary, write_all};
+//!
+//! let mut rec = Recorder::with_capacity(10, 1000);
+//! for _ in 0..1000 {
+//!     rec.begin_frame();
+//!     rec.phase_start(Phase::Input); /* poll events, turn them into edits */
+//!     rec.phase_start(Phase::Delta); /* apply edits to the sample grids */
+//!     rec.add_samples(4096);
+//!     rec.phase_start(Phase::Upload); /* copy dirty ranges */
+//!     rec.add_bytes(65536);
+//!     rec.time(Phase::Record, || { /* record commands */ });
+//!     rec.end_frame();
+//!     // When a timestamp query for frame `i` becomes available: rec.set_gpu_ms(i, ms);
+//! }
+//! let run = RunInfo { scenario: "drag".into(), ..RunInfo::default() };
+//! eprint!("{}", Summary::from_frames(rec.frames()).table());
+//! write_all("out/profile".as_ref(), &run, rec.frames()).expect("profile written");
+//! ```
+//!
+//! # Files written by [`write_all`]
+//!
+//! - `frames.csv`: [`write_frames_csv`]; one row per frame.
+//! - `summary.json`: [`write_summary_json`]; run info and [`Summary`].
+//! - `summary.txt`: [`Summary::table`].
+//! - `trace.json`: [`write_trace_json`]; Chrome trace (chrome://tracing, ui.perfetto.dev).
+//! - `frame_times.svg`: [`write_frame_times_svg`]; frame time over the run, phases stacked.
+//! - `histogram.svg`: [`write_histogram_svg`]; frame-time distribution with p50/p99.
 
 mod csv;
 mod histogram;
@@ -51,6 +82,14 @@ use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
+/// File names used by [`write_all`].
+pub const FRAMES_CSV: &str = "frames.csv";
+pub const SUMMARY_JSON: &str = "summary.json";
+pub const SUMMARY_TXT: &str = "summary.txt";
+pub const TRACE_JSON: &str = "trace.json";
+pub const FRAME_TIMES_SVG: &str = "frame_times.svg";
+pub const HISTOGRAM_SVG: &str = "histogram.svg";
+
 /// A profile file could not be written or read; the message names the path.
 #[derive(Debug, thiserror::Error)]
 pub enum ProfileError {
@@ -63,6 +102,37 @@ pub enum ProfileError {
         path: PathBuf,
         source: serde_json::Error,
     },
+}
+
+/// Writes every report into `dir` (created if missing) and returns the paths written, in the
+/// order listed in the module documentation.
+pub fn write_all(
+    dir: &Path,
+    run: &RunInfo,
+    frames: &[FrameRecord],
+) -> Result<Vec<PathBuf>, ProfileError> {
+    std::fs::create_dir_all(dir).map_err(|source| ProfileError::Write {
+        path: dir.to_owned(),
+        source,
+    })?;
+    let summary = Summary::from_frames(frames);
+    let path = |name: &str| dir.join(name);
+
+    let paths = vec![
+        path(FRAMES_CSV),
+        path(SUMMARY_JSON),
+        path(SUMMARY_TXT),
+        path(TRACE_JSON),
+        path(FRAME_TIMES_SVG),
+        path(HISTOGRAM_SVG),
+    ];
+    write_frames_csv(&paths[0], frames)?;
+    write_summary_json(&paths[1], run, &summary)?;
+    write_file(&paths[2], |w| w.write_all(summary.table().as_bytes()))?;
+    write_trace_json(&paths[3], run, frames)?;
+    write_frame_times_svg(&paths[4], run, frames)?;
+    write_histogram_svg(&paths[5], run, frames)?;
+    Ok(paths)
 }
 
 /// Creates `path` and fills it through a buffered writer, attaching the path to any error.
@@ -81,3 +151,6 @@ fn write_file(
         source,
     })
 }
+
+#[cfg(test)]
+mod tests;
