@@ -1,0 +1,252 @@
+//! Plain-text tables for the terminal: [`Summary::table`] and [`compare`].
+
+use super::{Phase, Section, Stats, Summary};
+
+/// Rows of cells rendered with the first column left-aligned and the others right-aligned.
+struct TextTable {
+    rows: Vec<Vec<String>>,
+}
+
+impl TextTable {
+    fn new(header: &[&str]) -> Self {
+        TextTable {
+            rows: vec![header.iter().map(|s| s.to_string()).collect()],
+        }
+    }
+
+    fn row(&mut self, cells: Vec<String>) {
+        self.rows.push(cells);
+    }
+
+    fn render(&self) -> String {
+        let columns = self.rows.iter().map(Vec::len).max().unwrap_or(0);
+        let width = |c: usize| {
+            self.rows
+                .iter()
+                .filter_map(|r| r.get(c))
+                .map(|s| s.chars().count())
+                .max()
+                .unwrap_or(0)
+        };
+        let widths: Vec<usize> = (0..columns).map(width).collect();
+        let mut out = String::new();
+        for (i, row) in self.rows.iter().enumerate() {
+            let mut line = String::new();
+            for (c, cell) in row.iter().enumerate() {
+                let w = widths[c];
+                if c == 0 {
+                    line.push_str(&format!("{cell:<w$}"));
+                } else {
+                    line.push_str(&format!("  {cell:>w$}"));
+                }
+            }
+            out.push_str(line.trim_end());
+            out.push('\n');
+            if i == 0 {
+                let total = widths.iter().sum::<usize>() + 2 * columns.saturating_sub(1);
+                out.push_str(&"-".repeat(total));
+                out.push('\n');
+            }
+        }
+        out
+    }
+}
+
+fn ms(v: f64) -> String {
+    format!("{v:.3}")
+}
+
+fn stats_cells(label: &str, s: &Stats) -> Vec<String> {
+    let mut cells = vec![label.to_string(), s.count.to_string()];
+    cells.extend([s.mean, s.p50, s.p90, s.p95, s.p99, s.max, s.low_1pct].map(ms));
+    cells
+}
+
+/// Bytes with a binary unit, e.g. `1.50 MiB`.
+pub(super) fn human_bytes(bytes: f64) -> String {
+    const UNITS: [&str; 5] = ["B", "KiB", "MiB", "GiB", "TiB"];
+    let mut v = bytes;
+    let mut unit = 0;
+    while v >= 1024.0 && unit + 1 < UNITS.len() {
+        v /= 1024.0;
+        unit += 1;
+    }
+    if unit == 0 {
+        format!("{v:.0} B")
+    } else {
+        format!("{v:.2} {}", UNITS[unit])
+    }
+}
+
+/// A count with an SI suffix, e.g. `65.5 k`.
+pub(super) fn human_count(count: f64) -> String {
+    const UNITS: [&str; 5] = ["", " k", " M", " G", " T"];
+    let mut v = count;
+    let mut unit = 0;
+    while v >= 1000.0 && unit + 1 < UNITS.len() {
+        v /= 1000.0;
+        unit += 1;
+    }
+    if unit == 0 {
+        format!("{v:.0}")
+    } else {
+        format!("{v:.1}{}", UNITS[unit])
+    }
+}
+
+impl Summary {
+    /// Terminal table of the measured frames (times in ms): frame, each phase, "other" and
+    /// GPU, then bytes and samples per frame and a warm-up line. Ends with a newline.
+    pub fn table(&self) -> String {
+        let Some(m) = &self.measured else {
+            let mut out = format!("no measured frames ({} frames, all warm-up)\n", self.frames);
+            if let Some(w) = &self.warmup {
+                out.push_str(&warmup_line(w));
+            }
+            return out;
+        };
+        let mut t = TextTable::new(&[
+            "phase (ms)",
+            "count",
+            "mean",
+            "p50",
+            "p90",
+            "p95",
+            "p99",
+            "max",
+            "1% low",
+        ]);
+        t.row(stats_cells("frame", &m.frame_ms));
+        for (phase, s) in m.phase_ms.iter() {
+            t.row(stats_cells(&format!("  {phase}"), s));
+        }
+        t.row(stats_cells("  (other)", &m.other_ms));
+        match &m.gpu_ms {
+            Some(g) => t.row(stats_cells("gpu", g)),
+            None => t.row(vec!["gpu".into(), "0".into()]),
+        }
+        let mut out = t.render();
+        out.push_str(&format!(
+            "{:.1} fps over {} frames ({:.2} s)\n",
+            m.fps, m.frames, m.duration_s
+        ));
+        out.push_str(&format!(
+            "bytes/frame    {} (total {})\n",
+            human_bytes(m.bytes_per_frame),
+            human_bytes(m.bytes_uploaded as f64)
+        ));
+        out.push_str(&format!(
+            "samples/frame  {} (total {})\n",
+            human_count(m.samples_per_frame),
+            human_count(m.samples_touched as f64)
+        ));
+        if let Some(w) = &self.warmup {
+            out.push_str(&warmup_line(w));
+        }
+        out
+    }
+}
+
+fn warmup_line(w: &Section) -> String {
+    format!(
+        "warm-up        {} frames, mean {} ms, max {} ms (excluded above)\n",
+        w.frames,
+        ms(w.frame_ms.mean),
+        ms(w.frame_ms.max)
+    )
+}
+
+/// Side-by-side table of two runs' measured frames, e.g. `compare("incremental", &inc,
+/// "naive", &naive)`: mean and p99 of frame, phase and GPU times, and bytes and samples per
+/// frame, each with the ratio B/A (above 1: B is slower or moves more data).
+pub fn compare(a_name: &str, a: &Summary, b_name: &str, b: &Summary) -> String {
+    let mut t = TextTable::new(&["ms", "mean A", "mean B", "B/A", "p99 A", "p99 B", "B/A"]);
+    let (ma, mb) = (a.measured.as_ref(), b.measured.as_ref());
+    let row = |label: &str, sa: Option<&Stats>, sb: Option<&Stats>| {
+        let mean = |s: Option<&Stats>| s.map(|s| s.mean);
+        let p99 = |s: Option<&Stats>| s.map(|s| s.p99);
+        let mut cells = vec![label.to_string()];
+        cells.extend(value_pair(mean(sa), mean(sb), ms));
+        cells.extend(value_pair(p99(sa), p99(sb), ms));
+        cells
+    };
+    t.row(row(
+        "frame",
+        ma.map(|m| &m.frame_ms),
+        mb.map(|m| &m.frame_ms),
+    ));
+    for phase in Phase::ALL {
+        t.row(row(
+            &format!("  {phase}"),
+            ma.map(|m| &m.phase_ms[phase]),
+            mb.map(|m| &m.phase_ms[phase]),
+        ));
+    }
+    t.row(row(
+        "  (other)",
+        ma.map(|m| &m.other_ms),
+        mb.map(|m| &m.other_ms),
+    ));
+    t.row(row(
+        "gpu",
+        ma.and_then(|m| m.gpu_ms.as_ref()),
+        mb.and_then(|m| m.gpu_ms.as_ref()),
+    ));
+    let per_frame = |label: &str, get: fn(&Section) -> f64, fmt: fn(f64) -> String| {
+        let mut cells = vec![label.to_string()];
+        cells.extend(value_pair(ma.map(get), mb.map(get), fmt));
+        cells
+    };
+    t.row(per_frame("bytes/frame", |m| m.bytes_per_frame, human_bytes));
+    t.row(per_frame(
+        "samples/frame",
+        |m| m.samples_per_frame,
+        human_count,
+    ));
+    format!("A = {a_name}, B = {b_name}\n{}", t.render())
+}
+
+/// `[a, b, b/a]` cells; `-` for a missing value or an undefined ratio.
+fn value_pair(a: Option<f64>, b: Option<f64>, fmt: fn(f64) -> String) -> [String; 3] {
+    let cell = |v: Option<f64>| v.map_or_else(|| "-".to_string(), fmt);
+    let ratio = match (a, b) {
+        (Some(a), Some(b)) if a > 0.0 => format!("{:.2}x", b / a),
+        (Some(a), Some(b)) if a == 0.0 && b == 0.0 => "1.00x".to_string(),
+        _ => "-".to_string(),
+    };
+    [cell(a), cell(b), ratio]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn table_columns_are_aligned() {
+        let mut t = TextTable::new(&["name", "value"]);
+        t.row(vec!["a".into(), "1.000".into()]);
+        t.row(vec!["longer".into(), "10.000".into()]);
+        let text = t.render();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines[0], "name     value");
+        assert_eq!(lines[1], "-".repeat(14));
+        assert_eq!(lines[2], "a        1.000");
+        assert_eq!(lines[3], "longer  10.000");
+    }
+
+    #[test]
+    fn human_units() {
+        assert_eq!(human_bytes(512.0), "512 B");
+        assert_eq!(human_bytes(1536.0), "1.50 KiB");
+        assert_eq!(human_bytes(3.0 * 1024.0 * 1024.0), "3.00 MiB");
+        assert_eq!(human_count(999.0), "999");
+        assert_eq!(human_count(65_536.0), "65.5 k");
+    }
+
+    #[test]
+    fn ratios() {
+        assert_eq!(value_pair(Some(2.0), Some(6.0), ms)[2], "3.00x");
+        assert_eq!(value_pair(Some(0.0), Some(1.0), ms)[2], "-");
+        assert_eq!(value_pair(None, Some(1.0), ms), ["-", "1.000", "-"]);
+    }
+}
