@@ -17,9 +17,15 @@ deps:
 build: deps
 	$(CARGO) build --release
 
-# The viewer on the demo scene; without a display it falls back to a headless scripted run.
+# The viewer on the demo scene. Without a display, a headless run of the demo with a scripted
+# drag that writes a PNG (out/run/final.png) and a frame-time summary (out/run/summary.txt).
 run: deps
-	$(CARGO) run --release -- view
+	@if [ -n "$$DISPLAY" ]; then \
+		$(CARGO) run --release -- view; \
+	else \
+		echo "no display (DISPLAY is unset): running the demo headless with a scripted drag"; \
+		$(CARGO) run --release -- bench --scenario drag --frames 120 --warmup 10 --out out/run; \
+	fi
 
 lint: deps
 	$(CARGO) fmt --check

@@ -3,6 +3,7 @@
 use clap::{Args, Parser, Subcommand};
 use prespline::cli::{self, CliError};
 use prespline::render::{NetMode, OrbitCamera, ViewOptions, Wire};
+use prespline::view::scenario::Scenario;
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -51,6 +52,40 @@ enum Command {
         /// Where Ctrl+S writes (default: the scene file, or prespline-demo.json for the demo).
         #[arg(long, value_name = "PATH")]
         save_as: Option<PathBuf>,
+        /// Record per-frame phase timings while interacting and write the reports (CSV, JSON
+        /// summary, Chrome trace, SVG plots) into DIR when the window closes.
+        #[arg(long, value_name = "DIR")]
+        profile: Option<PathBuf>,
+    },
+    /// Run a scripted, reproducible editing session and report where every millisecond goes.
+    Bench {
+        /// Scene file (JSON); the demo scene without it.
+        scene: Option<PathBuf>,
+        /// What the scripted user does.
+        #[arg(long, default_value = "drag", value_parser = Scenario::parse, value_name = "drag|erbs-rotate|orbit|idle")]
+        scenario: Scenario,
+        /// Measured frames.
+        #[arg(long, default_value_t = 300)]
+        frames: usize,
+        /// Warm-up frames before measuring (shader compilation, first uploads), reported separately.
+        #[arg(long, default_value_t = 30)]
+        warmup: usize,
+        /// Image or window size.
+        #[arg(long, default_value = "1280x720", value_parser = cli::render::parse_size, value_name = "WxH")]
+        size: (u32, u32),
+        /// Run in a window (no vsync) instead of headless.
+        #[arg(long)]
+        window: bool,
+        /// Also run the same session the way tools without pre-evaluation work (full re-sampling
+        /// and full upload of edited objects every frame) and compare.
+        #[arg(long)]
+        naive: bool,
+        /// Output directory for the reports.
+        #[arg(long, default_value = "bench-out", value_name = "DIR")]
+        out: PathBuf,
+        /// MSAA samples (1, 2, 4, 8); 0 picks 4 where supported.
+        #[arg(long, default_value_t = 0)]
+        msaa: u32,
     },
     /// Render a scene headless (no display needed) into a PNG image.
     Render {
@@ -141,13 +176,39 @@ fn main() -> ExitCode {
             no_vsync,
             script,
             save_as,
+            profile,
         } => cli::view::run(&cli::view::ViewOptions {
             scene: scene.as_deref(),
             size,
             vsync: !no_vsync,
             script: script.as_deref(),
             save_as: save_as.as_deref(),
+            profile: profile.as_deref(),
         }),
+        Command::Bench {
+            scene,
+            scenario,
+            frames,
+            warmup,
+            size,
+            window,
+            naive,
+            out,
+            msaa,
+        } => {
+            let args = cli::bench::BenchArgs {
+                scene,
+                scenario,
+                frames,
+                warmup,
+                size,
+                window,
+                naive,
+                out,
+                msaa,
+            };
+            cli::bench::run(&args).map(|line| eprintln!("{line}"))
+        }
         Command::Render {
             scene,
             out,

@@ -1,5 +1,6 @@
 //! Command implementations behind `src/main.rs`, kept in the library so tests can call them.
 
+pub mod bench;
 pub mod render;
 pub mod sample;
 pub mod view;

@@ -1,6 +1,7 @@
 //! `prespline view`: the interactive viewer.
 
 use super::CliError;
+use crate::profile::{RunInfo, Summary, write_all};
 use crate::scene::Scene;
 use crate::scene::demo::demo_scene;
 use crate::view::app::{self, ViewArgs};
@@ -15,6 +16,7 @@ pub struct ViewOptions<'a> {
     pub vsync: bool,
     pub script: Option<&'a Path>,
     pub save_as: Option<&'a Path>,
+    pub profile: Option<&'a Path>,
 }
 
 pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
@@ -51,6 +53,32 @@ pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
         size: opts.size,
         vsync: opts.vsync,
         script,
+        scenario: None,
+        warmup: 0,
+        max_frames: None,
+        naive: false,
     };
-    app::run(args).map(|_| ()).map_err(CliError)
+    let title = args.title.clone();
+    let run = app::run(args).map_err(CliError)?;
+    if let Some(dir) = opts.profile {
+        let summary = Summary::from_frames(&run.frames);
+        eprint!("{}", summary.table());
+        let info = RunInfo {
+            scenario: "interactive".into(),
+            scene: title,
+            size: format!("{}x{}", opts.size.0, opts.size.1),
+            frames: run.frames.len(),
+            device: run.device,
+            mode: "incremental".into(),
+            ..RunInfo::default()
+        };
+        let paths = write_all(dir, &info, &run.frames).map_err(|e| CliError(e.to_string()))?;
+        eprintln!(
+            "profile of {} frames in {} ({} files)",
+            run.frames.len(),
+            dir.display(),
+            paths.len()
+        );
+    }
+    Ok(())
 }

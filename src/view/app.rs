@@ -2,10 +2,15 @@
 //! translation, the frame loop, scripted input and screenshots.
 
 use super::input::{InputEvent, Key, Modifiers, MouseButton};
+use super::scenario::{Scenario, ScenarioDriver};
 use super::script::ScriptPlayer;
 use super::session::Session;
 use crate::cli::render::validation_mode;
-use crate::gpu::{OffscreenDesc, Renderer, RendererDesc, Swapchain, SwapchainDesc, ValidationSink};
+use crate::gpu::{
+    FRAMES_IN_FLIGHT, OffscreenDesc, Renderer, RendererDesc, Swapchain, SwapchainDesc,
+    ValidationSink,
+};
+use crate::profile::{FrameRecord, Phase, Recorder};
 use crate::scene::Scene;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -27,21 +32,21 @@ pub struct ViewArgs {
     pub size: (u32, u32),
     pub vsync: bool,
     pub script: Option<Vec<super::script::ScriptEvent>>,
+    /// A benchmark scenario driving the input instead of (or besides) a script.
+    pub scenario: Option<Scenario>,
+    /// Frames excluded from statistics (shader compilation, first uploads).
+    pub warmup: usize,
+    /// Close the window after this many frames (warm-up included).
+    pub max_frames: Option<usize>,
+    /// Re-sample and upload edited objects in full (`--naive`).
+    pub naive: bool,
 }
 
-/// Per-frame wall-clock phases measured by the loop, in milliseconds.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct FrameTimes {
-    pub index: u64,
-    pub input: f64,
-    pub delta: f64,
-    pub upload: f64,
-    pub record: f64,
-    pub submit: f64,
-    pub frame: f64,
-    pub gpu: Option<f64>,
-    pub bytes: usize,
-    pub samples: usize,
+/// What a viewer run measured.
+#[derive(Debug, Clone)]
+pub struct ViewRun {
+    pub frames: Vec<FrameRecord>,
+    pub device: String,
 }
 
 struct Running {
@@ -57,12 +62,15 @@ struct App {
     running: Option<Running>,
     sink: Option<ValidationSink>,
     script: Option<ScriptPlayer>,
+    driver: Option<ScenarioDriver>,
     frame: u64,
     start: Option<Instant>,
     last: Option<Instant>,
     error: Option<String>,
-    input_ms: f64,
-    times: Vec<FrameTimes>,
+    /// Frames run from the end of the previous one, so input handled between redraws counts
+    /// as this frame's input phase.
+    rec: Recorder,
+    device: String,
 }
 
 /// Whether an X11 display is reachable (this build's winit backend is X11; Wayland sessions
@@ -71,25 +79,28 @@ pub fn display_available() -> bool {
     std::env::var_os("DISPLAY").is_some_and(|d| !d.is_empty())
 }
 
-/// Opens the viewer and runs until the window closes. Returns the frame timings.
-pub fn run(args: ViewArgs) -> Result<Vec<FrameTimes>, String> {
+/// Opens the viewer and runs until the window closes (or the frame limit). Returns the frame
+/// timings.
+pub fn run(args: ViewArgs) -> Result<ViewRun, String> {
     if !display_available() {
         return Err("no display: DISPLAY is not set (prespline view needs X11 or XWayland; for headless use try `prespline render` or `prespline bench`)".into());
     }
     let event_loop = EventLoop::new().map_err(|e| format!("cannot open the display: {e}"))?;
     event_loop.set_control_flow(ControlFlow::Poll);
     let script = args.script.clone().map(ScriptPlayer::new);
+    let rec = Recorder::with_capacity(args.warmup, args.max_frames.unwrap_or(4096));
     let mut app = App {
         args,
         running: None,
         sink: None,
         script,
+        driver: None,
         frame: 0,
         start: None,
         last: None,
         error: None,
-        input_ms: 0.0,
-        times: Vec::new(),
+        rec,
+        device: String::new(),
     };
     event_loop
         .run_app(&mut app)
@@ -109,7 +120,10 @@ pub fn run(args: ViewArgs) -> Result<Vec<FrameTimes>, String> {
     }
     match app.error {
         Some(e) => Err(e),
-        None => Ok(app.times),
+        None => Ok(ViewRun {
+            frames: app.rec.into_frames(),
+            device: app.device,
+        }),
     }
 }
 
@@ -185,76 +199,82 @@ impl App {
     }
 
     fn input(&mut self, e: InputEvent) {
-        let t = Instant::now();
         if let Some(r) = self.running.as_mut() {
             r.session.handle(e);
         }
-        self.input_ms += t.elapsed().as_secs_f64() * 1e3;
     }
 
     fn redraw(&mut self) -> Result<(), String> {
         let Some(r) = self.running.as_mut() else {
             return Ok(());
         };
-        let frame_start = Instant::now();
-        let start = *self.start.get_or_insert(frame_start);
+        let rec = &mut self.rec;
+        if rec.current_frame().is_none() {
+            rec.begin_frame();
+            rec.phase_start(Phase::Input);
+        }
+        let index = rec.current_frame().unwrap_or(0);
+        let start = *self.start.get_or_insert_with(Instant::now);
         let mut shots = Vec::new();
+        let mut actions = Vec::new();
         if let Some(script) = self.script.as_mut() {
-            for action in script.due(self.frame, start.elapsed().as_secs_f64()) {
-                if let Some(path) = r.session.perform(action) {
-                    shots.push(path);
-                }
+            actions.extend(script.due(self.frame, start.elapsed().as_secs_f64()));
+        }
+        if let Some(driver) = self.driver.as_mut() {
+            actions.extend(driver.actions(self.frame as usize, &r.session));
+        }
+        for action in actions {
+            if let Some(path) = r.session.perform(action) {
+                shots.push(path);
             }
         }
-        let input = self.input_ms + frame_start.elapsed().as_secs_f64() * 1e3;
-        self.input_ms = 0.0;
-        let t = Instant::now();
+        rec.phase_start(Phase::Delta);
         let applied = r.session.apply_pending();
-        let delta = t.elapsed().as_secs_f64() * 1e3;
-        let mut times = FrameTimes {
-            index: self.frame,
-            input,
-            delta,
-            samples: applied.samples,
-            ..FrameTimes::default()
-        };
-        match r
+        rec.add_samples(applied.samples as u64);
+        rec.phase_start(Phase::Present);
+        if let Some(mut frame) = r
             .renderer
             .begin_swapchain(&mut r.swapchain)
             .map_err(|e| e.to_string())?
         {
-            None => {}
-            Some(mut frame) => {
-                let t = Instant::now();
-                let stats = r.session.upload(&mut frame).map_err(|e| e.to_string())?;
-                times.upload = t.elapsed().as_secs_f64() * 1e3;
-                times.bytes = stats.bytes;
-                let t = Instant::now();
-                r.session
-                    .record(&mut frame, true)
-                    .map_err(|e| e.to_string())?;
-                times.record = t.elapsed().as_secs_f64() * 1e3;
-                let t = Instant::now();
-                frame.finish().map_err(|e| e.to_string())?;
-                times.submit = t.elapsed().as_secs_f64() * 1e3;
+            if let Some(ms) = frame.gpu_time_ms() {
+                // The slot's previous use was FRAMES_IN_FLIGHT frames ago.
+                rec.set_gpu_ms(index.saturating_sub(FRAMES_IN_FLIGHT), ms);
             }
+            rec.phase_start(Phase::Upload);
+            let stats = r.session.upload(&mut frame).map_err(|e| e.to_string())?;
+            rec.add_bytes(stats.bytes as u64);
+            rec.phase_start(Phase::Record);
+            r.session
+                .record(&mut frame, true)
+                .map_err(|e| e.to_string())?;
+            rec.phase_start(Phase::Submit);
+            frame.finish().map_err(|e| e.to_string())?;
         }
+        rec.phase_end();
         for path in shots {
             screenshot(r, &path)?;
             r.session
                 .set_status(format!("screenshot {}", path.display()));
         }
-        times.gpu = r.renderer.last_gpu_time_ms();
-        r.session.hud.gpu_ms = times.gpu;
+        r.session.hud.gpu_ms = r.renderer.last_gpu_time_ms();
         let now = Instant::now();
         if let Some(last) = self.last {
-            let ms = (now - last).as_secs_f64() * 1e3;
-            r.session.hud.push_frame(ms);
-            times.frame = ms;
+            r.session.hud.push_frame((now - last).as_secs_f64() * 1e3);
         }
         self.last = Some(now);
-        self.times.push(times);
+        rec.end_frame();
         self.frame += 1;
+        if self
+            .args
+            .max_frames
+            .is_some_and(|m| self.frame as usize >= m)
+        {
+            r.session.quit = true;
+        } else {
+            rec.begin_frame();
+            rec.phase_start(Phase::Input);
+        }
         Ok(())
     }
 }

@@ -31,7 +31,10 @@ impl Scenario {
             "erbs-rotate" => Ok(Scenario::ErbsRotate),
             "orbit" => Ok(Scenario::Orbit),
             "idle" => Ok(Scenario::Idle),
-            _ => Err(format!("unknown scenario '{s}' (expected one of: {})", Self::NAMES.join(", "))),
+            _ => Err(format!(
+                "unknown scenario '{s}' (expected one of: {})",
+                Self::NAMES.join(", ")
+            )),
         }
     }
 
@@ -62,18 +65,33 @@ pub struct ScenarioDriver {
 }
 
 impl ScenarioDriver {
-    pub fn new(scenario: Scenario, session: &Session, warmup: usize, frames: usize) -> Result<Self, String> {
-        let target = match scenario {
-            Scenario::Drag => Some(drag_target(session).ok_or("the drag scenario needs an object with control points")?),
-            Scenario::ErbsRotate => {
-                Some(erbs_target(session).ok_or("the erbs-rotate scenario needs an ERBS curve or surface in the scene")?)
-            }
-            Scenario::Orbit | Scenario::Idle => None,
-        };
+    pub fn new(
+        scenario: Scenario,
+        session: &Session,
+        warmup: usize,
+        frames: usize,
+    ) -> Result<Self, String> {
+        let target =
+            match scenario {
+                Scenario::Drag => Some(
+                    drag_target(session)
+                        .ok_or("the drag scenario needs an object with control points")?,
+                ),
+                Scenario::ErbsRotate => Some(erbs_target(session).ok_or(
+                    "the erbs-rotate scenario needs an ERBS curve or surface in the scene",
+                )?),
+                Scenario::Orbit | Scenario::Idle => None,
+            };
         if warmup < 4 && target.is_some() {
             return Err("this scenario needs at least 4 warm-up frames to aim and select".into());
         }
-        Ok(Self { scenario, warmup, frames, target, start: (0.0, 0.0) })
+        Ok(Self {
+            scenario,
+            warmup,
+            frames,
+            target,
+            start: (0.0, 0.0),
+        })
     }
 
     /// The control point the scenario works on.
@@ -88,15 +106,28 @@ impl ScenarioDriver {
         let button = |b, pressed| Action::Input(InputEvent::Button { button: b, pressed });
         let circle = |start: (f64, f64), k: usize, centre_offset: bool| {
             let t = TAU * (k - w + 1) as f64 / PERIOD;
-            let (cx, cy) = if centre_offset { (start.0 - RADIUS, start.1) } else { start };
-            Action::Input(InputEvent::CursorMoved { x: cx + RADIUS * t.cos(), y: cy + RADIUS * t.sin() })
+            let (cx, cy) = if centre_offset {
+                (start.0 - RADIUS, start.1)
+            } else {
+                start
+            };
+            Action::Input(InputEvent::CursorMoved {
+                x: cx + RADIUS * t.cos(),
+                y: cy + RADIUS * t.sin(),
+            })
         };
         match self.scenario {
             Scenario::Idle => Vec::new(),
             Scenario::Orbit => {
                 if k + 1 == w {
                     let [width, height] = session.size();
-                    vec![Action::Input(InputEvent::CursorMoved { x: width * 0.5, y: height * 0.5 }), button(MouseButton::Middle, true)]
+                    vec![
+                        Action::Input(InputEvent::CursorMoved {
+                            x: width * 0.5,
+                            y: height * 0.5,
+                        }),
+                        button(MouseButton::Middle, true),
+                    ]
                 } else if k >= w && k < last {
                     vec![Action::MoveBy(4.0, 0.0)]
                 } else if k == last {
@@ -116,7 +147,10 @@ impl ScenarioDriver {
                     // Circle through the grabbed point, so the drag starts without a jump.
                     vec![circle(self.start, k, true)]
                 } else if k == last {
-                    vec![circle(self.start, k, true), button(MouseButton::Left, false)]
+                    vec![
+                        circle(self.start, k, true),
+                        button(MouseButton::Left, false),
+                    ]
                 } else {
                     Vec::new()
                 }
@@ -126,18 +160,30 @@ impl ScenarioDriver {
                 if k + 4 == w {
                     vec![Action::MoveTo(h)]
                 } else if k + 3 == w {
-                    vec![button(MouseButton::Left, true), button(MouseButton::Left, false)]
+                    vec![
+                        button(MouseButton::Left, true),
+                        button(MouseButton::Left, false),
+                    ]
                 } else if k + 2 == w {
                     // Off the pivot, so the screen angle is well defined.
                     let (x, y) = session.handle_position(h).unwrap_or(session.cursor());
                     self.start = (x, y);
                     vec![Action::Input(InputEvent::CursorMoved { x: x + RADIUS, y })]
                 } else if k + 1 == w {
-                    vec![Action::Key { key: Key::Char('r'), mods: Default::default() }]
+                    vec![Action::Key {
+                        key: Key::Char('r'),
+                        mods: Default::default(),
+                    }]
                 } else if k >= w && k < last {
                     vec![circle(self.start, k, false)]
                 } else if k == last {
-                    vec![circle(self.start, k, false), Action::Key { key: Key::Enter, mods: Default::default() }]
+                    vec![
+                        circle(self.start, k, false),
+                        Action::Key {
+                            key: Key::Enter,
+                            mods: Default::default(),
+                        },
+                    ]
                 } else {
                     Vec::new()
                 }
@@ -157,7 +203,10 @@ fn drag_target(session: &Session) -> Option<Handle> {
     match doc.objects[best].sampled.model() {
         ModelRef::Surface(s) => {
             let [nu, nv] = s.count();
-            Some(Handle::Point { object: best, point: Index2::Two(nu / 2, nv / 2) })
+            Some(Handle::Point {
+                object: best,
+                point: Index2::Two(nu / 2, nv / 2),
+            })
         }
         _ => handles.get(handles.len() / 2).map(|(h, _)| *h),
     }
@@ -172,12 +221,20 @@ fn erbs_target(session: &Session) -> Option<Handle> {
                 let [nu, nv] = s.count();
                 let (k, l) = (nu / 2, nv / 2);
                 let [a, b] = s.local_patch(k, l).count();
-                return Some(Handle::LocalPoint { object, local: Index2::Two(k, l), point: Index2::Two(a / 2, b / 2) });
+                return Some(Handle::LocalPoint {
+                    object,
+                    local: Index2::Two(k, l),
+                    point: Index2::Two(a / 2, b / 2),
+                });
             }
             ModelRef::ErbsCurve(c) => {
                 let l = c.local_curves().len() / 2;
                 let q = c.local_curves()[l].points().len() / 2;
-                return Some(Handle::LocalPoint { object, local: Index2::One(l), point: Index2::One(q) });
+                return Some(Handle::LocalPoint {
+                    object,
+                    local: Index2::One(l),
+                    point: Index2::One(q),
+                });
             }
             _ => {}
         }

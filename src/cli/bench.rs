@@ -1,0 +1,212 @@
+//! `prespline bench`: a scripted, reproducible editing session with per-frame phase timing,
+//! headless (offscreen) by default or in a window, optionally followed by the same session in
+//! naive mode (full re-sampling and full upload on every edit) for a same-run comparison.
+
+use super::CliError;
+use super::render::validation_mode;
+use crate::gpu::{FRAMES_IN_FLIGHT, OffscreenDesc, Renderer, RendererDesc};
+use crate::profile::{
+    FrameRecord, Phase, Progress, Recorder, RunInfo, Summary, compare, write_all,
+};
+use crate::scene::Scene;
+use crate::scene::demo::demo_scene;
+use crate::view::app::{self, ViewArgs};
+use crate::view::scenario::{Scenario, ScenarioDriver};
+use crate::view::session::Session;
+use std::path::{Path, PathBuf};
+
+/// Options of one `bench` run.
+#[derive(Debug, Clone)]
+pub struct BenchArgs {
+    pub scene: Option<PathBuf>,
+    pub scenario: Scenario,
+    pub frames: usize,
+    pub warmup: usize,
+    pub size: (u32, u32),
+    pub window: bool,
+    pub naive: bool,
+    pub out: PathBuf,
+    pub msaa: u32,
+}
+
+/// Runs the benchmark, writes the reports and returns the closing line.
+pub fn run(args: &BenchArgs) -> Result<String, CliError> {
+    if args.frames == 0 {
+        return Err(CliError("--frames must be at least 1".into()));
+    }
+    let (scene, scene_name) = match &args.scene {
+        Some(p) => (
+            Scene::load(p).map_err(|e| CliError::in_file(p, e))?,
+            p.display().to_string(),
+        ),
+        None => (demo_scene(), "demo".to_string()),
+    };
+    let modes: &[bool] = if args.naive { &[false, true] } else { &[false] };
+    let mut summaries = Vec::new();
+    let mut written = Vec::new();
+    for &naive in modes {
+        let mode = if naive { "naive" } else { "incremental" };
+        let dir = if args.naive {
+            args.out.join(mode)
+        } else {
+            args.out.clone()
+        };
+        eprintln!(
+            "bench: {} on {scene_name}, {} frames + {} warm-up, {}x{}, {mode}, {}",
+            args.scenario.name(),
+            args.frames,
+            args.warmup,
+            args.size.0,
+            args.size.1,
+            if args.window { "window" } else { "headless" }
+        );
+        let (frames, device) = if args.window {
+            run_window(args, &scene, naive)?
+        } else {
+            run_headless(args, &scene, naive, &dir)?
+        };
+        let summary = Summary::from_frames(&frames);
+        eprint!("{}", summary.table());
+        let mut info = RunInfo {
+            scenario: args.scenario.name().into(),
+            scene: scene_name.clone(),
+            size: format!("{}x{}", args.size.0, args.size.1),
+            frames: args.frames,
+            warmup_frames: args.warmup,
+            device,
+            mode: mode.into(),
+            ..RunInfo::default()
+        };
+        info = info.with("target", if args.window { "window" } else { "offscreen" });
+        let paths = write_all(&dir, &info, &frames).map_err(|e| CliError(e.to_string()))?;
+        written.extend(paths);
+        summaries.push((mode, summary));
+    }
+    if let [(a, inc), (b, naive)] = summaries.as_slice() {
+        eprint!("{}", compare(a, inc, b, naive));
+        if let (Some(i), Some(n)) = (&inc.measured, &naive.measured) {
+            let (di, dn) = (i.phase_ms[Phase::Delta].mean, n.phase_ms[Phase::Delta].mean);
+            if di > 0.0 {
+                eprintln!(
+                    "edit cost (delta phase, mean): incremental {:.1} µs, naive {:.1} µs: {:.0}× less with pre-evaluation",
+                    di * 1e3,
+                    dn * 1e3,
+                    dn / di
+                );
+            }
+        }
+    }
+    Ok(format!(
+        "bench results in {} ({} files)",
+        args.out.display(),
+        written.len()
+    ))
+}
+
+/// The session in an offscreen target: exactly the viewer's per-frame work without a window.
+fn run_headless(
+    args: &BenchArgs,
+    scene: &Scene,
+    naive: bool,
+    dir: &Path,
+) -> Result<(Vec<FrameRecord>, String), CliError> {
+    let gpu = |e: crate::gpu::GpuError| CliError(e.to_string());
+    let mut renderer = Renderer::new(&RendererDesc {
+        app_name: "prespline bench".into(),
+        validation: validation_mode(),
+        ..RendererDesc::default()
+    })
+    .map_err(gpu)?;
+    let device = renderer.caps().name.clone();
+    let (w, h) = args.size;
+    let mut target = renderer
+        .create_offscreen(&OffscreenDesc {
+            width: w,
+            height: h,
+            samples: args.msaa,
+        })
+        .map_err(gpu)?;
+    let mut session =
+        Session::new(&mut renderer, scene, dir.join("scene.json"), [w, h]).map_err(gpu)?;
+    session.naive = naive;
+    let total = args.warmup + args.frames;
+    let result = (|| -> Result<Recorder, CliError> {
+        let mut driver = ScenarioDriver::new(args.scenario, &session, args.warmup, args.frames)
+            .map_err(CliError)?;
+        let mut rec = Recorder::with_capacity(args.warmup, total);
+        let mut progress = Progress::new(Some(total));
+        for k in 0..total {
+            let index = rec.begin_frame();
+            rec.phase_start(Phase::Input);
+            for action in driver.actions(k, &session) {
+                session.perform(action);
+            }
+            rec.phase_start(Phase::Delta);
+            let applied = session.apply_pending();
+            rec.add_samples(applied.samples as u64);
+            // Waiting for the frame slot's fence is what presenting costs offscreen.
+            rec.phase_start(Phase::Present);
+            let mut frame = renderer.begin_offscreen(&mut target).map_err(gpu)?;
+            if let Some(ms) = frame.gpu_time_ms() {
+                rec.set_gpu_ms(index.saturating_sub(FRAMES_IN_FLIGHT), ms);
+            }
+            rec.phase_start(Phase::Upload);
+            let stats = session.upload(&mut frame).map_err(gpu)?;
+            rec.add_bytes(stats.bytes as u64);
+            rec.phase_start(Phase::Record);
+            session.record(&mut frame, true).map_err(gpu)?;
+            rec.phase_start(Phase::Submit);
+            frame.finish().map_err(gpu)?;
+            rec.end_frame();
+            session
+                .hud
+                .push_frame(rec.frames().last().map_or(0.0, |f| f.frame_ms));
+            progress.update(k + 1);
+        }
+        progress.finish(total);
+        // The last frames' GPU times arrive when their slots are waited on.
+        renderer.wait_idle().map_err(gpu)?;
+        std::fs::create_dir_all(dir)
+            .map_err(|e| CliError(format!("cannot create {}: {e}", dir.display())))?;
+        let png = dir.join("final.png");
+        renderer
+            .read_pixels(&target)
+            .map_err(gpu)?
+            .write_png(&png)
+            .map_err(gpu)?;
+        Ok(rec)
+    })();
+    session.destroy(&mut renderer);
+    renderer.destroy_offscreen(target).map_err(gpu)?;
+    let sink = renderer.validation_sink();
+    drop(renderer);
+    if let Some(errors) = sink.map(|s| s.errors()).filter(|e| !e.is_empty()) {
+        return Err(CliError(format!(
+            "Vulkan validation reported {} error(s), first: {}",
+            errors.len(),
+            errors[0]
+        )));
+    }
+    Ok((result?.into_frames(), device))
+}
+
+fn run_window(
+    args: &BenchArgs,
+    scene: &Scene,
+    naive: bool,
+) -> Result<(Vec<FrameRecord>, String), CliError> {
+    let run = app::run(ViewArgs {
+        scene: scene.clone(),
+        title: format!("bench {}", args.scenario.name()),
+        save_path: args.out.join("scene.json"),
+        size: args.size,
+        vsync: false,
+        script: None,
+        scenario: Some(args.scenario),
+        warmup: args.warmup,
+        max_frames: Some(args.warmup + args.frames),
+        naive,
+    })
+    .map_err(CliError)?;
+    Ok((run.frames, run.device))
+}

@@ -1,0 +1,149 @@
+//! `prespline bench` produces every report in one run (structure only — timings are never
+//! asserted in tests).
+
+use std::path::Path;
+use std::process::Command;
+
+fn prespline() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_prespline"));
+    let icd = prespline::gpu::LAVAPIPE_ICD;
+    c.env("VK_DRIVER_FILES", icd)
+        .env("VK_ICD_FILENAMES", icd)
+        .env("PRESPLINE_VALIDATION", "1");
+    c
+}
+
+fn check_reports(dir: &Path, frames: usize, warmup: usize) {
+    for f in [
+        "frames.csv",
+        "summary.json",
+        "summary.txt",
+        "trace.json",
+        "frame_times.svg",
+        "histogram.svg",
+        "final.png",
+    ] {
+        assert!(dir.join(f).is_file(), "{} missing", dir.join(f).display());
+    }
+    let csv = std::fs::read_to_string(dir.join("frames.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header = lines.next().unwrap();
+    for col in [
+        "frame",
+        "frame_ms",
+        "delta_ms",
+        "upload_ms",
+        "record_ms",
+        "submit_ms",
+        "present_ms",
+        "gpu_ms",
+        "bytes_uploaded",
+    ] {
+        assert!(
+            header.split(',').any(|c| c == col),
+            "CSV header lacks {col}: {header}"
+        );
+    }
+    assert_eq!(lines.count(), frames + warmup, "one row per frame");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    let measured = &summary["summary"]["measured"];
+    for key in ["mean", "p50", "p90", "p95", "p99", "max", "low_1pct"] {
+        assert!(
+            measured["frame_ms"][key].is_number(),
+            "summary lacks frame_ms.{key}: {measured}"
+        );
+        assert!(
+            measured["phase_ms"]["delta"][key].is_number(),
+            "summary lacks delta.{key}"
+        );
+    }
+    let trace: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("trace.json")).unwrap()).unwrap();
+    let events = trace["traceEvents"].as_array().unwrap();
+    assert!(
+        events
+            .iter()
+            .any(|e| e["ph"] == "X" && e["dur"].is_number())
+    );
+    for svg in ["frame_times.svg", "histogram.svg"] {
+        let text = std::fs::read_to_string(dir.join(svg)).unwrap();
+        assert!(
+            text.starts_with("<svg") && text.trim_end().ends_with("</svg>"),
+            "{svg}"
+        );
+    }
+}
+
+#[test]
+fn bench_writes_every_report_for_both_modes() {
+    let out = std::env::temp_dir().join(format!("prespline-bench-{}", std::process::id()));
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/erbs_surface.json");
+    let r = prespline()
+        .arg("bench")
+        .arg(&scene)
+        .args([
+            "--scenario",
+            "erbs-rotate",
+            "--frames",
+            "6",
+            "--warmup",
+            "4",
+            "--size",
+            "320x200",
+            "--naive",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(r.status.success(), "{err}");
+    assert!(
+        err.contains("p99") && err.contains("1% low"),
+        "terminal table missing:\n{err}"
+    );
+    assert!(err.contains("edit cost"), "comparison missing:\n{err}");
+    assert!(
+        err.lines().last().unwrap().contains(out.to_str().unwrap()),
+        "the last line says where the results are:\n{err}"
+    );
+    check_reports(&out.join("incremental"), 6, 4);
+    check_reports(&out.join("naive"), 6, 4);
+}
+
+#[test]
+fn every_scenario_runs_headless() {
+    for scenario in ["drag", "orbit", "idle"] {
+        let out =
+            std::env::temp_dir().join(format!("prespline-bench-{scenario}-{}", std::process::id()));
+        let r = prespline()
+            .args([
+                "bench",
+                "--scenario",
+                scenario,
+                "--frames",
+                "3",
+                "--warmup",
+                "4",
+                "--size",
+                "200x120",
+                "--out",
+            ])
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(
+            r.status.success(),
+            "{scenario}: {}",
+            String::from_utf8_lossy(&r.stderr)
+        );
+        check_reports(&out, 3, 4);
+    }
+    let r = prespline()
+        .args(["bench", "--scenario", "spin"])
+        .output()
+        .unwrap();
+    assert!(!r.status.success());
+    assert!(String::from_utf8_lossy(&r.stderr).contains("unknown scenario 'spin'"));
+}
