@@ -57,7 +57,7 @@ for k in range(3):
     row = []
     for l in range(3):
         cx, cy = 2.0 * k, 2.0 * l
-        pts = [[[cx + 1.3 * (a - 1), cy + 1.3 * (b - 1), (1.0 + 0.3 * ((k + l) % 2)) if (a, b) == (1, 1) else 0.0]
+        pts = [[[cx + 1.3 * (a - 1), cy + 1.3 * (b - 1), (2.2 + 1.2 * ((k + l) % 2)) if (a, b) == (1, 1) else 0.0]
                 for b in range(3)] for a in range(3)]
         row.append({"points": pts})
     patches.append(row)

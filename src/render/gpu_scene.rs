@@ -331,7 +331,8 @@ impl GpuScene {
                             offset: go,
                             shape: GridShape { rows: k, cols: k },
                         };
-                        frame.draw_wire(&o.controls, sg, 1, color)?;
+                        // Outline and centre lines only: full wire grids of every patch bury the surface.
+                        frame.draw_wire(&o.controls, sg, (k - 1) / 2, color)?;
                     }
                     if nets || chosen {
                         for r in 0..nr {

@@ -224,8 +224,8 @@ impl App {
             actions.extend(driver.actions(self.frame as usize, &r.session));
         }
         for action in actions {
-            if let Some(path) = r.session.perform(action) {
-                shots.push(path);
+            if let Some(shot) = r.session.perform(action) {
+                shots.push(shot);
             }
         }
         rec.phase_start(Phase::Delta);
@@ -252,8 +252,8 @@ impl App {
             frame.finish().map_err(|e| e.to_string())?;
         }
         rec.phase_end();
-        for path in shots {
-            screenshot(r, &path)?;
+        for (path, hud) in shots {
+            screenshot(r, &path, hud)?;
             r.session
                 .set_status(format!("screenshot {}", path.display()));
         }
@@ -279,8 +279,9 @@ impl App {
     }
 }
 
-/// Renders what the window shows (without the HUD) offscreen at the window size into a PNG.
-fn screenshot(r: &mut Running, path: &Path) -> Result<(), String> {
+/// Renders what the window shows offscreen at the window size into a PNG; without `hud` the
+/// overlay (whose numbers change from run to run) is left out, as golden tests need.
+fn screenshot(r: &mut Running, path: &Path, hud: bool) -> Result<(), String> {
     let [w, h] = r.session.size();
     let mut target = r
         .renderer
@@ -293,7 +294,7 @@ fn screenshot(r: &mut Running, path: &Path) -> Result<(), String> {
     let result = (|| {
         let mut frame = r.renderer.begin_offscreen(&mut target)?;
         r.session.upload(&mut frame)?;
-        r.session.record(&mut frame, false)?;
+        r.session.record(&mut frame, hud)?;
         frame.finish()?;
         r.renderer.read_pixels(&target)
     })();

@@ -122,20 +122,37 @@ impl Hud {
             for (k, l) in lines.iter().enumerate() {
                 push_text(&mut v, l, 16.0, 14.0 + k as f32 * line, scale, TEXT);
             }
-            // Frame-time graph: one bar per frame, 33 ms full scale (lines at 16.7 and 33.3 ms).
+            // Frame-time graph: one bar per frame. Full scale is 33 ms, or the next of 50, 100,
+            // 200, 500, 1000 ms above the slowest recent frame (software rendering is slow), so
+            // bars are never pegged; reference lines at 16.7 and 33.3 ms and at full scale.
             let (gx, gy) = (16.0, 16.0 + 2.0 * line);
-            for ms in [16.7f32, 33.3] {
-                push_rect(
-                    &mut v,
-                    gx,
-                    gy + gh - gh * ms / 33.3,
-                    gw,
-                    1.0,
-                    [90, 90, 100, 255],
-                );
+            let slowest = self.frames.iter().copied().fold(0.0f32, f32::max);
+            let full = [33.3f32, 50.0, 100.0, 200.0, 500.0, 1000.0]
+                .into_iter()
+                .find(|&f| slowest <= f)
+                .unwrap_or(slowest);
+            for ms in [16.7f32, 33.3, full] {
+                if ms <= full {
+                    push_rect(
+                        &mut v,
+                        gx,
+                        gy + gh - gh * ms / full,
+                        gw,
+                        1.0,
+                        [90, 90, 100, 255],
+                    );
+                }
             }
+            push_text(
+                &mut v,
+                &format!("{full:.0} ms"),
+                gx + gw + 6.0,
+                gy,
+                2.0,
+                DIM,
+            );
             for (k, &ms) in self.frames.iter().enumerate() {
-                let h = (gh * ms / 33.3).min(gh);
+                let h = (gh * ms / full).min(gh);
                 let c = if ms > 33.3 {
                     [235, 80, 70, 255]
                 } else if ms > 16.7 {

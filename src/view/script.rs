@@ -9,7 +9,8 @@
 //!  {"frame": 4, "press": "left"}, {"frame": 5, "move_by": [0, -40]}, {"frame": 6, "release": "left"},
 //!  {"frame": 7, "key": "r"}, {"frame": 8, "type": "30"}, {"frame": 9, "key": "enter"},
 //!  {"frame": 10, "key": "z", "ctrl": true}, {"frame": 11, "wheel": 2},
-//!  {"frame": 12, "screenshot": "shot.png"}, {"frame": 13, "quit": true}]
+//!  {"frame": 12, "screenshot": "shot.png"}, {"frame": 13, "screenshot": "hud.png", "hud": true},
+//!  {"frame": 14, "quit": true}]
 //! ```
 //!
 //! `move_to` aims the cursor at a control point (`"local"` too for ERBS objects), so scripts
@@ -40,7 +41,8 @@ pub enum Action {
     MoveTo(Handle),
     MoveBy(f64, f64),
     Type(String),
-    Screenshot(PathBuf),
+    /// A PNG of the view (with the HUD when the flag is set).
+    Screenshot(PathBuf, bool),
     Quit,
 }
 
@@ -78,7 +80,7 @@ fn parse_event(v: &Value, doc: &Document) -> Result<ScriptEvent, String> {
         alt: flag("alt"),
     };
     let known = [
-        "frame", "t", "ctrl", "shift", "alt", "object", "local", "point",
+        "frame", "t", "ctrl", "shift", "alt", "object", "local", "point", "hud",
     ];
     let actions: Vec<&String> = obj
         .keys()
@@ -129,9 +131,10 @@ fn parse_event(v: &Value, doc: &Document) -> Result<ScriptEvent, String> {
             Action::Key { key: k, mods }
         }
         "type" => Action::Type(arg.as_str().ok_or("'type' expects a string")?.to_string()),
-        "screenshot" => Action::Screenshot(PathBuf::from(
-            arg.as_str().ok_or("'screenshot' expects a file name")?,
-        )),
+        "screenshot" => Action::Screenshot(
+            PathBuf::from(arg.as_str().ok_or("'screenshot' expects a file name")?),
+            flag("hud"),
+        ),
         "quit" => Action::Quit,
         other => return Err(format!("unknown action '{other}'")),
     };

@@ -239,8 +239,8 @@ impl Session {
         Ok(stats)
     }
 
-    /// Performs a scripted action as if typed; returns the path of a requested screenshot.
-    pub fn perform(&mut self, action: Action) -> Option<PathBuf> {
+    /// Performs a scripted action as if typed; returns a requested screenshot (path, with HUD).
+    pub fn perform(&mut self, action: Action) -> Option<(PathBuf, bool)> {
         match action {
             Action::Input(e) => self.handle(e),
             Action::Key { key, mods } => {
@@ -273,7 +273,7 @@ impl Session {
                     });
                 }
             }
-            Action::Screenshot(path) => return Some(path),
+            Action::Screenshot(path, hud) => return Some((path, hud)),
             Action::Quit => self.quit = true,
         }
         None
