@@ -119,7 +119,7 @@ fn incremental_mirrors_end_identical_to_a_fresh_upload() {
         for _ in 0..1 + rng.below(4) {
             let e = random_edit(&doc, &mut rng);
             let region = doc.apply(&e);
-            gs.note(e.object, &region);
+            gs.note(&doc, &e, &region);
         }
         uploaded += draw_frame(&mut renderer, &mut target, &mut gs, &doc, &shot);
     }

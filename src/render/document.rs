@@ -2,8 +2,8 @@
 //! structures (polygons, nets, ERBS local curves and patches) that are drawn and picked.
 
 use super::camera::Bounds;
-use crate::geom::BezierCurve;
 use crate::geom::knots::uniform_params;
+use crate::geom::{BezierCurve, TensorSurface};
 use crate::sampling::{DirtyRegion, ModelRef, SampleMode, SampledObject};
 use crate::scene::{Edit, EditOp, Index2, Samples, Scene, SceneObject};
 use glam::DVec3;
@@ -156,27 +156,7 @@ impl Document {
             }
             ModelRef::ErbsSurface(s) => {
                 let [rows, cols] = s.count();
-                let patches = s
-                    .local_patches()
-                    .iter()
-                    .map(|p| {
-                        let [nr, nc] = p.count();
-                        let [(u0, u1), (v0, v1)] = p.domain();
-                        let us = uniform_params(u0, u1, LOCAL_PATCH_SAMPLES);
-                        let vs = uniform_params(v0, v1, LOCAL_PATCH_SAMPLES);
-                        let grid = us
-                            .iter()
-                            .flat_map(|&u| vs.iter().map(move |&v| (u, v)))
-                            .map(|(u, v)| (p.eval(u, v), p.normal(u, v)))
-                            .collect();
-                        LocalPatch {
-                            net_rows: nr,
-                            net_cols: nc,
-                            points: p.points().to_vec(),
-                            grid,
-                        }
-                    })
-                    .collect();
+                let patches = s.local_patches().iter().map(local_patch).collect();
                 Controls::LocalPatches {
                     rows,
                     cols,
@@ -288,6 +268,48 @@ impl Document {
                 },
             },
         }
+    }
+}
+
+/// One ERBS local curve or patch's display data.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LocalControls {
+    Curve(LocalCurve),
+    Patch(LocalPatch),
+}
+
+impl Document {
+    /// Display data of one ERBS local curve/patch of object `i` (what an edit of that local
+    /// changes), without recomputing the others.
+    pub fn local_controls(&self, i: usize, local: Index2) -> Option<LocalControls> {
+        match (self.objects[i].sampled.model(), local) {
+            (ModelRef::ErbsCurve(c), Index2::One(l)) => {
+                Some(LocalControls::Curve(local_curve(c.local_curves().get(l)?)))
+            }
+            (ModelRef::ErbsSurface(s), Index2::Two(k, l)) => {
+                let [nu, nv] = s.count();
+                (k < nu && l < nv).then(|| LocalControls::Patch(local_patch(s.local_patch(k, l))))
+            }
+            _ => None,
+        }
+    }
+}
+
+fn local_patch(p: &TensorSurface) -> LocalPatch {
+    let [nr, nc] = p.count();
+    let [(u0, u1), (v0, v1)] = p.domain();
+    let us = uniform_params(u0, u1, LOCAL_PATCH_SAMPLES);
+    let vs = uniform_params(v0, v1, LOCAL_PATCH_SAMPLES);
+    let grid = us
+        .iter()
+        .flat_map(|&u| vs.iter().map(move |&v| (u, v)))
+        .map(|(u, v)| (p.eval(u, v), p.normal(u, v)))
+        .collect();
+    LocalPatch {
+        net_rows: nr,
+        net_cols: nc,
+        points: p.points().to_vec(),
+        grid,
     }
 }
 

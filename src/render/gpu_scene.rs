@@ -2,14 +2,16 @@
 //! structures, with per-frame-slot dirty tracking so each slot receives exactly the rows changed
 //! since it was last written.
 
-use super::document::{Controls, Document, Handle, LOCAL_CURVE_SAMPLES, LOCAL_PATCH_SAMPLES};
+use super::document::{
+    Controls, Document, Handle, LOCAL_CURVE_SAMPLES, LOCAL_PATCH_SAMPLES, LocalControls,
+};
 use super::style::{NetMode, Palette, ViewOptions, Wire};
 use crate::gpu::{
     FRAMES_IN_FLIGHT, Frame, GpuResult, GridShape, Mirror, PointRun, PointStyle, PolylineStyle,
     Renderer, SurfaceGrid, SurfaceStyle,
 };
 use crate::sampling::{DirtyRegion, DirtySet};
-use crate::scene::Index2;
+use crate::scene::{Edit, EditOp, Index2};
 use glam::DVec3;
 
 /// Where an object's control structures sit in its control mirror (offsets in floats).
@@ -37,7 +39,10 @@ struct ObjectGpu {
     /// Sample rows (surfaces) or samples (curves) each slot has not seen yet.
     dirty: [DirtySet; FRAMES_IN_FLIGHT],
     controls: Mirror,
-    controls_dirty: [bool; FRAMES_IN_FLIGHT],
+    /// The control mirror's contents, kept so an edit of one ERBS local recomputes only that
+    /// local's floats and each slot copies only the float ranges it has not seen.
+    controls_cache: Vec<f32>,
+    controls_dirty: [DirtySet; FRAMES_IN_FLIGHT],
     layout: ControlLayout,
 }
 
@@ -96,20 +101,83 @@ impl GpuScene {
                 samples,
                 dirty: Default::default(),
                 controls,
-                controls_dirty: [false; FRAMES_IN_FLIGHT],
+                controls_cache: data,
+                controls_dirty: Default::default(),
                 layout,
             });
         }
         Ok(Self { objects, scratch })
     }
 
-    /// Records that an edit of `object` changed `region` (and its control structures).
-    pub fn note(&mut self, object: usize, region: &DirtyRegion) {
-        let o = &mut self.objects[object];
-        for d in &mut o.dirty {
+    /// Records what an applied edit changed: the sample rows of `region`, and the control
+    /// structures (only the edited local curve/patch for ERBS local edits).
+    pub fn note(&mut self, doc: &Document, edit: &Edit, region: &DirtyRegion) {
+        self.note_samples(edit.object, region);
+        let local = match &edit.op {
+            EditOp::TransformLocal { local, .. }
+            | EditOp::TranslateLocalPoint { local, .. }
+            | EditOp::SetLocalPoints { local, .. } => Some(*local),
+            _ => None,
+        };
+        match local {
+            Some(l) => self.note_local(doc, edit.object, l),
+            None => self.note_controls(doc, edit.object),
+        }
+    }
+
+    /// Marks sample rows dirty for every slot.
+    pub fn note_samples(&mut self, object: usize, region: &DirtyRegion) {
+        for d in &mut self.objects[object].dirty {
             d.insert(region.rows());
         }
-        o.controls_dirty = [true; FRAMES_IN_FLIGHT];
+    }
+
+    /// Recomputes all control structures of `object` and marks them dirty for every slot.
+    pub fn note_controls(&mut self, doc: &Document, object: usize) {
+        let (_, data) = control_floats(&doc.controls(object));
+        let o = &mut self.objects[object];
+        if data.len() == o.controls_cache.len() {
+            o.controls_cache = data;
+            for d in &mut o.controls_dirty {
+                d.insert(0..o.controls_cache.len());
+            }
+        }
+    }
+
+    /// Recomputes one ERBS local's display floats (samples or grid, control points).
+    fn note_local(&mut self, doc: &Document, object: usize, local: Index2) {
+        let o = &mut self.objects[object];
+        let (ranges, floats): (Vec<std::ops::Range<usize>>, Vec<Vec<f32>>) =
+            match (&o.layout, doc.local_controls(object, local)) {
+                (ControlLayout::LocalCurves(locals), Some(LocalControls::Curve(c))) => {
+                    let Index2::One(l) = local else { return };
+                    let (so, po, count) = locals[l];
+                    let mut s = Vec::new();
+                    c.samples.iter().for_each(|&q| push3(&mut s, q));
+                    let mut p = Vec::new();
+                    c.points.iter().for_each(|&q| push3(&mut p, q));
+                    (vec![so..so + s.len(), po..po + count * 3], vec![s, p])
+                }
+                (ControlLayout::LocalPatches { cols, patches }, Some(LocalControls::Patch(p))) => {
+                    let Index2::Two(k, l) = local else { return };
+                    let (go, po, nr, nc) = patches[k * cols + l];
+                    let mut g = Vec::new();
+                    for &(pos, n) in &p.grid {
+                        push3(&mut g, pos);
+                        push3(&mut g, n);
+                    }
+                    let mut q = Vec::new();
+                    p.points.iter().for_each(|&x| push3(&mut q, x));
+                    (vec![go..go + g.len(), po..po + nr * nc * 3], vec![g, q])
+                }
+                _ => return self.note_controls(doc, object),
+            };
+        for (r, f) in ranges.into_iter().zip(floats) {
+            o.controls_cache[r.clone()].copy_from_slice(&f);
+            for d in &mut o.controls_dirty {
+                d.insert(r.clone());
+            }
+        }
     }
 
     /// Copies into this frame's slot exactly what changed since the slot was last written:
@@ -135,11 +203,13 @@ impl GpuScene {
                     stats.bytes += self.scratch.len() * 4;
                 }
             }
-            if o.controls_dirty[slot] {
-                o.controls_dirty[slot] = false;
-                let (_, data) = control_floats(&doc.controls(i));
-                frame.write_mirror(&mut o.controls).write(0, &data)?;
-                stats.bytes += data.len() * 4;
+            let ranges = o.controls_dirty[slot].take();
+            if !ranges.is_empty() {
+                let mut w = frame.write_mirror(&mut o.controls);
+                for r in ranges {
+                    w.write(r.start, &o.controls_cache[r.clone()])?;
+                    stats.bytes += r.len() * 4;
+                }
             }
         }
         Ok(stats)

@@ -213,13 +213,14 @@ impl Session {
                 }
             } else {
                 samples += region.samples();
-                self.gpu.note(e.object, &region);
+                self.gpu.note(&self.doc, e, &region);
             }
         }
         for &i in &edited {
             let region = self.doc.objects[i].sampled.rebuild_all();
             samples += region.samples();
-            self.gpu.note(i, &region);
+            self.gpu.note_samples(i, &region);
+            self.gpu.note_controls(&self.doc, i);
         }
         let micros = start.elapsed().as_secs_f64() * 1e6;
         self.projected = None;
