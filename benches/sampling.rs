@@ -26,41 +26,77 @@ fn surface() -> Shape {
         })
         .collect();
     let k = KnotVector::clamped_uniform(3, n, 0.0, 1.0).into_vec();
-    Shape::BSplineSurface(TensorSurface::bspline([3, 3], [k.clone(), k], [n, n], pts, None).unwrap())
+    Shape::BSplineSurface(
+        TensorSurface::bspline([3, 3], [k.clone(), k], [n, n], pts, None).unwrap(),
+    )
 }
 
 fn curve() -> Shape {
     let n = 1000;
-    let pts = (0..n).map(|i| DVec3::new(i as f64, (0.1 * i as f64).sin(), 0.0)).collect();
-    Shape::BSplineCurve(BSplineCurve::new(3, KnotVector::clamped_uniform(3, n, 0.0, 1.0).into_vec(), pts, None).unwrap())
+    let pts = (0..n)
+        .map(|i| DVec3::new(i as f64, (0.1 * i as f64).sin(), 0.0))
+        .collect();
+    Shape::BSplineCurve(
+        BSplineCurve::new(
+            3,
+            KnotVector::clamped_uniform(3, n, 0.0, 1.0).into_vec(),
+            pts,
+            None,
+        )
+        .unwrap(),
+    )
 }
 
 /// 10 × 10 bicubic local patches tiling [0, 10]².
 fn erbs_surface() -> Shape {
     let n = 10;
-    let knots: Vec<f64> = std::iter::once(0.0).chain((0..n).map(|i| i as f64)).chain(std::iter::once((n - 1) as f64)).collect();
+    let knots: Vec<f64> = std::iter::once(0.0)
+        .chain((0..n).map(|i| i as f64))
+        .chain(std::iter::once((n - 1) as f64))
+        .collect();
     let mut patches = Vec::new();
     for k in 0..n {
         for l in 0..n {
             let pts = (0..16)
-                .map(|q| DVec3::new(k as f64 + (q / 4) as f64 / 3.0, l as f64 + (q % 4) as f64 / 3.0, ((k * l + q) % 5) as f64 * 0.1))
+                .map(|q| {
+                    DVec3::new(
+                        k as f64 + (q / 4) as f64 / 3.0,
+                        l as f64 + (q % 4) as f64 / 3.0,
+                        ((k * l + q) % 5) as f64 * 0.1,
+                    )
+                })
                 .collect();
             patches.push(TensorSurface::bezier([4, 4], pts, None).unwrap());
         }
     }
-    Shape::ErbsSurface(ErbsSurface::new([knots.clone(), knots], [n, n], patches, BFunctionKind::ExpoRational).unwrap())
+    Shape::ErbsSurface(
+        ErbsSurface::new(
+            [knots.clone(), knots],
+            [n, n],
+            patches,
+            BFunctionKind::ExpoRational,
+        )
+        .unwrap(),
+    )
 }
 
 fn rotation_about(centre: DVec3, angle: f64) -> DMat4 {
-    DMat4::from_translation(centre) * DMat4::from_rotation_z(angle) * DMat4::from_translation(-centre)
+    DMat4::from_translation(centre)
+        * DMat4::from_rotation_z(angle)
+        * DMat4::from_translation(-centre)
 }
 
 /// The edit scenarios: (name, object, edit batch).
 fn scenarios() -> Vec<(&'static str, &'static str, Vec<EditOp>)> {
-    let mv = |i, j| EditOp::TranslatePoint { point: Index2::Two(i, j), delta: DVec3::new(0.0, 0.0, 1e-3) };
+    let mv = |i, j| EditOp::TranslatePoint {
+        point: Index2::Two(i, j),
+        delta: DVec3::new(0.0, 0.0, 1e-3),
+    };
     let mut state = 12345u64;
     let mut next = move || {
-        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         ((state >> 33) % 100) as usize
     };
     let ten = (0..10).map(|_| mv(next(), next())).collect();
@@ -68,11 +104,21 @@ fn scenarios() -> Vec<(&'static str, &'static str, Vec<EditOp>)> {
         ("interior point", "surface", vec![mv(50, 50)]),
         ("boundary point", "surface", vec![mv(0, 50)]),
         ("ten random points", "surface", ten),
-        ("curve point", "curve", vec![EditOp::TranslatePoint { point: Index2::One(500), delta: DVec3::new(0.0, 1e-3, 0.0) }]),
+        (
+            "curve point",
+            "curve",
+            vec![EditOp::TranslatePoint {
+                point: Index2::One(500),
+                delta: DVec3::new(0.0, 1e-3, 0.0),
+            }],
+        ),
         (
             "ERBS patch rotation",
             "erbs",
-            vec![EditOp::TransformLocal { local: Index2::Two(4, 5), matrix: rotation_about(DVec3::new(4.5, 5.5, 0.0), 1e-3) }],
+            vec![EditOp::TransformLocal {
+                local: Index2::Two(4, 5),
+                matrix: rotation_about(DVec3::new(4.5, 5.5, 0.0), 1e-3),
+            }],
         ),
     ]
 }
@@ -81,7 +127,11 @@ fn objects() -> Vec<(&'static str, Shape, Samples)> {
     vec![
         ("surface", surface(), Samples::Surface([SURFACE_SAMPLES; 2])),
         ("curve", curve(), Samples::Curve(CURVE_SAMPLES)),
-        ("erbs", erbs_surface(), Samples::Surface([SURFACE_SAMPLES; 2])),
+        (
+            "erbs",
+            erbs_surface(),
+            Samples::Surface([SURFACE_SAMPLES; 2]),
+        ),
     ]
 }
 
@@ -123,8 +173,14 @@ fn bench(c: &mut Criterion) {
 
 fn invert(op: &EditOp) -> EditOp {
     match op {
-        EditOp::TranslatePoint { point, delta } => EditOp::TranslatePoint { point: *point, delta: -*delta },
-        EditOp::TransformLocal { local, matrix } => EditOp::TransformLocal { local: *local, matrix: matrix.inverse() },
+        EditOp::TranslatePoint { point, delta } => EditOp::TranslatePoint {
+            point: *point,
+            delta: -*delta,
+        },
+        EditOp::TransformLocal { local, matrix } => EditOp::TransformLocal {
+            local: *local,
+            matrix: matrix.inverse(),
+        },
         other => other.clone(),
     }
 }
@@ -146,7 +202,11 @@ fn summary() {
     for (name, shape, samples) in &objs {
         let n = SampledObject::new(shape, *samples, SampleMode::Render).sample_count();
         match mean_ns("full", name) {
-            Some(ns) => println!("| {name} | {n} | {:.3} ms | {:.1} |", ns / 1e6, n as f64 / (ns / 1e9) / 1e6),
+            Some(ns) => println!(
+                "| {name} | {n} | {:.3} ms | {:.1} |",
+                ns / 1e6,
+                n as f64 / (ns / 1e9) / 1e6
+            ),
             None => println!("| {name} | {n} | not measured | |"),
         }
     }
@@ -158,7 +218,11 @@ fn summary() {
         let touched: usize = batch.iter().map(|op| obj.apply(op).samples()).sum();
         // A row whose estimate is missing still prints, so a broken lookup cannot hide it.
         match (mean_ns("edit", name), mean_ns("full", target)) {
-            (Some(e), Some(f)) => println!("| {name} | {target} | {:.2} | {touched} | 1/{:.0} |", e / 1e3, f / e),
+            (Some(e), Some(f)) => println!(
+                "| {name} | {target} | {:.2} | {touched} | 1/{:.0} |",
+                e / 1e3,
+                f / e
+            ),
             (Some(e), None) => println!("| {name} | {target} | {:.2} | {touched} | |", e / 1e3),
             _ => println!("| {name} | {target} | not measured | {touched} | |"),
         }

@@ -62,7 +62,11 @@ impl DirtySet {
     /// Everything in 0..n (a fresh mirror).
     pub fn all(n: usize) -> Self {
         Self {
-            ranges: if n > 0 { std::iter::once(0..n).collect() } else { Vec::new() },
+            ranges: if n > 0 {
+                std::iter::once(0..n).collect()
+            } else {
+                Vec::new()
+            },
         }
     }
 
