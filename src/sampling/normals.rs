@@ -1,6 +1,7 @@
 //! Unit normals of surface samples, with the geometry layer's fallback where Su × Sv vanishes.
 
-use super::grid::SampleGrid;
+use super::grid::{PartialSet, SampleGrid};
+use super::shading;
 use crate::geom::surface::{normal_with_fallback, regular_normal};
 use glam::DVec3;
 use std::ops::Range;
@@ -20,6 +21,9 @@ pub fn update(
     params: [&[f64]; 2],
     model: &impl NormalSource,
 ) {
+    if grid.partials == PartialSet::Shading {
+        return update_shading(grid, rows, cols, params, model);
+    }
     let Some(normals) = grid.normals.as_mut() else {
         return;
     };
@@ -37,6 +41,30 @@ pub fn update(
                 .unwrap_or_else(|| fallback(su, sv, params[0][i], params[1][j], model));
         }
     }
+}
+
+/// [`update`] for `Shading` grids (S, Su, Sv per sample), a row segment at a time through the
+/// vectorised kernel; the degenerate samples take the same fallback afterwards.
+fn update_shading(
+    grid: &mut SampleGrid,
+    rows: Range<usize>,
+    cols: Range<usize>,
+    params: [&[f64]; 2],
+    model: &impl NormalSource,
+) {
+    let Some(normals) = grid.normals.as_mut() else {
+        return;
+    };
+    let mv = grid.dims[1];
+    let mut degenerate = Vec::new();
+    for i in rows {
+        let (a, b) = (i * mv + cols.start, i * mv + cols.end);
+        let data = grid.data[a * 3..b * 3].as_chunks::<3>().0;
+        shading::normals_of(data, &mut normals[a..b], |jj| {
+            degenerate.push((i, cols.start + jj))
+        });
+    }
+    resolve_degenerate(grid, &degenerate, params, model);
 }
 
 /// Normals of samples `(i, j)` whose Su × Sv the fast kernels found degenerate

@@ -65,10 +65,10 @@ impl<const L: usize> std::ops::Mul for Lanes<L> {
 }
 
 /// The `Shading` grid a kernel writes: `data[(i * width + j) * 3 + p]` with p over S, Su, Sv,
-/// and `normals[i * width + j]`.
+/// and `normals[i * width + j]` when there are normals.
 pub(crate) struct ShadingGrid<'a> {
     pub data: &'a mut [DVec3],
-    pub normals: &'a mut [DVec3],
+    pub normals: Option<&'a mut [DVec3]>,
     pub width: usize,
 }
 
@@ -152,10 +152,19 @@ impl Rect<'_> {
         };
         let mv = out.width;
         let mut data = out.data[rows.start * mv * 3..rows.end * mv * 3].chunks_exact_mut(mv * 3);
-        let mut normals = out.normals[rows.start * mv..rows.end * mv].chunks_exact_mut(mv);
         let split = rows.start + rows.len() / LANES * LANES;
-        kernel.rows::<LANES>(rows.start..split, &mut data, &mut normals, degenerate);
-        kernel.rows::<1>(split..rows.end, &mut data, &mut normals, degenerate);
+        match out.normals {
+            Some(normals) => {
+                let mut normals = normals[rows.start * mv..rows.end * mv].chunks_exact_mut(mv);
+                kernel.rows::<LANES, true>(rows.start..split, &mut data, &mut normals, degenerate);
+                kernel.rows::<1, true>(split..rows.end, &mut data, &mut normals, degenerate);
+            }
+            None => {
+                let mut none = std::iter::empty();
+                kernel.rows::<LANES, false>(rows.start..split, &mut data, &mut none, degenerate);
+                kernel.rows::<1, false>(split..rows.end, &mut data, &mut none, degenerate);
+            }
+        }
     }
 }
 
@@ -176,8 +185,8 @@ struct Kernel<'a, const WU: usize, const WV: usize> {
 
 impl<const WU: usize, const WV: usize> Kernel<'_, WU, WV> {
     /// Rows `rows` (a multiple of L of them) in groups of L; `data` and `normals` yield the
-    /// grid's rows in the same order.
-    fn rows<'g, const L: usize>(
+    /// grid's rows in the same order (`normals` only if N).
+    fn rows<'g, const L: usize, const N: bool>(
         &self,
         rows: Range<usize>,
         data: &mut impl Iterator<Item = &'g mut [DVec3]>,
@@ -209,8 +218,9 @@ impl<const WU: usize, const WV: usize> Kernel<'_, WU, WV> {
                     .as_chunks_mut::<3>()
                     .0
             });
-            let n: [&mut [DVec3]; L] = std::array::from_fn(|_| {
-                &mut normals.next().expect("one normal row per sample row")[j0..j1]
+            let n: [&mut [DVec3]; L] = std::array::from_fn(|_| match N {
+                true => &mut normals.next().expect("one normal row per sample row")[j0..j1],
+                false => &mut [],
             });
             for (jj, (&f, cv)) in self.firsts.iter().zip(&coeffs).enumerate() {
                 let win: &[QCol<L>; WV] = q[f..f + WV].try_into().expect("WV columns");
@@ -221,6 +231,9 @@ impl<const WU: usize, const WV: usize> Kernel<'_, WU, WV> {
                         DVec3::new(s[3][l], s[4][l], s[5][l]),
                         DVec3::new(s[6][l], s[7][l], s[8][l]),
                     ];
+                }
+                if !N {
+                    continue;
                 }
                 stage[..6].copy_from_slice(&s[3..]);
                 normals_staged(&mut stage);
@@ -345,7 +358,7 @@ pub(crate) fn translate_surface(
     tables: [&HermiteTable; 2],
     point: [usize; 2],
     delta: DVec3,
-    out: ShadingGrid<'_>,
+    mut out: ShadingGrid<'_>,
     degenerate: &mut Vec<(usize, usize)>,
 ) -> (Range<usize>, Range<usize>) {
     let [tu, tv] = tables;
@@ -365,7 +378,10 @@ pub(crate) fn translate_surface(
         let cu = coeffs(tu, k, i);
         let (a, b) = (i * mv + cols.start, i * mv + cols.end);
         let data = out.data[a * 3..b * 3].as_chunks_mut::<3>().0;
-        let normals = &mut out.normals[a..b];
+        let normals = &mut out
+            .normals
+            .as_deref_mut()
+            .expect("shading grids keep normals")[a..b];
         for (s, cv) in data.iter_mut().zip(&cv) {
             s[0] += delta * (cu[0] * cv[0]);
             s[1] += delta * (cu[1] * cv[0]);
@@ -379,7 +395,11 @@ pub(crate) fn translate_surface(
 
 /// Unit normals of `data`'s samples (S, Su, Sv each) into `normals`, `LANES` at a time so that
 /// the square roots and divisions vectorise; reports the index of every degenerate sample.
-fn normals_of(data: &[[DVec3; 3]], normals: &mut [DVec3], mut degenerate: impl FnMut(usize)) {
+pub(crate) fn normals_of(
+    data: &[[DVec3; 3]],
+    normals: &mut [DVec3],
+    mut degenerate: impl FnMut(usize),
+) {
     let mut stage = [Lanes([0.0; LANES]); 4];
     let (data4, rest) = data.as_chunks::<LANES>();
     let (normals4, normals_rest) = normals.as_chunks_mut::<LANES>();
@@ -471,10 +491,12 @@ mod tests {
     //! The fast paths against the generic code: `Square(1)` grids (which hold S, Su, Sv among
     //! other partials) and curve orders above 1 never take them.
     use super::*;
-    use crate::geom::{BSplineCurve, TensorSurface};
+    use crate::geom::{BFunctionKind, BSplineCurve, ErbsSurface, TensorSurface};
+    use crate::sampling::erbs_surface::ErbsSurfaceSampler;
     use crate::sampling::grid::{PartialSet, SampleGrid};
     use crate::sampling::spline_curve::SplineCurveSampler;
     use crate::sampling::spline_surface::SplineSurfaceSampler;
+    use glam::DMat4;
 
     struct Rng(u64);
 
@@ -594,6 +616,61 @@ mod tests {
             }
         }
         assert!(worst < 1e-13, "worst {worst:e}");
+    }
+
+    #[test]
+    fn erbs_shading_matches_the_generic_path() {
+        // Local patches through the fast kernel (degrees 1..=3) or two_pass (4), the written-out
+        // blend and the row-wise normals, against Square(1) grids that take none of them.
+        let mut rng = Rng(0x5151_7e57);
+        for case in 0..12 {
+            let count = [2 + rng.below(3), 2 + rng.below(3)];
+            let knots = count.map(|n| {
+                let mut k = vec![0.0];
+                let mut t = 0.0;
+                for _ in 0..n {
+                    k.push(t);
+                    t += rng.range(0.3, 2.0);
+                }
+                k.push(k[n]);
+                k
+            });
+            let patches = (0..count[0] * count[1])
+                .map(|_| {
+                    let c = [2 + rng.below(4), 2 + rng.below(4)];
+                    let pts = (0..c[0] * c[1]).map(|_| rng.vec(5.0)).collect();
+                    TensorSurface::bezier(c, pts, None).unwrap()
+                })
+                .collect();
+            let kind = if case % 2 == 0 {
+                BFunctionKind::ExpoRational
+            } else {
+                BFunctionKind::Smoothstep
+            };
+            let e = ErbsSurface::new(knots, count, patches, kind).unwrap();
+            let samples = [2 + rng.below(40), 2 + rng.below(40)];
+            let mut fast = ErbsSurfaceSampler::new(e.clone(), samples, PartialSet::Shading, true);
+            let mut generic = ErbsSurfaceSampler::new(e, samples, PartialSet::Square(1), true);
+            let d = difference(fast.grid(), generic.grid());
+            assert!(d < 1e-13, "case {case}: {d:e}");
+            for _ in 0..10 {
+                let (k, l) = (rng.below(count[0]), rng.below(count[1]));
+                if rng.below(2) == 0 {
+                    let m = DMat4::from_translation(rng.vec(1.0))
+                        * DMat4::from_axis_angle(rng.vec(1.0).normalize(), rng.range(-1.0, 1.0));
+                    fast.transform_local(k, l, &m);
+                    generic.transform_local(k, l, &m);
+                } else {
+                    let [da, db] = fast.surface().local_patch(k, l).degree();
+                    let (qa, qb) = (rng.below(da + 1), rng.below(db + 1));
+                    let v = rng.vec(1.0);
+                    fast.translate_local_point(k, l, qa, qb, v);
+                    generic.translate_local_point(k, l, qa, qb, v);
+                }
+                let d = difference(fast.grid(), generic.grid());
+                assert!(d < 1e-12, "case {case}: {d:e}");
+            }
+        }
     }
 
     #[test]

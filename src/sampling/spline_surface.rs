@@ -261,7 +261,7 @@ impl SplineSurfaceSampler {
 fn shading_grid(grid: &mut SampleGrid) -> ShadingGrid<'_> {
     ShadingGrid {
         data: &mut grid.data,
-        normals: grid.normals.as_mut().expect("shading grids keep normals"),
+        normals: Some(grid.normals.as_mut().expect("shading grids keep normals")),
         width: grid.dims[1],
     }
 }
