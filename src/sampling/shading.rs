@@ -460,8 +460,9 @@ fn sample_curve_w<const W: usize>(
     for ((o, cv), &span) in out.iter_mut().zip(coeffs).zip(spans) {
         let first = span + 1 - W;
         let win: &[DVec3; W] = pts[first..first + W].try_into().expect("W points");
-        let (mut c, mut d) = (DVec3::ZERO, DVec3::ZERO);
-        for k in 0..W {
+        // From the first product, as in the surface kernel.
+        let (mut c, mut d) = (win[0] * cv[0][0], win[0] * cv[1][0]);
+        for k in 1..W {
             c += win[k] * cv[0][k];
             d += win[k] * cv[1][k];
         }
