@@ -30,7 +30,7 @@ type QCol<const L: usize> = [Lanes<L>; 6];
 /// One value for each of L sample rows. Aligned so that SSE2 arithmetic may take its operands
 /// straight from memory (legacy SSE memory operands must be 16-byte aligned).
 #[derive(Debug, Clone, Copy)]
-#[repr(C, align(32))]
+#[repr(C, align(16))]
 struct Lanes<const L: usize>([f64; L]);
 
 impl<const L: usize> std::ops::Index<usize> for Lanes<L> {
@@ -208,7 +208,8 @@ impl<const WU: usize, const WV: usize> Kernel<'_, WU, WV> {
         // The normal goes through memory on purpose: computed from registers and stored
         // straight into the rows, LLVM's SLP vectoriser pairs x and y of one lane to suit the
         // stores and leaves the square root and divisions scalar; from and to lane-layout
-        // memory they vectorise across the lanes (measured: ~15% of the whole pass).
+        // memory they vectorise across the lanes (measured: ~15–20% of the whole pass with
+        // 4 lanes; with 2 lanes LLVM forwards through the buffer and pairs x and y again).
         let mut stage = Box::new([Lanes([0.0; L]); 10]);
         let (j0, j1) = (self.cols.start, self.cols.end);
         for i0 in rows.step_by(L) {
