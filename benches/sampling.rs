@@ -185,13 +185,11 @@ fn invert(op: &EditOp) -> EditOp {
     }
 }
 
-/// Reads criterion's mean estimate (ns) for a benchmark id.
+/// Reads criterion's mean estimate (ns) for a benchmark id. Criterion keeps spaces in its
+/// directory names (`criterion/edit/interior point/`), so the id is used as it is.
 fn mean_ns(group: &str, id: &str) -> Option<f64> {
     let dir = std::env::var("CARGO_TARGET_DIR").unwrap_or_else(|_| "target".into());
-    let path = format!(
-        "{dir}/criterion/{group}/{}/new/estimates.json",
-        id.replace(' ', "_")
-    );
+    let path = format!("{dir}/criterion/{group}/{id}/new/estimates.json");
     let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(path).ok()?).ok()?;
     v["mean"]["point_estimate"].as_f64()
 }
@@ -203,12 +201,13 @@ fn summary() {
     let objs = objects();
     for (name, shape, samples) in &objs {
         let n = SampledObject::new(shape, *samples, SampleMode::Render).sample_count();
-        if let Some(ns) = mean_ns("full", name) {
-            println!(
+        match mean_ns("full", name) {
+            Some(ns) => println!(
                 "| {name} | {n} | {:.3} ms | {:.1} |",
                 ns / 1e6,
                 n as f64 / (ns / 1e9) / 1e6
-            );
+            ),
+            None => println!("| {name} | {n} | not measured | |"),
         }
     }
     println!("\n| edit | object | µs per edit batch | samples touched | edit / full |");
@@ -217,12 +216,15 @@ fn summary() {
         let (_, shape, samples) = objs.iter().find(|o| o.0 == target).unwrap();
         let mut obj = SampledObject::new(shape, *samples, SampleMode::Render);
         let touched: usize = batch.iter().map(|op| obj.apply(op).samples()).sum();
-        if let (Some(e), Some(f)) = (mean_ns("edit", name), mean_ns("full", target)) {
-            println!(
+        // A row whose estimate is missing still prints, so a broken lookup cannot hide it.
+        match (mean_ns("edit", name), mean_ns("full", target)) {
+            (Some(e), Some(f)) => println!(
                 "| {name} | {target} | {:.2} | {touched} | 1/{:.0} |",
                 e / 1e3,
                 f / e
-            );
+            ),
+            (Some(e), None) => println!("| {name} | {target} | {:.2} | {touched} | |", e / 1e3),
+            _ => println!("| {name} | {target} | not measured | {touched} | |"),
         }
     }
 }

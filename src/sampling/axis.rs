@@ -112,6 +112,19 @@ impl HermiteTable {
         Some(&self.m[base..base + w])
     }
 
+    /// Derivative rows kept per sample (min(g, d) + 1).
+    #[inline]
+    pub fn rows_kept(&self) -> usize {
+        self.rows
+    }
+
+    /// All of M in storage order, per sample `rows_kept() × (d+1)` values, for kernels that
+    /// walk it linearly instead of looking rows up one by one.
+    #[inline]
+    pub fn matrix(&self) -> &[f64] {
+        &self.m
+    }
+
     /// Coefficient of control point k in the r-th derivative at sample j (0 if inactive).
     #[inline]
     pub fn coeff(&self, j: usize, r: usize, k: usize) -> f64 {

@@ -6,6 +6,7 @@ use super::dirty::DirtyRegion;
 use super::erbs_axis::ErbsAxis;
 use super::grid::{PartialSet, SampleGrid};
 use super::normals::NormalSource;
+use super::shading::{self, ShadingGrid};
 use super::spline_surface::{Rect, two_pass};
 use crate::geom::ErbsSurface;
 use crate::geom::knots::KnotVector;
@@ -34,6 +35,9 @@ pub struct ErbsSurfaceSampler {
     terms: Vec<Vec<BlendTerm>>,
     patches: Vec<LocalPatch>,
     grid: SampleGrid,
+    /// Reused buffer for an edit's change of one patch's samples: a fresh allocation of that
+    /// size is mapped and zeroed by the kernel on every edit.
+    scratch: Vec<DVec3>,
 }
 
 impl ErbsSurfaceSampler {
@@ -107,6 +111,7 @@ impl ErbsSurfaceSampler {
             terms,
             patches,
             grid,
+            scratch: Vec::new(),
         };
         s.full();
         s
@@ -130,8 +135,10 @@ impl ErbsSurfaceSampler {
         self.grid.data.fill(DVec3::ZERO);
         for idx in 0..self.patches.len() {
             self.sample_patch(idx);
-            let delta = self.patches[idx].samples.clone();
+            // The patch's samples are the whole delta; lent out instead of cloned.
+            let delta = std::mem::take(&mut self.patches[idx].samples);
             self.blend_in(idx, &delta);
+            self.patches[idx].samples = delta;
         }
         let [mu, mv] = self.grid.dims;
         self.update_normals(0..mu, 0..mv);
@@ -145,6 +152,20 @@ impl ErbsSurfaceSampler {
         let nv = self.surface.count()[1];
         let patch = self.surface.local_patch(idx / nv, idx % nv);
         let p = &mut self.patches[idx];
+        let [tu, tv] = &p.tables;
+        if self.grid.partials == PartialSet::Shading
+            && shading::surface_supported([tu.degree(), tv.degree()])
+        {
+            let out = ShadingGrid {
+                data: &mut p.samples,
+                normals: None,
+                width: p.cols.len(),
+            };
+            let (rows, cols) = (0..p.rows.len(), 0..p.cols.len());
+            let nv = patch.count()[1];
+            shading::sample_surface(tu, tv, patch.points(), nv, rows, cols, out, &mut Vec::new());
+            return;
+        }
         let rect = Rect {
             rows: p.rows.clone(),
             cols: p.cols.clone(),
@@ -170,17 +191,23 @@ impl ErbsSurfaceSampler {
         let idx = k * self.surface.count()[1] + l;
         let stride = self.partials.len();
         let p = &mut self.patches[idx];
-        let mut delta = vec![DVec3::ZERO; p.samples.len()];
-        for (n, (d, s)) in delta.iter_mut().zip(p.samples.iter_mut()).enumerate() {
-            let moved = if n % stride == 0 {
-                a.transform_point3(*s)
-            } else {
-                a.transform_vector3(*s)
-            };
-            *d = moved - *s;
-            *s = moved;
+        let mut delta = std::mem::take(&mut self.scratch);
+        delta.resize(p.samples.len(), DVec3::ZERO);
+        let samples = p.samples.chunks_exact_mut(stride);
+        for (d, s) in delta.chunks_exact_mut(stride).zip(samples) {
+            for (q, (d, s)) in d.iter_mut().zip(s).enumerate() {
+                let moved = if q == 0 {
+                    a.transform_point3(*s)
+                } else {
+                    a.transform_vector3(*s)
+                };
+                *d = moved - *s;
+                *s = moved;
+            }
         }
-        self.finish(idx, &delta)
+        let region = self.finish(idx, &delta);
+        self.scratch = delta;
+        region
     }
 
     /// Moves control point (qa, qb) of local patch (k, l): Δs^(ab) = Mu[a][qa] Mv[b][qb] Δ.
@@ -197,7 +224,8 @@ impl ErbsSurfaceSampler {
         let stride = self.partials.len();
         let p = &mut self.patches[idx];
         let width = p.cols.len();
-        let mut d = vec![DVec3::ZERO; p.samples.len()];
+        let mut d = std::mem::take(&mut self.scratch);
+        d.resize(p.samples.len(), DVec3::ZERO);
         for li in 0..p.rows.len() {
             for lj in 0..width {
                 let base = (li * width + lj) * stride;
@@ -209,7 +237,9 @@ impl ErbsSurfaceSampler {
                 }
             }
         }
-        self.finish(idx, &d)
+        let region = self.finish(idx, &d);
+        self.scratch = d;
+        region
     }
 
     /// Sets every control point of local patch (k, l) exactly (samples move by the differences).
@@ -250,6 +280,36 @@ impl ErbsSurfaceSampler {
         let stride = self.partials.len();
         let mv = self.grid.dims[1];
         let width = p.cols.len();
+        if self.grid.partials == PartialSet::Shading {
+            // The Leibniz terms of S, Su, Sv written out (the generic loop below with its
+            // terms in the same order, up to the sign of an exact zero): no per-sample term
+            // lists and slices.
+            let wv: Vec<[f64; 2]> = p
+                .cols
+                .clone()
+                .map(|j| {
+                    let w = self.axes[1].weights(j, l);
+                    [w[0], w[1]]
+                })
+                .collect();
+            for (i, d) in p.rows.clone().zip(delta.chunks_exact(width * 3)) {
+                let wu = self.axes[0].weights(i, k);
+                let (wu0, wu1) = (wu[0], wu[1]);
+                let out =
+                    &mut self.grid.data[(i * mv + p.cols.start) * 3..(i * mv + p.cols.end) * 3];
+                let (out, d) = (out.as_chunks_mut::<3>().0, d.as_chunks::<3>().0);
+                for ((o, d), &[wv0, wv1]) in out.iter_mut().zip(d).zip(&wv) {
+                    let w00 = wu0 * wv0;
+                    o[0] += d[0] * w00;
+                    o[1] += d[0] * (wu1 * wv0) + d[1] * w00;
+                    o[2] += d[0] * (wu0 * wv1) + d[2] * w00;
+                }
+            }
+            return DirtyRegion::Surface {
+                rows: p.rows.clone(),
+                cols: p.cols.clone(),
+            };
+        }
         for i in p.rows.clone() {
             let wu = self.axes[0].weights(i, k);
             for j in p.cols.clone() {

@@ -15,6 +15,7 @@ pub mod grid;
 pub mod normals;
 pub mod object;
 pub mod rational;
+mod shading;
 pub mod spline_curve;
 pub mod spline_surface;
 

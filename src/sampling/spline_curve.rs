@@ -4,6 +4,7 @@ use super::axis::HermiteTable;
 use super::dirty::DirtyRegion;
 use super::grid::{PartialSet, SampleGrid};
 use super::rational::QuotientRule;
+use super::shading;
 use crate::geom::BSplineCurve;
 use crate::geom::point::to_homogeneous;
 use glam::{DVec3, DVec4};
@@ -62,6 +63,14 @@ impl SplineCurveSampler {
     pub fn rebuild(&mut self, range: Range<usize>) -> DirtyRegion {
         let g = self.grid.stride();
         match &mut self.hom {
+            None if g == 2 && shading::curve_supported(self.curve.degree()) => {
+                shading::sample_curve(
+                    &self.table,
+                    self.curve.points(),
+                    range.clone(),
+                    &mut self.grid.data,
+                );
+            }
             None => {
                 let pts = self.curve.points();
                 for j in range.clone() {
@@ -134,6 +143,10 @@ impl SplineCurveSampler {
 
     fn add_polynomial(&mut self, k: usize, delta: DVec3) {
         let g = self.grid.stride();
+        if g == 2 && self.table.degree() >= 1 {
+            shading::translate_curve(&self.table, k, delta, &mut self.grid.data);
+            return;
+        }
         let rows = g.min(self.table.degree() + 1);
         for j in self.table.range(k) {
             let col = k - self.table.first(j);

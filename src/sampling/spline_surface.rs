@@ -5,6 +5,7 @@ use super::dirty::DirtyRegion;
 use super::grid::{PartialSet, SampleGrid};
 use super::normals::NormalSource;
 use super::rational::QuotientRule;
+use super::shading::{self, ShadingGrid};
 use super::spline_curve::dot;
 use crate::geom::TensorSurface;
 use crate::geom::point::to_homogeneous;
@@ -82,6 +83,22 @@ impl SplineSurfaceSampler {
     /// (S_ab = Q_a·M_v[b]ᵀ) — (d+1) products per output instead of (d+1)².
     pub fn rebuild(&mut self, rows: Range<usize>, cols: Range<usize>) -> DirtyRegion {
         let nv = self.surface.count()[1];
+        if self.fast_shading() && shading::surface_supported(self.surface.degree()) {
+            let mut degenerate = Vec::new();
+            let [tu, tv] = &self.tables;
+            shading::sample_surface(
+                tu,
+                tv,
+                self.surface.points(),
+                nv,
+                rows.clone(),
+                cols.clone(),
+                shading_grid(&mut self.grid),
+                &mut degenerate,
+            );
+            self.resolve_degenerate(&degenerate);
+            return DirtyRegion::Surface { rows, cols };
+        }
         let stride = self.grid.stride();
         let mv = self.grid.dims[1];
         let [tu, tv] = &self.tables;
@@ -130,6 +147,19 @@ impl SplineSurfaceSampler {
     /// Moves control point (k, l): S_ij += M_u[i][·][k] M_v[j][·][l] Δ over I_k × I_l only.
     pub fn translate_point(&mut self, k: usize, l: usize, delta: DVec3) -> DirtyRegion {
         self.surface.translate_point(k, l, delta);
+        if self.fast_shading() {
+            let mut degenerate = Vec::new();
+            let [tu, tv] = &self.tables;
+            let (rows, cols) = shading::translate_surface(
+                [tu, tv],
+                [k, l],
+                delta,
+                shading_grid(&mut self.grid),
+                &mut degenerate,
+            );
+            self.resolve_degenerate(&degenerate);
+            return DirtyRegion::Surface { rows, cols };
+        }
         match self.surface.weights() {
             None => {
                 let (rows, cols) = (self.tables[0].range(k), self.tables[1].range(l));
@@ -209,12 +239,37 @@ impl SplineSurfaceSampler {
         DirtyRegion::Surface { rows, cols }
     }
 
+    /// Whether the `shading` kernels apply: a polynomial surface of degree ≥ 1 both ways on a
+    /// `Shading` grid with normals (what the renderer asks for).
+    fn fast_shading(&self) -> bool {
+        !self.surface.is_rational()
+            && self.grid.partials == PartialSet::Shading
+            && self.grid.normals.is_some()
+            && self.surface.degree().iter().all(|&d| d >= 1)
+    }
+
+    fn resolve_degenerate(&mut self, samples: &[(usize, usize)]) {
+        let params = [
+            self.tables[0].params.as_slice(),
+            self.tables[1].params.as_slice(),
+        ];
+        super::normals::resolve_degenerate(&mut self.grid, samples, params, &self.surface);
+    }
+
     fn update_normals(&mut self, rows: Range<usize>, cols: Range<usize>) {
         let params = [
             self.tables[0].params.as_slice(),
             self.tables[1].params.as_slice(),
         ];
         super::normals::update(&mut self.grid, rows, cols, params, &self.surface);
+    }
+}
+
+fn shading_grid(grid: &mut SampleGrid) -> ShadingGrid<'_> {
+    ShadingGrid {
+        data: &mut grid.data,
+        normals: Some(grid.normals.as_mut().expect("shading grids keep normals")),
+        width: grid.dims[1],
     }
 }
 
