@@ -10,7 +10,7 @@ use crate::gpu::{
     FRAMES_IN_FLIGHT, Frame, GpuResult, GridShape, Mirror, PointRun, PointStyle, PolylineStyle,
     Renderer, SurfaceGrid, SurfaceStyle,
 };
-use crate::sampling::{DirtyRegion, DirtySet};
+use crate::sampling::{DirtyRegion, DirtySet, ModelRef};
 use crate::scene::{Edit, EditOp, Index2};
 use glam::DVec3;
 
@@ -119,9 +119,35 @@ impl GpuScene {
             | EditOp::SetLocalPoints { local, .. } => Some(*local),
             _ => None,
         };
-        match local {
-            Some(l) => self.note_local(doc, edit.object, l),
-            None => self.note_controls(doc, edit.object),
+        match (local, &edit.op) {
+            (Some(l), _) => self.note_local(doc, edit.object, l),
+            (None, EditOp::TranslatePoint { point, .. } | EditOp::SetPoint { point, .. }) => {
+                self.note_point(doc, edit.object, *point)
+            }
+            // A weight moves no control point.
+            (None, EditOp::SetWeight { .. }) => {}
+            (None, _) => self.note_controls(doc, edit.object),
+        }
+    }
+
+    /// Updates one control point's three floats (a drag must not copy a 10 000-point net).
+    fn note_point(&mut self, doc: &Document, object: usize, point: Index2) {
+        let o = &mut self.objects[object];
+        let (index, p) = match (&o.layout, doc.objects[object].sampled.model()) {
+            (ControlLayout::Polygon { .. }, ModelRef::Curve(c)) => match point {
+                Index2::One(k) => (k, c.points()[k]),
+                Index2::Two(..) => return,
+            },
+            (ControlLayout::Net { cols, .. }, ModelRef::Surface(s)) => match point {
+                Index2::Two(i, j) => (i * cols + j, s.point(i, j)),
+                Index2::One(_) => return,
+            },
+            _ => return self.note_controls(doc, object),
+        };
+        let r = index * 3..index * 3 + 3;
+        o.controls_cache[r.clone()].copy_from_slice(&[p.x as f32, p.y as f32, p.z as f32]);
+        for d in &mut o.controls_dirty {
+            d.insert(r.clone());
         }
     }
 

@@ -197,12 +197,14 @@ impl Session {
             return ApplyStats::default();
         }
         let start = Instant::now();
-        let edits = if self.merge {
-            merge_edits(&self.pending)
+        // One edit per frame (a drag) is the common case: nothing to merge.
+        let edits = if self.merge && self.pending.len() > 1 {
+            let merged = merge_edits(&self.pending);
+            self.pending.clear();
+            merged
         } else {
-            self.pending.clone()
+            std::mem::take(&mut self.pending)
         };
-        self.pending.clear();
         let mut samples = 0;
         let mut edited = Vec::new();
         for e in &edits {
