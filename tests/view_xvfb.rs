@@ -40,8 +40,7 @@ const SCRIPT: &str = r#"[
 
 #[test]
 fn scripted_session_saves_exact_edits_and_matches_the_golden() {
-    if std::env::var_os("DISPLAY").is_none_or(|d| d.is_empty()) {
-        eprintln!("skipped: DISPLAY is not set (make test runs this under Xvfb)");
+    if !display() {
         return;
     }
     let dir = std::env::temp_dir().join(format!("prespline-view-{}", std::process::id()));
@@ -50,11 +49,7 @@ fn scripted_session_saves_exact_edits_and_matches_the_golden() {
     let saved = dir.join("saved.json");
     let script = dir.join("script.json");
     std::fs::write(&script, SCRIPT.replace("SHOT", shot.to_str().unwrap())).unwrap();
-    let icd = prespline::gpu::LAVAPIPE_ICD;
-    let out = Command::new(env!("CARGO_BIN_EXE_prespline"))
-        .env("VK_DRIVER_FILES", icd)
-        .env("VK_ICD_FILENAMES", icd)
-        .env("PRESPLINE_VALIDATION", "1")
+    let out = prespline()
         .args(["view", "--size", "960x600", "--script"])
         .arg(&script)
         .arg("--save-as")
@@ -101,4 +96,90 @@ fn scripted_session_saves_exact_edits_and_matches_the_golden() {
 
     let pixels = Pixels::read_png(&shot).unwrap();
     common::assert_golden("view_session", &pixels, 2, 0.002);
+}
+
+fn display() -> bool {
+    let ok = std::env::var_os("DISPLAY").is_some_and(|d| !d.is_empty());
+    if !ok {
+        eprintln!("skipped: DISPLAY is not set (make test runs this under Xvfb)");
+    }
+    ok
+}
+
+fn prespline() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_prespline"));
+    let icd = prespline::gpu::LAVAPIPE_ICD;
+    c.env("VK_DRIVER_FILES", icd)
+        .env("VK_ICD_FILENAMES", icd)
+        .env("PRESPLINE_VALIDATION", "1");
+    c
+}
+
+#[test]
+fn view_profile_writes_the_reports_when_the_window_closes() {
+    if !display() {
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("prespline-view-profile-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let script = dir.join("script.json");
+    std::fs::write(&script, r#"[{"frame": 2, "move": [300, 200]}, {"frame": 3, "wheel": 1}, {"frame": 8, "quit": true}]"#).unwrap();
+    let example =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/bspline_surface.json");
+    let out = prespline()
+        .arg("view")
+        .arg(&example)
+        .args(["--size", "320x240", "--script"])
+        .arg(&script)
+        .arg("--profile")
+        .arg(dir.join("profile"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("profile of"), "{err}");
+    for f in [
+        "frames.csv",
+        "summary.json",
+        "summary.txt",
+        "trace.json",
+        "frame_times.svg",
+        "histogram.svg",
+    ] {
+        assert!(dir.join("profile").join(f).is_file(), "{f} missing: {err}");
+    }
+}
+
+#[test]
+fn bench_runs_in_a_window() {
+    if !display() {
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("prespline-bench-window-{}", std::process::id()));
+    let out = prespline()
+        .args([
+            "bench",
+            "--window",
+            "--scenario",
+            "drag",
+            "--frames",
+            "5",
+            "--warmup",
+            "4",
+            "--size",
+            "320x200",
+            "--out",
+        ])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let csv = std::fs::read_to_string(dir.join("frames.csv")).unwrap();
+    assert_eq!(
+        csv.lines().count(),
+        1 + 9,
+        "header + warm-up + measured frames:\n{csv}"
+    );
+    assert!(dir.join("frame_times.svg").is_file());
 }

@@ -4,7 +4,7 @@ use super::basis::hermite_into;
 use super::bspline::BSplineCurve;
 use super::error::{GeomError, GeomResult};
 use super::knots::KnotVector;
-use super::point::{Point, rational_curve_derivs, to_homogeneous};
+use super::point::{Point, homogeneous, rational_curve_derivs};
 use glam::{DVec3, DVec4};
 
 /// A Bézier curve C(t) = Σ C_i B^n_i((t−a)/(b−a)), t ∈ [a, b]; with weights it is rational and
@@ -95,15 +95,7 @@ impl BezierCurve {
 
     /// Homogeneous control points (w_i C_i, w_i); weight 1 for polynomial curves.
     pub fn homogeneous_points(&self) -> Vec<DVec4> {
-        match &self.weights {
-            Some(w) => self
-                .points
-                .iter()
-                .zip(w)
-                .map(|(&p, &w)| to_homogeneous(p, w))
-                .collect(),
-            None => self.points.iter().map(|p| p.extend(1.0)).collect(),
-        }
+        homogeneous(&self.points, self.weights.as_deref())
     }
 
     fn local(&self, t: f64) -> f64 {

@@ -4,7 +4,7 @@ use super::basis::hermite_into;
 use super::bezier::{check_points, check_weights, combine_rows};
 use super::error::{GeomError, GeomResult};
 use super::knots::KnotVector;
-use super::point::{Point, rational_curve_derivs, to_homogeneous};
+use super::point::{Point, homogeneous, rational_curve_derivs};
 use glam::{DVec3, DVec4};
 
 /// c(t) = Σ c_i b_{d,i}(t) on [t_d, t_n]; with weights a NURBS curve evaluated in homogeneous
@@ -103,15 +103,7 @@ impl BSplineCurve {
 
     /// Homogeneous control points (w_i c_i, w_i); weight 1 for polynomial curves.
     pub fn homogeneous_points(&self) -> Vec<DVec4> {
-        match &self.weights {
-            Some(w) => self
-                .points
-                .iter()
-                .zip(w)
-                .map(|(&p, &w)| to_homogeneous(p, w))
-                .collect(),
-            None => self.points.iter().map(|p| p.extend(1.0)).collect(),
-        }
+        homogeneous(&self.points, self.weights.as_deref())
     }
 
     /// c(t) by de Boor's algorithm.

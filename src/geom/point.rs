@@ -43,6 +43,18 @@ pub fn to_homogeneous(p: DVec3, w: f64) -> DVec4 {
     (p * w).extend(w)
 }
 
+/// Homogeneous control points (w_i P_i, w_i); weight 1 for polynomial objects.
+pub fn homogeneous(points: &[DVec3], weights: Option<&[f64]>) -> Vec<DVec4> {
+    match weights {
+        Some(w) => points
+            .iter()
+            .zip(w)
+            .map(|(&p, &w)| to_homogeneous(p, w))
+            .collect(),
+        None => points.iter().map(|p| p.extend(1.0)).collect(),
+    }
+}
+
 /// Binomial coefficient C(n, k) as f64 (exact for the small n used in derivative rules).
 pub fn binomial(n: usize, k: usize) -> f64 {
     if k > n {

@@ -6,7 +6,7 @@ use super::bezier::{check_points, check_weights};
 use super::bspline::de_boor;
 use super::error::{GeomError, GeomResult};
 use super::knots::KnotVector;
-use super::point::{binomial, to_homogeneous};
+use super::point::{binomial, homogeneous, to_homogeneous};
 use glam::{DVec3, DVec4};
 
 /// S(u,v) = Σ_i Σ_j P_ij N_i(u) N_j(v). Control points are row-major, `points[i * nv + j]`, with
@@ -179,15 +179,7 @@ impl TensorSurface {
 
     /// Homogeneous control points (w P, w), row-major.
     pub fn homogeneous_points(&self) -> Vec<DVec4> {
-        match &self.weights {
-            Some(w) => self
-                .points
-                .iter()
-                .zip(w)
-                .map(|(&p, &w)| to_homogeneous(p, w))
-                .collect(),
-            None => self.points.iter().map(|p| p.extend(1.0)).collect(),
-        }
+        homogeneous(&self.points, self.weights.as_deref())
     }
 
     /// Parameter domains [(u0, u1), (v0, v1)].

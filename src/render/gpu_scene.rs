@@ -339,17 +339,7 @@ impl GpuScene {
                 )?;
             }
             ControlLayout::Net { rows, cols } if nets => {
-                for r in 0..*rows {
-                    polyline(frame, &o.controls, PointRun::grid_row(0, *cols, 3, r), &net)?;
-                }
-                for c in 0..*cols {
-                    polyline(
-                        frame,
-                        &o.controls,
-                        PointRun::grid_column(0, *rows, *cols, 3, c),
-                        &net,
-                    )?;
-                }
+                control_net(frame, &o.controls, 0, *rows, *cols, &net)?;
                 let pick = |h: Handle| match h {
                     Handle::Point {
                         point: Index2::Two(a, b),
@@ -431,17 +421,7 @@ impl GpuScene {
                         frame.draw_wire(&o.controls, sg, (k - 1) / 2, color)?;
                     }
                     if nets || chosen {
-                        for r in 0..nr {
-                            polyline(frame, &o.controls, PointRun::grid_row(po, nc, 3, r), &net)?;
-                        }
-                        for c in 0..nc {
-                            polyline(
-                                frame,
-                                &o.controls,
-                                PointRun::grid_column(po, nr, nc, 3, c),
-                                &net,
-                            )?;
-                        }
+                        control_net(frame, &o.controls, po, nr, nc, &net)?;
                         let pick = |h: Handle| match h {
                             Handle::LocalPoint {
                                 local: l,
@@ -475,6 +455,30 @@ impl GpuScene {
             renderer.destroy_mirror(o.controls);
         }
     }
+}
+
+/// A `rows × cols` control net stored row-major from float `base`: every row and column as a
+/// polyline, columns read with a stride (no copies).
+fn control_net(
+    frame: &mut Frame<'_>,
+    m: &Mirror,
+    base: usize,
+    rows: usize,
+    cols: usize,
+    style: &PolylineStyle,
+) -> GpuResult<()> {
+    for r in 0..rows {
+        polyline(frame, m, PointRun::grid_row(base, cols, 3, r), style)?;
+    }
+    for c in 0..cols {
+        polyline(
+            frame,
+            m,
+            PointRun::grid_column(base, rows, cols, 3, c),
+            style,
+        )?;
+    }
+    Ok(())
 }
 
 /// Polylines need two points; degree-0 local curves have one.

@@ -24,23 +24,30 @@ pub fn update(
     if grid.partials == PartialSet::Shading {
         return update_shading(grid, rows, cols, params, model);
     }
+    let (stride, (iu, iv)) = (grid.partials.len(), first_partial_slots(grid));
     let Some(normals) = grid.normals.as_mut() else {
         return;
     };
-    let stride = grid.partials.len();
-    let (iu, iv) = (
-        grid.partials.index(1, 0).expect("normals need Su"),
-        grid.partials.index(0, 1).expect("normals need Sv"),
-    );
     let mv = grid.dims[1];
+    let mut degenerate = Vec::new();
     for i in rows {
         for j in cols.clone() {
             let base = (i * mv + j) * stride;
-            let (su, sv) = (grid.data[base + iu], grid.data[base + iv]);
-            normals[i * mv + j] = regular_normal(su, sv)
-                .unwrap_or_else(|| fallback(su, sv, params[0][i], params[1][j], model));
+            match regular_normal(grid.data[base + iu], grid.data[base + iv]) {
+                Some(n) => normals[i * mv + j] = n,
+                None => degenerate.push((i, j)),
+            }
         }
     }
+    resolve_degenerate(grid, &degenerate, params, model);
+}
+
+/// Storage slots of Su and Sv.
+fn first_partial_slots(grid: &SampleGrid) -> (usize, usize) {
+    (
+        grid.partials.index(1, 0).expect("normals need Su"),
+        grid.partials.index(0, 1).expect("normals need Sv"),
+    )
 }
 
 /// [`update`] for `Shading` grids (S, Su, Sv per sample), a row segment at a time through the
@@ -78,14 +85,10 @@ pub(crate) fn resolve_degenerate(
     if samples.is_empty() {
         return;
     }
+    let (stride, (iu, iv)) = (grid.partials.len(), first_partial_slots(grid));
     let Some(normals) = grid.normals.as_mut() else {
         return;
     };
-    let stride = grid.partials.len();
-    let (iu, iv) = (
-        grid.partials.index(1, 0).expect("normals need Su"),
-        grid.partials.index(0, 1).expect("normals need Sv"),
-    );
     let mv = grid.dims[1];
     for &(i, j) in samples {
         let base = (i * mv + j) * stride;

@@ -115,20 +115,7 @@ fn parse_object(i: usize, v: &Value) -> Result<SceneObject, SceneError> {
                 as_usize(&at, "degree", "degree[1]", &dv[1])?,
             ];
             check_degree(&at, "degree", degree[0].max(degree[1]))?;
-            let kv = as_array(&at, "knots", require(&at, obj, "knots")?)?;
-            if kv.len() != 2 {
-                return Err(at.err(
-                    "knots",
-                    format!(
-                        "expected [[u knots], [v knots]], found {} entries",
-                        kv.len()
-                    ),
-                ));
-            }
-            let knots = [
-                as_f64_list(&at, "knots", "u knot", &kv[0])?,
-                as_f64_list(&at, "knots", "v knot", &kv[1])?,
-            ];
+            let knots = knot_pair(&at, obj)?;
             let (count, points) = point_grid(&at, "points", require(&at, obj, "points")?)?;
             let weights = weight_grid(&at, obj, count)?;
             let s = TensorSurface::bspline(degree, knots, count, points, weights)
@@ -137,20 +124,7 @@ fn parse_object(i: usize, v: &Value) -> Result<SceneObject, SceneError> {
         }
         "erbs_surface" => {
             check_fields(&at, obj, &fields(&["knots", "local", "bfunction"]))?;
-            let kv = as_array(&at, "knots", require(&at, obj, "knots")?)?;
-            if kv.len() != 2 {
-                return Err(at.err(
-                    "knots",
-                    format!(
-                        "expected [[u knots], [v knots]], found {} entries",
-                        kv.len()
-                    ),
-                ));
-            }
-            let knots = [
-                as_f64_list(&at, "knots", "u knot", &kv[0])?,
-                as_f64_list(&at, "knots", "v knot", &kv[1])?,
-            ];
+            let knots = knot_pair(&at, obj)?;
             let (count, patches) = as_grid(&at, "local", require(&at, obj, "local")?, |idx, v| {
                 local_patch(&at, &format!("local{idx}"), v)
             })?;
@@ -187,6 +161,24 @@ fn opt<'a>(obj: &'a Map<String, Value>, field: &str) -> Option<&'a Value> {
 
 fn geom(at: &At, e: GeomError) -> SceneError {
     at.err(e.field, e.message)
+}
+
+/// `[[u knots], [v knots]]` of a surface.
+fn knot_pair(at: &At, obj: &Map<String, Value>) -> Result<[Vec<f64>; 2], SceneError> {
+    let kv = as_array(at, "knots", require(at, obj, "knots")?)?;
+    if kv.len() != 2 {
+        return Err(at.err(
+            "knots",
+            format!(
+                "expected [[u knots], [v knots]], found {} entries",
+                kv.len()
+            ),
+        ));
+    }
+    Ok([
+        as_f64_list(at, "knots", "u knot", &kv[0])?,
+        as_f64_list(at, "knots", "v knot", &kv[1])?,
+    ])
 }
 
 fn check_degree(at: &At, field: &str, degree: usize) -> Result<(), SceneError> {
