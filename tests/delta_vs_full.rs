@@ -57,7 +57,11 @@ fn delta_equals_full_for_every_kind_and_mode() {
     for kind in Kind::ALL {
         for seed in 0..40u64 {
             let (scene, edits) = case(kind, seed * 7 + kind as u64, 300, 20);
-            for mode in [SampleMode::Derivatives(2), SampleMode::Render] {
+            for mode in [
+                SampleMode::Derivatives(0),
+                SampleMode::Derivatives(2),
+                SampleMode::Render,
+            ] {
                 let (err, nerr) = delta_error(&scene, &edits, mode, None);
                 worst = worst.max(err);
                 assert!(

@@ -24,6 +24,9 @@ pub fn update(
     if grid.partials == PartialSet::Shading {
         return update_shading(grid, rows, cols, params, model);
     }
+    if grid.normals.is_none() {
+        return;
+    }
     let (stride, (iu, iv)) = (grid.partials.len(), first_partial_slots(grid));
     let Some(normals) = grid.normals.as_mut() else {
         return;
@@ -83,6 +86,9 @@ pub(crate) fn resolve_degenerate(
     model: &impl NormalSource,
 ) {
     if samples.is_empty() {
+        return;
+    }
+    if grid.normals.is_none() {
         return;
     }
     let (stride, (iu, iv)) = (grid.partials.len(), first_partial_slots(grid));
