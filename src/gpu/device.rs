@@ -280,6 +280,31 @@ impl Device {
         &self.raw
     }
 
+    /// Allocates memory for a resource through gpu-allocator (images are not linear, buffers
+    /// are). Fails once teardown has taken the allocator.
+    pub(crate) fn allocate(
+        &self,
+        name: &str,
+        requirements: vk::MemoryRequirements,
+        location: gpu_allocator::MemoryLocation,
+        linear: bool,
+    ) -> GpuResult<gpu_allocator::vulkan::Allocation> {
+        match self.allocator().as_mut() {
+            Some(a) => a
+                .allocate(&gpu_allocator::vulkan::AllocationCreateDesc {
+                    name,
+                    requirements,
+                    location,
+                    linear,
+                    allocation_scheme: gpu_allocator::vulkan::AllocationScheme::GpuAllocatorManaged,
+                })
+                .map_err(GpuError::from),
+            None => Err(GpuError::InvalidArgument(
+                "device is being destroyed".into(),
+            )),
+        }
+    }
+
     /// Locks the allocator. `None` only after [`Device::destroy`] started, which cannot be
     /// observed from safe code since `destroy` takes `self`.
     pub(crate) fn allocator(&self) -> MutexGuard<'_, Option<Allocator>> {

@@ -2,10 +2,10 @@
 
 use ash::vk;
 use gpu_allocator::MemoryLocation;
-use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+use gpu_allocator::vulkan::Allocation;
 
 use super::device::Device;
-use super::error::{GpuError, GpuResult, VkResultExt};
+use super::error::{GpuResult, VkResultExt};
 use super::pipeline::DEPTH_FORMAT;
 
 /// Parameters for [`Image::new`].
@@ -80,31 +80,15 @@ impl Image {
         let raw = unsafe { device.raw.create_image(&info, None) }.vk("vkCreateImage")?;
         // SAFETY: `raw` was just created from this device.
         let requirements = unsafe { device.raw.get_image_memory_requirements(raw) };
-        let allocation = {
-            let mut guard = device.allocator();
-            let result = match guard.as_mut() {
-                Some(a) => a
-                    .allocate(&AllocationCreateDesc {
-                        name: desc.name,
-                        requirements,
-                        location: MemoryLocation::GpuOnly,
-                        linear: false,
-                        allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-                    })
-                    .map_err(GpuError::from),
-                None => Err(GpuError::InvalidArgument(
-                    "device is being destroyed".into(),
-                )),
-            };
-            match result {
+        let allocation =
+            match device.allocate(desc.name, requirements, MemoryLocation::GpuOnly, false) {
                 Ok(a) => a,
                 Err(e) => {
                     // SAFETY: the image is unused and has no memory bound.
                     unsafe { device.raw.destroy_image(raw, None) };
                     return Err(e);
                 }
-            }
-        };
+            };
         let mut image = Self {
             raw,
             view: vk::ImageView::null(),

@@ -9,7 +9,7 @@ use std::ptr::NonNull;
 
 use ash::vk;
 use gpu_allocator::MemoryLocation;
-use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+use gpu_allocator::vulkan::Allocation;
 
 use super::device::Device;
 use super::error::{GpuError, GpuResult, VkResultExt};
@@ -154,29 +154,12 @@ impl Device {
             requirements.alignment = requirements.alignment.max(atom);
             requirements.size = requirements.size.div_ceil(atom) * atom;
         }
-        let allocation = {
-            let mut guard = self.allocator();
-            let result = match guard.as_mut() {
-                Some(a) => a
-                    .allocate(&AllocationCreateDesc {
-                        name: desc.name,
-                        requirements,
-                        location: desc.location,
-                        linear: true,
-                        allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-                    })
-                    .map_err(GpuError::from),
-                None => Err(GpuError::InvalidArgument(
-                    "device is being destroyed".into(),
-                )),
-            };
-            match result {
-                Ok(a) => a,
-                Err(e) => {
-                    // SAFETY: the buffer is unused and has no memory bound.
-                    unsafe { self.raw.destroy_buffer(raw, None) };
-                    return Err(e);
-                }
+        let allocation = match self.allocate(desc.name, requirements, desc.location, true) {
+            Ok(a) => a,
+            Err(e) => {
+                // SAFETY: the buffer is unused and has no memory bound.
+                unsafe { self.raw.destroy_buffer(raw, None) };
+                return Err(e);
             }
         };
         let mut buffer = Buffer {
