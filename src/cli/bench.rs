@@ -80,6 +80,9 @@ pub fn run(args: &BenchArgs) -> Result<String, CliError> {
         info = info.with("target", if args.window { "window" } else { "offscreen" });
         let paths = write_all(&dir, &info, &frames).map_err(|e| CliError(e.to_string()))?;
         written.extend(paths);
+        if !args.window {
+            written.push(dir.join("final.png"));
+        }
         summaries.push((mode, summary));
     }
     if let [(a, inc), (b, naive)] = summaries.as_slice() {
