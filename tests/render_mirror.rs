@@ -5,7 +5,7 @@
 mod common;
 
 use glam::{DMat4, DVec3};
-use prespline::gpu::{OffscreenDesc, Pixels, Renderer};
+use prespline::gpu::{OffscreenDesc, OffscreenTarget, Pixels, Renderer};
 use prespline::render::offscreen::{Shot, shot_camera};
 use prespline::render::{Document, GpuScene, Highlight, NetMode, ViewOptions, Wire};
 use prespline::scene::demo::demo_scene;
@@ -74,7 +74,7 @@ fn options() -> ViewOptions {
 
 fn draw_frame(
     renderer: &mut Renderer,
-    target: &mut prespline::gpu::OffscreenTarget,
+    target: &mut OffscreenTarget,
     gs: &mut GpuScene,
     doc: &Document,
     shot: &Shot,
@@ -89,29 +89,52 @@ fn draw_frame(
     stats.bytes
 }
 
-#[test]
-fn incremental_mirrors_end_identical_to_a_fresh_upload() {
-    let (mut renderer, sink) = common::renderer();
-    let mut doc = Document::new(&scene());
-    // A fixed camera so both renders frame the same view even though edits move the bounds.
+/// A shot with the camera fixed on the unedited document, so renders before and after edits
+/// frame the same view even though edits move the bounds.
+fn fixed_shot(doc: &Document, width: u32, height: u32) -> Shot {
     let base = Shot {
-        width: 480,
-        height: 320,
+        width,
+        height,
         camera: None,
         options: options(),
         msaa: 1,
     };
-    let shot = Shot {
-        camera: Some(shot_camera(&doc, &base)),
+    Shot {
+        camera: Some(shot_camera(doc, &base)),
         ..base
-    };
-    let mut target = renderer
+    }
+}
+
+fn offscreen(renderer: &mut Renderer, shot: &Shot) -> OffscreenTarget {
+    renderer
         .create_offscreen(&OffscreenDesc {
-            width: 480,
-            height: 320,
-            samples: 1,
+            width: shot.width,
+            height: shot.height,
+            samples: shot.msaa,
         })
-        .unwrap();
+        .unwrap()
+}
+
+/// One frame of `doc` through a freshly created (fully uploaded) GPU scene.
+fn fresh_render(
+    renderer: &mut Renderer,
+    target: &mut OffscreenTarget,
+    doc: &Document,
+    shot: &Shot,
+) -> Pixels {
+    let mut gs = GpuScene::new(renderer, doc).unwrap();
+    draw_frame(renderer, target, &mut gs, doc, shot);
+    let pixels = renderer.read_pixels(target).unwrap();
+    gs.destroy(renderer);
+    pixels
+}
+
+#[test]
+fn incremental_mirrors_end_identical_to_a_fresh_upload() {
+    let (mut renderer, sink) = common::renderer();
+    let mut doc = Document::new(&scene());
+    let shot = fixed_shot(&doc, 480, 320);
+    let mut target = offscreen(&mut renderer, &shot);
     let mut gs = GpuScene::new(&mut renderer, &doc).unwrap();
     let mut rng = Lcg(7);
     let mut uploaded = 0;
@@ -127,10 +150,7 @@ fn incremental_mirrors_end_identical_to_a_fresh_upload() {
     let incremental: Pixels = renderer.read_pixels(&target).unwrap();
     gs.destroy(&mut renderer);
 
-    let mut fresh_gs = GpuScene::new(&mut renderer, &doc).unwrap();
-    draw_frame(&mut renderer, &mut target, &mut fresh_gs, &doc, &shot);
-    let fresh = renderer.read_pixels(&target).unwrap();
-    fresh_gs.destroy(&mut renderer);
+    let fresh = fresh_render(&mut renderer, &mut target, &doc, &shot);
     renderer.destroy_offscreen(target).unwrap();
     common::teardown(renderer, sink);
 
@@ -158,24 +178,8 @@ fn a_missed_update_is_detected() {
     // Negative control: if one slot skipped its dirty rows the comparison must fail.
     let (mut renderer, sink) = common::renderer();
     let mut doc = Document::new(&scene());
-    let base = Shot {
-        width: 320,
-        height: 200,
-        camera: None,
-        options: options(),
-        msaa: 1,
-    };
-    let shot = Shot {
-        camera: Some(shot_camera(&doc, &base)),
-        ..base
-    };
-    let mut target = renderer
-        .create_offscreen(&OffscreenDesc {
-            width: 320,
-            height: 200,
-            samples: 1,
-        })
-        .unwrap();
+    let shot = fixed_shot(&doc, 320, 200);
+    let mut target = offscreen(&mut renderer, &shot);
     let mut gs = GpuScene::new(&mut renderer, &doc).unwrap();
     draw_frame(&mut renderer, &mut target, &mut gs, &doc, &shot);
     // Lift the centre of the B-spline surface but do not tell the GPU scene.
@@ -190,10 +194,7 @@ fn a_missed_update_is_detected() {
     draw_frame(&mut renderer, &mut target, &mut gs, &doc, &shot);
     let stale = renderer.read_pixels(&target).unwrap();
     gs.destroy(&mut renderer);
-    let mut fresh_gs = GpuScene::new(&mut renderer, &doc).unwrap();
-    draw_frame(&mut renderer, &mut target, &mut fresh_gs, &doc, &shot);
-    let fresh = renderer.read_pixels(&target).unwrap();
-    fresh_gs.destroy(&mut renderer);
+    let fresh = fresh_render(&mut renderer, &mut target, &doc, &shot);
     renderer.destroy_offscreen(target).unwrap();
     common::teardown(renderer, sink);
     assert_ne!(stale.rgba, fresh.rgba);
