@@ -258,6 +258,24 @@ fn scenes(seeds: &[u64], kinds: &[Kind], opts: &Options) -> Vec<Scene> {
         .collect()
 }
 
+/// One case per scene, no edits, derivative order 0..=2 by seed.
+fn unedited_cases<'a>(test: &'static str, seeds: &[u64], scenes: &'a [Scene]) -> Vec<Case<'a>> {
+    seeds
+        .iter()
+        .zip(scenes)
+        .map(|(&seed, scene)| Case {
+            test,
+            seed,
+            scene,
+            edits: None,
+            derivatives: (seed % 3) as usize,
+            explicit_derivatives: true,
+            full: false,
+            tolerance: TOL,
+        })
+        .collect()
+}
+
 #[test]
 fn curves_agree_with_oracle() {
     let seeds = seeds(60, 1);
@@ -270,21 +288,7 @@ fn curves_agree_with_oracle() {
         Kind::BSplineCurve,
     ];
     let scenes = scenes(&seeds, &kinds, &Options::default());
-    let cases = seeds
-        .iter()
-        .zip(&scenes)
-        .map(|(&seed, scene)| Case {
-            test: "curves",
-            seed,
-            scene,
-            edits: None,
-            derivatives: (seed % 3) as usize,
-            explicit_derivatives: true,
-            full: false,
-            tolerance: TOL,
-        })
-        .collect();
-    run_all("curves", cases);
+    run_all("curves", unedited_cases("curves", &seeds, &scenes));
 }
 
 #[test]
@@ -297,21 +301,7 @@ fn surfaces_agree_with_oracle() {
         Kind::BSplineSurface,
     ];
     let scenes = scenes(&seeds, &kinds, &Options::default());
-    let cases = seeds
-        .iter()
-        .zip(&scenes)
-        .map(|(&seed, scene)| Case {
-            test: "surfaces",
-            seed,
-            scene,
-            edits: None,
-            derivatives: (seed % 3) as usize,
-            explicit_derivatives: true,
-            full: false,
-            tolerance: TOL,
-        })
-        .collect();
-    run_all("surfaces", cases);
+    run_all("surfaces", unedited_cases("surfaces", &seeds, &scenes));
 }
 
 /// ERBS with derivative orders 3 and 4 (B-function derivatives of high order, full Leibniz
