@@ -4,8 +4,8 @@ use super::CliError;
 use crate::gpu::{Renderer, RendererDesc, ValidationMode};
 use crate::render::offscreen::{Shot, render_document};
 use crate::render::{Document, OrbitCamera, ViewOptions};
-use crate::scene::Scene;
 use crate::scene::edit::parse_edits;
+use crate::scene::{Scene, SceneError};
 use std::path::Path;
 use std::time::Instant;
 
@@ -48,7 +48,8 @@ pub fn load_document(scene_path: &Path, edits: Option<&Path>) -> Result<Document
         let text = std::fs::read_to_string(path)
             .map_err(|e| CliError(format!("cannot read {}: {e}", path.display())))?;
         for e in parse_edits(&text, &scene).map_err(|e| CliError::in_file(path, e))? {
-            doc.apply(&e);
+            doc.apply(&e)
+                .map_err(|err| CliError::in_file(path, SceneError(err.to_string())))?;
         }
     }
     Ok(doc)

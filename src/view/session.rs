@@ -8,15 +8,15 @@ use super::input::{InputEvent, Key, Modifiers, MouseButton};
 use super::picking::{PICK_RADIUS, Projected, pick, project_all};
 use super::script::Action;
 use super::tools::{Axis, Drag, Transform, TransformKind, View};
-use super::undo::{UndoStack, local_points};
+use super::undo::UndoStack;
 use crate::gpu::{Frame, GpuResult, Renderer};
+use crate::model::{Edit, Index2, merge_edits};
 use crate::render::overlays::overlay_lines;
 use crate::render::{
     Bounds, Document, GpuScene, Handle, Highlight, NetMode, OrbitCamera, Palette, UploadStats,
     ViewOptions, Wire,
 };
-use crate::scene::edit::merge_edits;
-use crate::scene::{Edit, EditOp, Index2, Scene};
+use crate::scene::Scene;
 use glam::{DMat4, DVec3};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -184,10 +184,19 @@ impl Session {
         self.view().project(world)
     }
 
-    /// Queues an edit for this frame, recording it for undo.
+    /// Queues an edit for this frame, recording it for undo. A structural edit is applied at
+    /// once, after what was queued before it: undo must capture the model each edit sees, and
+    /// the edits after a refinement address the refined net.
     pub fn queue(&mut self, edit: Edit) {
+        let structural = edit.edit.is_structural();
+        if structural {
+            self.apply_pending();
+        }
         self.undo.record(&self.doc, &edit);
         self.pending.push(edit);
+        if structural {
+            self.apply_pending();
+        }
     }
 
     /// Applies this frame's queued edits (merged per control point) through the delta path and
@@ -208,7 +217,14 @@ impl Session {
         let mut samples = 0;
         let mut edited = Vec::new();
         for e in &edits {
-            let region = self.doc.apply(e);
+            let region = match self.doc.apply(e) {
+                Ok(r) => r,
+                Err(err) => {
+                    let name = &self.doc.objects[e.object].name;
+                    self.set_status(format!("{name}: edit refused: {err}"));
+                    continue;
+                }
+            };
             if self.naive {
                 if !edited.contains(&e.object) {
                     edited.push(e.object);
@@ -368,8 +384,10 @@ impl Session {
                 self.mode = Mode::Pan;
             }
             Mode::Drag { handle, mut drag } => {
-                if let Some(inc) = drag.update(&self.view(), self.cursor) {
-                    self.queue(Document::move_handle(handle, inc));
+                if let Some(inc) = drag.update(&self.view(), self.cursor)
+                    && let Some(edit) = self.doc.move_handle(handle, inc)
+                {
+                    self.queue(edit);
                 }
                 self.mode = Mode::Drag { handle, drag };
             }
@@ -614,7 +632,9 @@ impl Session {
                 .into_iter()
                 .find(|(x, _)| *x == h)
                 .map(|(_, p)| p),
-            Target::Local(o, l) => local_points(self.doc.objects[o].sampled.model(), l)
+            Target::Local(o, l) => self
+                .doc
+                .local_points(o, l)
                 .map(|p| p.iter().sum::<DVec3>() / p.len() as f64),
         };
         let Some(pivot) = pivot else { return };
@@ -641,16 +661,13 @@ impl Session {
         }
         t.applied = total;
         let edit = match *target {
-            Target::Local(object, local) => Edit {
-                object,
-                op: EditOp::TransformLocal { local, matrix: inc },
-            },
-            Target::Point(h) => {
-                // A point only translates: the increment's translation part.
-                Document::move_handle(h, inc.w_axis.truncate())
-            }
+            Target::Local(object, local) => self.doc.transform_local(object, local, inc),
+            // A point only translates: the increment's translation part.
+            Target::Point(h) => self.doc.move_handle(h, inc.w_axis.truncate()),
         };
-        self.queue(edit);
+        if let Some(edit) = edit {
+            self.queue(edit);
+        }
     }
 
     fn confirm_transform(&mut self) {
@@ -721,9 +738,7 @@ impl Session {
 
     fn frame_selection(&mut self) {
         let points: Vec<DVec3> = match (self.selected_local, self.selected) {
-            (Some((o, l)), _) => {
-                local_points(self.doc.objects[o].sampled.model(), l).unwrap_or_default()
-            }
+            (Some((o, l)), _) => self.doc.local_points(o, l).unwrap_or_default(),
             (None, Some(h)) => self
                 .doc
                 .handles(h.object())
