@@ -127,6 +127,19 @@ impl<S: Sampler> Sampler for Tracked<S> {
     }
 }
 
+/// Applies `edit` if it is of the sampler's kind. Edits arrive validated; checking again costs
+/// a few comparisons and keeps a stale index (say, after an undone refinement) from ever
+/// reaching the kernels.
+fn apply_kind<S: Sampler>(
+    s: &mut Tracked<S>,
+    edit: &ObjectEdit,
+    model_type: &str,
+) -> Result<DirtyRegion, EditError> {
+    let e = S::Edit::from_object(edit).ok_or_else(|| edit_kind_mismatch(edit, model_type))?;
+    e.validate(s.model())?;
+    Ok(s.apply(e))
+}
+
 /// A scene object with pre-evaluation data and its canonical sample grid.
 #[derive(Debug, Clone)]
 pub enum SampledObject {
@@ -198,14 +211,12 @@ impl SampledObject {
         each_sampler!(self, s => s.params())
     }
 
-    /// Applies a validated edit through the delta path; returns the samples it touched
-    /// (including any periodic rebuild's). An edit of another kind is an error.
+    /// Applies an edit through the delta path; returns the samples it touched (including any
+    /// periodic rebuild's). An edit of another kind, or one that does not fit the model, is an
+    /// error and changes nothing.
     pub fn apply(&mut self, edit: &ObjectEdit) -> Result<DirtyRegion, EditError> {
         let name = self.type_name();
-        each_sampler!(self, s => {
-            let e = KindEdit::from_object(edit).ok_or_else(|| edit_kind_mismatch(edit, name))?;
-            Ok(s.apply(e))
-        })
+        each_sampler!(self, s => apply_kind(s, edit, name))
     }
 
     /// Exact re-evaluation of everything touched since the last rebuild (drift reset).
