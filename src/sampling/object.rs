@@ -235,3 +235,77 @@ impl SampledObject {
         a * b
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::{BSplineCurve, KnotVector, TensorSurface};
+    use crate::model::{CurveEdit, CurveModel, PointEdit, SplineForm, SurfaceEdit, SurfaceModel};
+    use glam::DVec3;
+
+    /// A mirror that copies exactly the rows each edit reports, as the GPU mirrors do, must equal
+    /// the grid after every edit.
+    fn mirror_follows(obj: &mut SampledObject, edits: &[ObjectEdit]) {
+        let stride = obj.grid().stride();
+        let cols = obj.grid().dims[1];
+        let mut mirror = obj.grid().data.clone();
+        let bits = |v: &[DVec3]| -> Vec<[u64; 3]> {
+            v.iter().map(|p| p.to_array().map(f64::to_bits)).collect()
+        };
+        for (k, e) in edits.iter().enumerate() {
+            let region = obj.apply(e).unwrap();
+            let rows = region.rows.start * cols * stride..region.rows.end * cols * stride;
+            mirror[rows.clone()].copy_from_slice(&obj.grid().data[rows]);
+            assert!(
+                bits(&mirror) == bits(&obj.grid().data),
+                "after edit {k}, a mirror fed the reported regions differs from the grid"
+            );
+        }
+    }
+
+    fn wiggle(k: usize) -> DVec3 {
+        let x = k as f64;
+        DVec3::new((x * 0.7).sin(), (x * 1.3).cos(), (x * 0.37).sin()) * 0.123_456_7
+    }
+
+    #[test]
+    fn apply_reports_what_the_periodic_rebuild_rewrote() {
+        // Edits at both ends of a curve and a surface; every 3rd edit rebuilds everything touched
+        // since the last rebuild, which rewrites the other end's samples with exact values.
+        let n = 12;
+        let pts = (0..n).map(|i| DVec3::new(i as f64, 0.0, 0.0)).collect();
+        let knots = KnotVector::clamped_uniform(3, n, 0.0, 1.0).into_vec();
+        let c = BSplineCurve::new(3, knots.clone(), pts, None).unwrap();
+        let m = CurveModel::new(SplineForm::BSpline, c, 200).unwrap();
+        for mode in [SampleMode::Render, SampleMode::Derivatives(2)] {
+            let mut obj = SampledObject::new(&Model::Curve(m.clone()), mode);
+            obj.set_rebuild_interval(Some(3));
+            let edits: Vec<ObjectEdit> = (0..40)
+                .map(|k| {
+                    let point = if k % 2 == 0 { 1 } else { n - 2 };
+                    let delta = wiggle(k);
+                    CurveEdit::Point(PointEdit::Move { point, delta }).into_object()
+                })
+                .collect();
+            mirror_follows(&mut obj, &edits);
+        }
+        let pts = (0..n * n)
+            .map(|k| DVec3::new((k / n) as f64, (k % n) as f64, 0.0))
+            .collect();
+        let knots2 = KnotVector::clamped_uniform(2, n, 0.0, 1.0).into_vec();
+        let s = TensorSurface::bspline([3, 2], [knots, knots2], [n, n], pts, None).unwrap();
+        let m = SurfaceModel::new(SplineForm::BSpline, s, [40, 30]).unwrap();
+        for mode in [SampleMode::Render, SampleMode::Derivatives(1)] {
+            let mut obj = SampledObject::new(&Model::Surface(m.clone()), mode);
+            obj.set_rebuild_interval(Some(3));
+            let edits: Vec<ObjectEdit> = (0..40)
+                .map(|k| {
+                    let point = if k % 2 == 0 { [1, 1] } else { [n - 2, n - 2] };
+                    let delta = wiggle(k);
+                    SurfaceEdit::Point(PointEdit::Move { point, delta }).into_object()
+                })
+                .collect();
+            mirror_follows(&mut obj, &edits);
+        }
+    }
+}
