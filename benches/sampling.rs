@@ -16,7 +16,7 @@ use prespline::model::{
 };
 use prespline::sampling::{SampleMode, SampledObject};
 use std::hint::black_box;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 const SURFACE_SAMPLES: usize = 512;
 const CURVE_SAMPLES: usize = 100_000;
@@ -82,9 +82,7 @@ fn rotation_about(centre: DVec3, angle: f64) -> DMat4 {
         * DMat4::from_translation(-centre)
 }
 
-/// The edit scenarios: (name, object, edit batch). Batches of point and local edits repeat as
-/// they are; a structural batch is an edit followed by its undo, so every iteration starts from
-/// the same net.
+/// The edit scenarios: (name, object, edit batch). Batches repeat as they are.
 fn scenarios() -> Vec<(&'static str, &'static str, Vec<ObjectEdit>)> {
     let mv = |i, j| {
         SurfaceEdit::Point(PointEdit::Move {
@@ -101,19 +99,6 @@ fn scenarios() -> Vec<(&'static str, &'static str, Vec<ObjectEdit>)> {
         ((state >> 33) % 100) as usize
     };
     let ten = (0..10).map(|_| mv(next(), next())).collect();
-    let surface = surface();
-    let with_undo = |e: SurfaceEdit| {
-        let Model::Surface(m) = &surface else {
-            unreachable!("the surface workload is a B-spline surface")
-        };
-        vec![e.inverse(m).into_object(), e.into_object()]
-    };
-    let insert = SurfaceEdit::InsertKnot {
-        dir: 0,
-        t: 0.5037,
-        times: 1,
-    };
-    let elevate = SurfaceEdit::ElevateDegree { by: [1, 0] };
     vec![
         ("interior point", "surface", vec![mv(50, 50)]),
         ("boundary point", "surface", vec![mv(0, 50)]),
@@ -140,16 +125,33 @@ fn scenarios() -> Vec<(&'static str, &'static str, Vec<ObjectEdit>)> {
                 .into_object(),
             ],
         ),
-        ("insert u knot + undo", "surface", {
-            let mut b = with_undo(insert);
-            b.reverse();
-            b
-        }),
-        ("elevate u degree + undo", "surface", {
-            let mut b = with_undo(elevate);
-            b.reverse();
-            b
-        }),
+    ]
+}
+
+/// Structural edits of the surface: (name, edit). Each is timed alone; its undo runs between
+/// iterations, untimed, so every iteration refines the same 100 × 100 net.
+fn structural() -> Vec<(&'static str, SurfaceEdit)> {
+    vec![
+        (
+            "insert u knot",
+            SurfaceEdit::InsertKnot {
+                dir: 0,
+                t: 0.5037,
+                times: 1,
+            },
+        ),
+        (
+            "insert v knot",
+            SurfaceEdit::InsertKnot {
+                dir: 1,
+                t: 0.5037,
+                times: 1,
+            },
+        ),
+        (
+            "elevate u degree",
+            SurfaceEdit::ElevateDegree { by: [1, 0] },
+        ),
     ]
 }
 
@@ -187,6 +189,27 @@ fn bench(c: &mut Criterion) {
                 for e in &batch {
                     black_box(obj.apply(e).expect("the bench's edits fit their objects"));
                 }
+            })
+        });
+    }
+    let surface = surface();
+    let Model::Surface(model) = &surface else {
+        unreachable!("the surface workload is a B-spline surface")
+    };
+    let mut obj = SampledObject::new(&surface, SampleMode::Render);
+    for (name, edit) in structural() {
+        let undo = edit.inverse(model).into_object();
+        let edit = edit.into_object();
+        g.bench_function(BenchmarkId::from_parameter(name), |b| {
+            b.iter_custom(|iters| {
+                let mut timed = Duration::ZERO;
+                for _ in 0..iters {
+                    let start = Instant::now();
+                    black_box(obj.apply(&edit).expect("valid refinement"));
+                    timed += start.elapsed();
+                    obj.apply(&undo).expect("valid undo");
+                }
+                timed
             })
         });
     }
@@ -240,6 +263,17 @@ fn summary() {
     }
 }
 
+fn structural_summary() {
+    println!("\n| structural edit (100 × 100 surface, 512² samples) | µs |");
+    println!("|---|---:|");
+    for (name, _) in structural() {
+        match mean_ns("edit", name) {
+            Some(ns) => println!("| {name} | {:.1} |", ns / 1e3),
+            None => println!("| {name} | not measured |"),
+        }
+    }
+}
+
 fn main() {
     let mut c = Criterion::default().configure_from_args();
     bench(&mut c);
@@ -248,5 +282,6 @@ fn main() {
     // leaves fresh estimates to summarise.
     if std::env::args().any(|a| a == "--bench") {
         summary();
+        structural_summary();
     }
 }

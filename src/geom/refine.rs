@@ -7,18 +7,22 @@
 //! running the curve algorithm on every line of the net in that direction: the knots and the
 //! coefficients are the same for every line.
 
-use super::point::binomial;
-use glam::DVec4;
+use super::point::{Point, binomial};
+use glam::{DVec3, DVec4};
 
-/// A B-spline in homogeneous form: degree, knots (n+d+1) and n homogeneous control points.
+/// A B-spline's degree, knots (n+d+1) and n control points of any vector type: homogeneous
+/// points for rational curves, or packs of several lines of a surface net refined together.
 #[derive(Debug, Clone, PartialEq)]
-pub struct HomSpline {
+pub struct Spline<P> {
     pub degree: usize,
     pub knots: Vec<f64>,
-    pub points: Vec<DVec4>,
+    pub points: Vec<P>,
 }
 
-impl HomSpline {
+/// Homogeneous control points (w·P, w).
+pub type HomSpline = Spline<DVec4>;
+
+impl<P> Spline<P> {
     /// [t_d, t_n].
     fn domain(&self) -> (f64, f64) {
         (self.knots[self.degree], self.knots[self.points.len()])
@@ -28,43 +32,92 @@ impl HomSpline {
 /// CurveKnotIns (NURBS Book A5.1, Böhm): inserts `t` `r` times. The caller checks that t lies
 /// in the domain and that the resulting multiplicity stays at most the degree.
 #[must_use]
-pub fn curve_knot_ins(c: &HomSpline, t: f64, r: usize) -> HomSpline {
-    if r == 0 {
-        return c.clone();
+pub fn curve_knot_ins<P: Point>(c: &Spline<P>, t: f64, r: usize) -> Spline<P> {
+    let plan = KnotInsertion::new(&c.knots, c.degree, c.points.len(), t, r);
+    let mut points = vec![P::default(); c.points.len() + r];
+    plan.apply(&c.points, &mut points, 1);
+    Spline {
+        degree: c.degree,
+        knots: plan.knots,
+        points,
     }
-    let p = c.degree;
-    let u = &c.knots;
-    let pw = &c.points;
-    let np = pw.len();
-    let k = find_span(u, p, np, t);
-    let s = u.iter().filter(|&&x| x == t).count();
-    let mut q = vec![DVec4::ZERO; np + r];
-    // Unaffected points keep their places (shifted by r after the affected block).
-    q[..=k - p].copy_from_slice(&pw[..=k - p]);
-    q[k - s + r..np + r].copy_from_slice(&pw[k - s..np]);
-    let keep = p + 1 - s;
-    let mut rw: Vec<DVec4> = (0..keep).map(|i| pw[k - p + i]).collect();
-    let mut l = k - p;
-    for j in 1..=r {
-        l = k - p + j;
-        for i in 0..keep - j {
-            let alpha = (t - u[l + i]) / (u[i + k + 1] - u[l + i]);
-            rw[i] = rw[i + 1] * alpha + rw[i] * (1.0 - alpha);
+}
+
+/// CurveKnotIns split in two: the new knots and the coefficients of the affected points
+/// depend on the knots alone, so every line of a surface net (or a whole row of lines at once)
+/// reuses them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct KnotInsertion {
+    /// The refined knot vector.
+    pub knots: Vec<f64>,
+    /// FindSpan of t, t's multiplicity before, the degree and the insertion count.
+    k: usize,
+    s: usize,
+    p: usize,
+    r: usize,
+    /// Per step j = 1..=r, the α of the points i = 0..keep−j of the affected block.
+    alphas: Vec<Vec<f64>>,
+}
+
+impl KnotInsertion {
+    #[must_use]
+    pub fn new(u: &[f64], p: usize, n: usize, t: f64, r: usize) -> Self {
+        let k = find_span(u, p, n, t);
+        let s = u.iter().filter(|&&x| x == t).count();
+        let keep = (p + 1).saturating_sub(s);
+        let alphas = (1..=r)
+            .map(|j| {
+                let l = k - p + j;
+                (0..keep.saturating_sub(j))
+                    .map(|i| (t - u[l + i]) / (u[i + k + 1] - u[l + i]))
+                    .collect()
+            })
+            .collect();
+        let mut knots = Vec::with_capacity(u.len() + r);
+        knots.extend_from_slice(&u[..=k]);
+        knots.extend(std::iter::repeat_n(t, r));
+        knots.extend_from_slice(&u[k + 1..]);
+        Self {
+            knots,
+            k,
+            s,
+            p,
+            r,
+            alphas,
         }
-        q[l] = rw[0];
-        q[k + r - j - s] = rw[keep - j - 1];
     }
-    if l + 1 < k - s {
-        q[l + 1..k - s].copy_from_slice(&rw[1..k - s - l]);
-    }
-    let mut knots = Vec::with_capacity(u.len() + r);
-    knots.extend_from_slice(&u[..=k]);
-    knots.extend(std::iter::repeat_n(t, r));
-    knots.extend_from_slice(&u[k + 1..]);
-    HomSpline {
-        degree: p,
-        knots,
-        points: q,
+
+    /// Refines `old` (n blocks of `width` values: a point, or a whole row of points) into `new`
+    /// (n + r blocks). Unaffected blocks are copied; the affected ones are Böhm's combinations.
+    pub fn apply<P: Point>(&self, old: &[P], new: &mut [P], width: usize) {
+        let (k, s, p, r) = (self.k, self.s, self.p, self.r);
+        let n = old.len() / width;
+        let blocks = |a: usize, b: usize| a * width..b * width;
+        if r == 0 {
+            new.copy_from_slice(old);
+            return;
+        }
+        // Unaffected points keep their places (shifted by r after the affected block).
+        new[blocks(0, k - p + 1)].copy_from_slice(&old[blocks(0, k - p + 1)]);
+        new[blocks(k - s + r, n + r)].copy_from_slice(&old[blocks(k - s, n)]);
+        let keep = p + 1 - s;
+        let mut rw: Vec<P> = old[blocks(k - p, k - p + keep)].to_vec();
+        let mut l = k - p;
+        for (j, alphas) in (1..=r).zip(&self.alphas) {
+            l = k - p + j;
+            for (i, &alpha) in alphas.iter().enumerate() {
+                let (lo, hi) = rw[blocks(i, i + 2)].split_at_mut(width);
+                for (a, &b) in lo.iter_mut().zip(hi.iter()) {
+                    *a = b * alpha + *a * (1.0 - alpha);
+                }
+            }
+            new[blocks(l, l + 1)].copy_from_slice(&rw[blocks(0, 1)]);
+            let last = k + r - j - s;
+            new[blocks(last, last + 1)].copy_from_slice(&rw[blocks(keep - j - 1, keep - j)]);
+        }
+        if l + 1 < k - s {
+            new[blocks(l + 1, k - s)].copy_from_slice(&rw[blocks(1, k - s - l)]);
+        }
     }
 }
 
@@ -94,13 +147,13 @@ fn find_span(u: &[f64], p: usize, n: usize, t: f64) -> usize {
 /// d+1): end knots are inserted to multiplicity d, then the knots and points outside the domain
 /// are dropped. Clamped curves come back unchanged.
 #[must_use]
-pub fn clamp(c: &HomSpline) -> HomSpline {
+pub fn clamp<P: Point>(c: &Spline<P>) -> Spline<P> {
     let start = clamp_start(c);
     let reversed = reverse(&start);
     reverse(&clamp_start(&reversed))
 }
 
-fn clamp_start(c: &HomSpline) -> HomSpline {
+fn clamp_start<P: Point>(c: &Spline<P>) -> Spline<P> {
     let p = c.degree;
     let (a, _) = c.domain();
     let mult = c.knots.iter().filter(|&&x| x == a).count();
@@ -118,7 +171,7 @@ fn clamp_start(c: &HomSpline) -> HomSpline {
     let k = first + mult - 1;
     let mut knots = vec![a; p + 1];
     knots.extend_from_slice(&c.knots[first + mult..]);
-    HomSpline {
+    Spline {
         degree: p,
         knots,
         points: c.points[k - p..].to_vec(),
@@ -126,8 +179,8 @@ fn clamp_start(c: &HomSpline) -> HomSpline {
 }
 
 /// The curve with its parameter reversed (t ↦ −t): knots negated in reverse order.
-fn reverse(c: &HomSpline) -> HomSpline {
-    HomSpline {
+fn reverse<P: Point>(c: &Spline<P>) -> Spline<P> {
+    Spline {
         degree: c.degree,
         knots: c.knots.iter().rev().map(|&x| -x).collect(),
         points: c.points.iter().rev().copied().collect(),
@@ -138,13 +191,13 @@ fn reverse(c: &HomSpline) -> HomSpline {
 /// multiplicity grows by t, so the continuity there is kept. Unclamped curves are clamped first;
 /// interior knots of multiplicity d+1 (jumps) split the curve into pieces elevated separately.
 #[must_use]
-pub fn degree_elevate(c: &HomSpline, t: usize) -> HomSpline {
+pub fn degree_elevate<P: Point>(c: &Spline<P>, t: usize) -> Spline<P> {
     if t == 0 {
         return c.clone();
     }
     let c = clamp(c);
     let p = c.degree;
-    let mut out: Option<HomSpline> = None;
+    let mut out: Option<Spline<P>> = None;
     for piece in split_at_jumps(&c) {
         let e = if piece.points.len() == p + 1 {
             elevate_bezier(&piece, t)
@@ -165,7 +218,7 @@ pub fn degree_elevate(c: &HomSpline, t: usize) -> HomSpline {
 }
 
 /// Pieces between interior knots of multiplicity d+1, each clamped at both ends.
-fn split_at_jumps(c: &HomSpline) -> Vec<HomSpline> {
+fn split_at_jumps<P: Point>(c: &Spline<P>) -> Vec<Spline<P>> {
     let p = c.degree;
     let n = c.points.len();
     let mut pieces = Vec::new();
@@ -178,7 +231,7 @@ fn split_at_jumps(c: &HomSpline) -> Vec<HomSpline> {
         }
         if j - i + 1 == p + 1 {
             // Knots i..=j are the jump: the left piece ends with point i−1, the right starts at i.
-            pieces.push(HomSpline {
+            pieces.push(Spline {
                 degree: p,
                 knots: c.knots[k0..=j].to_vec(),
                 points: c.points[p0..i].to_vec(),
@@ -188,7 +241,7 @@ fn split_at_jumps(c: &HomSpline) -> Vec<HomSpline> {
         }
         i = j + 1;
     }
-    pieces.push(HomSpline {
+    pieces.push(Spline {
         degree: p,
         knots: c.knots[k0..].to_vec(),
         points: c.points[p0..].to_vec(),
@@ -215,7 +268,7 @@ fn bezier_alphas(p: usize, t: usize) -> Vec<Vec<f64>> {
 }
 
 /// A single Bézier span (d+1 points, clamped knots) elevated by t.
-fn elevate_bezier(c: &HomSpline, t: usize) -> HomSpline {
+fn elevate_bezier<P: Point>(c: &Spline<P>, t: usize) -> Spline<P> {
     let p = c.degree;
     let ph = p + t;
     let alphas = bezier_alphas(p, t);
@@ -224,13 +277,13 @@ fn elevate_bezier(c: &HomSpline, t: usize) -> HomSpline {
         .map(|row| {
             row.iter()
                 .zip(&c.points)
-                .fold(DVec4::ZERO, |acc, (&a, &q)| acc + q * a)
+                .fold(P::default(), |acc, (&a, &q)| acc + q * a)
         })
         .collect();
     let (a, b) = (c.knots[0], c.knots[c.knots.len() - 1]);
     let mut knots = vec![a; ph + 1];
     knots.extend(std::iter::repeat_n(b, ph + 1));
-    HomSpline {
+    Spline {
         degree: ph,
         knots,
         points,
@@ -239,7 +292,7 @@ fn elevate_bezier(c: &HomSpline, t: usize) -> HomSpline {
 
 /// A5.9 on a clamped curve whose interior knots have multiplicity at most d: Bézier segments
 /// are extracted by knot insertion, elevated, and the inserted knots removed again on the fly.
-fn degree_elevate_clamped(c: &HomSpline, t: usize) -> HomSpline {
+fn degree_elevate_clamped<P: Point>(c: &Spline<P>, t: usize) -> Spline<P> {
     let p = c.degree;
     let u = &c.knots;
     let pw = &c.points;
@@ -258,12 +311,12 @@ fn degree_elevate_clamped(c: &HomSpline, t: usize) -> HomSpline {
     let mut b = p + 1;
     let mut cind = 1;
     let mut ua = u[0];
-    let mut qw = vec![DVec4::ZERO; (n + 1) * (t + 1) + 1];
+    let mut qw = vec![P::default(); (n + 1) * (t + 1) + 1];
     qw[0] = pw[0];
     let mut uh = vec![ua; ph + 1];
-    let mut bpts: Vec<DVec4> = pw[..=p].to_vec();
-    let mut next_bpts = vec![DVec4::ZERO; p.max(1)];
-    let mut ebpts = vec![DVec4::ZERO; ph + 1];
+    let mut bpts: Vec<P> = pw[..=p].to_vec();
+    let mut next_bpts = vec![P::default(); p.max(1)];
+    let mut ebpts = vec![P::default(); ph + 1];
     let mut alfs = vec![0.0; p.max(1)];
     while b < m {
         let i0 = b;
@@ -303,7 +356,7 @@ fn degree_elevate_clamped(c: &HomSpline, t: usize) -> HomSpline {
         }
         for (i, e) in ebpts.iter_mut().enumerate().skip(lbz) {
             *e = (i.saturating_sub(t)..=p.min(i))
-                .fold(DVec4::ZERO, |acc, j| acc + bpts[j] * bezalfs[i][j]);
+                .fold(P::default(), |acc, j| acc + bpts[j] * bezalfs[i][j]);
         }
         if oldr > 1 {
             // Remove the knot u = ua oldr − 1 times.
@@ -362,65 +415,146 @@ fn degree_elevate_clamped(c: &HomSpline, t: usize) -> HomSpline {
     let count = mh - ph;
     qw.truncate(count);
     debug_assert_eq!(uh.len(), count + ph + 1);
-    HomSpline {
+    Spline {
         degree: ph,
         knots: uh,
         points: qw,
     }
 }
 
+/// Lines of a net refined together: their homogeneous coordinates side by side, so every step
+/// of a refinement algorithm is one short loop over the lanes (which the compiler vectorises)
+/// instead of one call per line.
+const LINES: usize = 4;
+
+/// `LINES` homogeneous points, one per line: lanes 4l..4l+4 hold line l's (w·P, w).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pack([f64; 4 * LINES]);
+
+impl Default for Pack {
+    fn default() -> Self {
+        Pack([0.0; 4 * LINES])
+    }
+}
+
+impl std::ops::Add for Pack {
+    type Output = Pack;
+    #[inline(always)]
+    fn add(self, o: Pack) -> Pack {
+        Pack(std::array::from_fn(|i| self.0[i] + o.0[i]))
+    }
+}
+
+impl std::ops::Sub for Pack {
+    type Output = Pack;
+    #[inline(always)]
+    fn sub(self, o: Pack) -> Pack {
+        Pack(std::array::from_fn(|i| self.0[i] - o.0[i]))
+    }
+}
+
+impl std::ops::AddAssign for Pack {
+    #[inline(always)]
+    fn add_assign(&mut self, o: Pack) {
+        for (a, b) in self.0.iter_mut().zip(o.0) {
+            *a += b;
+        }
+    }
+}
+
+impl std::ops::Mul<f64> for Pack {
+    type Output = Pack;
+    #[inline(always)]
+    fn mul(self, k: f64) -> Pack {
+        Pack(self.0.map(|x| x * k))
+    }
+}
+
+impl Point for Pack {
+    fn max_abs(self) -> f64 {
+        self.0.iter().fold(0.0, |m, x| m.max(x.abs()))
+    }
+}
+
+/// A refined net: the refined direction's degree and knots, the new count, and the control
+/// points (row-major) with their weights when the net is rational.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RefinedNet {
+    pub degree: usize,
+    pub knots: Vec<f64>,
+    pub count: [usize; 2],
+    pub points: Vec<DVec3>,
+    pub weights: Option<Vec<f64>>,
+}
+
 /// Runs a curve refinement on every line of a `count = [nu, nv]` row-major net along `dir`
-/// (0: lines of constant v index, running in u; 1: lines of constant u index). Returns the
-/// refined direction's knots and degree, the new count and the new net.
+/// (0: the lines of constant v index, running in u; 1: those of constant u index), `LINES`
+/// lines at a time, in homogeneous coordinates. The refinement's coefficients depend only on
+/// the knots, so all lines come out with the same degree and knots. Only the result is
+/// allocated at the net's size: for a large net, fresh pages cost more than the arithmetic.
 #[must_use]
 pub fn refine_net(
     degree: usize,
     knots: &[f64],
     count: [usize; 2],
-    net: &[DVec4],
+    (points, weights): (&[DVec3], Option<&[f64]>),
     dir: usize,
-    refine: impl Fn(&HomSpline) -> HomSpline,
-) -> (HomSpline, [usize; 2], Vec<DVec4>) {
+    refine: impl Fn(&Spline<Pack>) -> Spline<Pack>,
+) -> RefinedNet {
     let [nu, nv] = count;
     let (lines, len) = if dir == 0 { (nv, nu) } else { (nu, nv) };
-    let at = |line: usize, i: usize| {
+    let index = |line: usize, i: usize, cols: usize| {
         if dir == 0 {
-            i * nv + line
+            i * cols + line
         } else {
-            line * nv + i
+            line * cols + i
         }
     };
-    let mut refined: Vec<HomSpline> = Vec::with_capacity(lines);
-    for line in 0..lines {
-        let c = HomSpline {
-            degree,
-            knots: knots.to_vec(),
-            points: (0..len).map(|i| net[at(line, i)]).collect(),
-        };
-        refined.push(refine(&c));
-    }
-    let new_len = refined[0].points.len();
-    let new_count = if dir == 0 {
-        [new_len, nv]
-    } else {
-        [nu, new_len]
-    };
-    let mut out = vec![DVec4::ZERO; new_count[0] * new_count[1]];
-    for (line, r) in refined.iter().enumerate() {
-        for (i, &q) in r.points.iter().enumerate() {
-            let idx = if dir == 0 {
-                i * new_count[1] + line
-            } else {
-                line * new_count[1] + i
-            };
-            out[idx] = q;
-        }
-    }
-    let first = refined.swap_remove(0);
-    let shape = HomSpline {
-        degree: first.degree,
-        knots: first.knots,
+    let mut out = RefinedNet {
+        degree,
+        knots: Vec::new(),
+        count,
         points: Vec::new(),
+        weights: None,
     };
-    (shape, new_count, out)
+    let mut input = Spline {
+        degree,
+        knots: knots.to_vec(),
+        points: vec![Pack::default(); len],
+    };
+    for first in (0..lines).step_by(LINES) {
+        let group = first..(first + LINES).min(lines);
+        for (i, p) in input.points.iter_mut().enumerate() {
+            for (l, line) in group.clone().enumerate() {
+                let k = index(line, i, nv);
+                let w = weights.map_or(1.0, |w| w[k]);
+                let h = (points[k] * w).extend(w);
+                p.0[4 * l..4 * l + 4].copy_from_slice(&h.to_array());
+            }
+        }
+        let r = refine(&input);
+        if out.points.is_empty() {
+            out.count = if dir == 0 {
+                [r.points.len(), nv]
+            } else {
+                [nu, r.points.len()]
+            };
+            let n = out.count[0] * out.count[1];
+            out.points = vec![DVec3::ZERO; n];
+            out.weights = weights.map(|_| vec![0.0; n]);
+            out.degree = r.degree;
+            out.knots = r.knots;
+        }
+        for (i, p) in r.points.iter().enumerate() {
+            for (l, line) in group.clone().enumerate() {
+                let k = index(line, i, out.count[1]);
+                let h = &p.0[4 * l..4 * l + 4];
+                out.points[k] = DVec3::new(h[0], h[1], h[2]) / h[3];
+                if let Some(w) = out.weights.as_mut() {
+                    w[k] = h[3];
+                }
+            }
+        }
+    }
+    out
 }

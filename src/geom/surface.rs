@@ -6,8 +6,8 @@ use super::bezier::{check_points, check_weights};
 use super::bspline::de_boor;
 use super::error::{GeomError, GeomResult};
 use super::knots::KnotVector;
-use super::point::{binomial, homogeneous, to_homogeneous};
-use super::refine::{HomSpline, curve_knot_ins, degree_elevate, refine_net};
+use super::point::{Point, binomial, homogeneous, to_homogeneous};
+use super::refine::{KnotInsertion, Pack, Spline, degree_elevate, refine_net};
 use glam::{DVec3, DVec4};
 
 /// S(u,v) = Σ_i Σ_j P_ij N_i(u) N_j(v). Control points are row-major, `points[i * nv + j]`, with
@@ -19,6 +19,25 @@ pub struct TensorSurface {
     count: [usize; 2],
     points: Vec<DVec3>,
     weights: Option<Vec<f64>>,
+}
+
+/// Applies a knot insertion to a row-major net of `nv` columns: across rows (direction u,
+/// whole rows are the blocks) or within each row (direction v).
+fn insert_in_lines<P: Point>(
+    plan: &KnotInsertion,
+    dir: usize,
+    nv: usize,
+    old: &[P],
+    new: &mut [P],
+) {
+    if dir == 0 {
+        plan.apply(old, new, nv);
+    } else {
+        let grown = new.len() / (old.len() / nv);
+        for (o, n) in old.chunks_exact(nv).zip(new.chunks_exact_mut(grown)) {
+            plan.apply(o, n, 1);
+        }
+    }
 }
 
 /// All partial derivatives ∂^{a+b}S/∂u^a∂v^b for a, b ≤ n.
@@ -205,7 +224,41 @@ impl TensorSurface {
                 ),
             ));
         }
-        Ok(self.refined(dir, |c| curve_knot_ins(c, t, times)))
+        Ok(self.with_knot(dir, t, times))
+    }
+
+    /// SurfaceKnotIns without the checks: Böhm's coefficients once, applied to whole rows of
+    /// the net (direction u: rows of control points are the blocks) or within each row
+    /// (direction v). Polynomial nets refine their points directly, rational ones in
+    /// homogeneous coordinates.
+    fn with_knot(&self, dir: usize, t: f64, r: usize) -> Self {
+        let [nu, nv] = self.count;
+        let plan = KnotInsertion::new(&self.knots[dir], self.degree[dir], self.count[dir], t, r);
+        let mut count = self.count;
+        count[dir] += r;
+        let (points, weights) = match &self.weights {
+            None => {
+                let mut new = vec![DVec3::ZERO; count[0] * count[1]];
+                insert_in_lines(&plan, dir, nv, &self.points, &mut new);
+                (new, None)
+            }
+            Some(_) => {
+                let mut new = vec![DVec4::ZERO; count[0] * count[1]];
+                insert_in_lines(&plan, dir, nv, &self.homogeneous_points(), &mut new);
+                let points = new.iter().map(|h| h.truncate() / h.w).collect();
+                (points, Some(new.iter().map(|h| h.w).collect()))
+            }
+        };
+        debug_assert_eq!(nu * nv + r * if dir == 0 { nv } else { nu }, points.len());
+        let mut knots = self.knots.clone();
+        knots[dir] = KnotVector::new(plan.knots).expect("insertion keeps knots sorted");
+        Self {
+            degree: self.degree,
+            knots,
+            count,
+            points,
+            weights,
+        }
     }
 
     /// Degree elevation by `by` in direction `dir` (NURBS Book A5.10: DegreeElevateCurve on
@@ -215,24 +268,26 @@ impl TensorSurface {
         self.refined(dir, |c| degree_elevate(c, by))
     }
 
-    fn refined(&self, dir: usize, refine: impl Fn(&HomSpline) -> HomSpline) -> Self {
-        let (line, count, net) = refine_net(
+    fn refined(&self, dir: usize, refine: impl Fn(&Spline<Pack>) -> Spline<Pack>) -> Self {
+        let r = refine_net(
             self.degree[dir],
             &self.knots[dir],
             self.count,
-            &self.homogeneous_points(),
+            (&self.points, self.weights.as_deref()),
             dir,
             refine,
         );
-        let mut out = self.clone();
-        out.degree[dir] = line.degree;
-        out.knots[dir] = KnotVector::new(line.knots).expect("refinement keeps knots sorted");
-        out.count = count;
-        out.points = net.iter().map(|h| h.truncate() / h.w).collect();
-        if self.weights.is_some() {
-            out.weights = Some(net.iter().map(|h| h.w).collect());
+        let mut degree = self.degree;
+        let mut knots = self.knots.clone();
+        degree[dir] = r.degree;
+        knots[dir] = KnotVector::new(r.knots).expect("refinement keeps knots sorted");
+        Self {
+            degree,
+            knots,
+            count: r.count,
+            points: r.points,
+            weights: r.weights,
         }
-        out
     }
 
     /// Parameter domains [(u0, u1), (v0, v1)].

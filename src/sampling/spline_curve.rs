@@ -114,13 +114,7 @@ impl SplineCurveSampler {
     /// shape (and so every sample) is unchanged.
     fn retabulate(&mut self) {
         let c = self.model.curve();
-        self.table = HermiteTable::at_params(
-            c.knots(),
-            c.degree(),
-            c.points().len(),
-            self.table.params.clone(),
-            self.table.order(),
-        );
+        self.table = self.table.refit(c.knots(), c.degree(), c.points().len());
     }
 
     fn add_polynomial(&mut self, k: usize, delta: DVec3) {

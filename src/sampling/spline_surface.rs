@@ -185,13 +185,7 @@ impl SplineSurfaceSampler {
         for dir in 0..2 {
             let t = &self.tables[dir];
             if !t.tabulates(&s.knots()[dir], s.degree()[dir], s.count()[dir]) {
-                self.tables[dir] = HermiteTable::at_params(
-                    &s.knots()[dir],
-                    s.degree()[dir],
-                    s.count()[dir],
-                    t.params.clone(),
-                    t.order(),
-                );
+                self.tables[dir] = t.refit(&s.knots()[dir], s.degree()[dir], s.count()[dir]);
             }
         }
     }
