@@ -317,10 +317,8 @@ fn surface_refinement_keeps_shape_and_counts() {
             }
             SurfaceEdit::ElevateDegree { by } => {
                 assert_eq!(r.degree(), [s.degree()[0] + by[0], s.degree()[1] + by[1]]);
-                for dir in 0..2 {
-                    if by[dir] == 0 {
-                        assert_eq!(r.knots()[dir], s.knots()[dir]);
-                    }
+                for (dir, _) in by.iter().enumerate().filter(|(_, b)| **b == 0) {
+                    assert_eq!(r.knots()[dir], s.knots()[dir]);
                 }
             }
             _ => unreachable!(),
