@@ -77,9 +77,15 @@ pub fn read_elements(text: &str) -> Result<(Vec<FreeForm>, Vec<ObjWarning>), Obj
 pub fn parse_obj(text: &str) -> Result<ObjImport, ObjError> {
     let (elements, warnings) = read_elements(text)?;
     if elements.is_empty() {
+        // Say why, at the first thing that was read past (a skipped element, polygons, …).
+        let (line, why) = warnings
+            .first()
+            .map_or((1, String::new()), |w| (w.line, format!("; {}", w.message)));
         return Err(ObjError::new(
-            1,
-            "no free-form curve or surface (curv/surf with cstype bezier or bspline) to read",
+            line,
+            format!(
+                "no free-form curve or surface (curv/surf with cstype bezier or bspline) to read{why}"
+            ),
         ));
     }
     let mut used = HashSet::new();
