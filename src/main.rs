@@ -116,8 +116,10 @@ enum Command {
         #[command(flatten)]
         samples: SamplesArgs,
     },
-    /// Convert a scene between the JSON scene format and Wavefront OBJ free-form geometry
-    /// (direction from the extensions, .json or .obj; see docs/obj.md for the exact mapping).
+    /// Convert a scene between JSON and Wavefront OBJ (direction from the extensions).
+    ///
+    /// IN and OUT end in .json (the scene format) or .obj (free-form curves and surfaces);
+    /// control data are kept bit for bit. docs/obj.md describes the exact mapping.
     Convert {
         /// Input scene (.json or .obj).
         input: PathBuf,

@@ -461,3 +461,86 @@ fn the_erbs_comparison_catches_a_perturbation() {
     let nan: Vec<_> = vec![(DVec3::ONE, DVec3::new(f64::NAN, 1.0, 1.0))];
     assert!(worst(&nan) > TOL, "NaN must not pass");
 }
+
+// ---- prespline convert -------------------------------------------------------------------
+
+fn convert(args: &[&std::ffi::OsStr]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_prespline"))
+        .arg("convert")
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn temp_dir(tag: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("prespline-convert-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn convert_goes_both_ways_exactly_and_applies_samples() {
+    let dir = temp_dir("both");
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/nurbs_circle.json");
+    let (obj, json) = (dir.join("circle.OBJ"), dir.join("circle.json"));
+    for (a, b) in [(&src, &obj), (&obj, &json)] {
+        let out = convert(&[a.as_os_str(), b.as_os_str()]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{err}");
+        assert!(err.starts_with("wrote "), "{err}");
+    }
+    assert!(
+        std::fs::read_to_string(&obj)
+            .unwrap()
+            .contains("cstype rat bspline")
+    );
+    let original = Scene::load(&src).unwrap();
+    assert_eq!(Scene::load(&json).unwrap(), original);
+
+    let out = convert(&[
+        obj.as_os_str(),
+        json.as_os_str(),
+        "--samples".as_ref(),
+        "33".as_ref(),
+        "--samples".as_ref(),
+        "5x6".as_ref(),
+    ]);
+    assert!(out.status.success());
+    let resampled = Scene::load(&json).unwrap();
+    assert_eq!(resampled.objects[0].samples, Samples::Curve(33));
+    assert_eq!(resampled.objects[0].shape, original.objects[0].shape);
+}
+
+#[test]
+fn convert_refuses_what_it_cannot_write_and_writes_nothing() {
+    let dir = temp_dir("refuse");
+    let erbs = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/erbs_curve.json");
+    let obj = dir.join("erbs.obj");
+    let out = convert(&[erbs.as_os_str(), obj.as_os_str()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.starts_with(&format!("error: {}: object 'erbs': ", erbs.display())),
+        "{err}"
+    );
+    assert!(!obj.exists() && !dir.join("erbs.obj.tmp").exists());
+
+    let txt = dir.join("scene.txt");
+    let out = convert(&[erbs.as_os_str(), txt.as_os_str()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("cannot tell the format from the extension"),
+        "{err}"
+    );
+    for bad in ["0", "1", "2x1", "x", "4x", "100000x100000"] {
+        let out = convert(&[
+            erbs.as_os_str(),
+            obj.as_os_str(),
+            "--samples".as_ref(),
+            bad.as_ref(),
+        ]);
+        assert!(!out.status.success(), "--samples {bad}");
+    }
+}
