@@ -5,6 +5,7 @@
 pub mod cli;
 pub mod geom;
 pub mod gpu;
+pub mod model;
 pub mod profile;
 pub mod render;
 pub mod sampling;

@@ -5,9 +5,9 @@ mod oracle;
 
 use oracle::random::{Kind, Options, random_edits, random_scene};
 use oracle::rng::Rng;
+use prespline::model::{Edit, merge_edits};
 use prespline::sampling::{SampleMode, SampledObject};
-use prespline::scene::edit::{merge_edits, parse_edits};
-use prespline::scene::{Edit, Scene, parse_scene};
+use prespline::scene::{Scene, parse_edits, parse_scene};
 
 /// A random one-object scene of `kind` and `count` random edits for it, through the product's
 /// own parsers (so the edits are validated exactly as `prespline sample --edits` does).
@@ -33,12 +33,12 @@ fn delta_error(
     rebuild: Option<usize>,
 ) -> (f64, f64) {
     let o = &scene.objects[0];
-    let mut obj = SampledObject::new(&o.shape, o.samples, mode);
+    let mut obj = SampledObject::new(&o.model, mode);
     obj.set_rebuild_interval(rebuild);
     for e in edits {
-        obj.apply(&e.op);
+        obj.apply(&e.edit).expect("validated edits fit");
     }
-    let fresh = SampledObject::new(&obj.shape(), o.samples, mode);
+    let fresh = SampledObject::new(&obj.model().to_model(), mode);
     let err = obj.grid().max_relative_difference(fresh.grid());
     let normal_err = match (&obj.grid().normals, &fresh.grid().normals) {
         (Some(a), Some(b)) => a
@@ -101,9 +101,9 @@ fn merged_frame_edits_give_the_same_result() {
             assert!(merged.len() <= edits.len());
             let o = &scene.objects[0];
             let run = |list: &[Edit]| {
-                let mut obj = SampledObject::new(&o.shape, o.samples, SampleMode::Derivatives(1));
+                let mut obj = SampledObject::new(&o.model, SampleMode::Derivatives(1));
                 for e in list {
-                    obj.apply(&e.op);
+                    obj.apply(&e.edit).expect("validated edits fit");
                 }
                 obj
             };

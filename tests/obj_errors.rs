@@ -6,9 +6,10 @@
 mod common;
 
 use common::Rng;
+use prespline::cli::files::SampleOverride;
+use prespline::model::Model;
 use prespline::sampling::{SampleMode, SampledObject};
 use prespline::scene::obj::{parse_obj, parse_obj_bytes, scene_to_obj};
-use prespline::scene::{Samples, Shape};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -497,16 +498,18 @@ fn mutated_files_never_panic() {
             Ok(import) => {
                 ok += 1;
                 for o in &import.scene.objects {
-                    let samples = match o.samples {
-                        Samples::Curve(_) => Samples::Curve(3),
-                        Samples::Surface(_) => Samples::Surface([3, 3]),
-                    };
-                    let s = SampledObject::new(&o.shape, samples, SampleMode::Render);
-                    drop(s);
-                    assert!(!matches!(
-                        o.shape,
-                        Shape::ErbsCurve(_) | Shape::ErbsSurface(_)
-                    ));
+                    assert!(matches!(o.model, Model::Curve(_) | Model::Surface(_)));
+                }
+                // Every accepted object samples (with few samples: this is about validity).
+                let mut small = import.scene.clone();
+                SampleOverride {
+                    curve: Some(3),
+                    surface: Some([3, 3]),
+                }
+                .apply(&mut small)
+                .unwrap();
+                for o in &small.objects {
+                    drop(SampledObject::new(&o.model, SampleMode::Render));
                 }
                 let again =
                     scene_to_obj(&import.scene).unwrap_or_else(|e| panic!("seed {seed}: {e}"));

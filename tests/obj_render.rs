@@ -4,10 +4,11 @@
 
 mod common;
 
+use prespline::model::Model;
 use prespline::render::offscreen::{Shot, render_document};
 use prespline::render::{Document, NetMode, ViewOptions};
+use prespline::scene::Scene;
 use prespline::scene::obj::{load_obj, parse_obj};
-use prespline::scene::{Scene, Shape};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -154,9 +155,10 @@ fn viewer_edits_an_obj_model_and_saves_obj() {
     assert_eq!(before.objects.len(), after.objects.len());
     for (a, b) in before.objects.iter().zip(&after.objects) {
         assert_eq!(a.name, b.name);
-        assert_eq!(a.samples, b.samples);
-        match (&a.shape, &b.shape) {
-            (Shape::BSplineSurface(s0), Shape::BSplineSurface(s1)) if a.name == "vase" => {
+        assert_eq!(a.model.sample_dims(), b.model.sample_dims());
+        match (&a.model, &b.model) {
+            (Model::Surface(s0), Model::Surface(s1)) if a.name == "vase" => {
+                let (s0, s1) = (s0.surface(), s1.surface());
                 assert_eq!(s0.knots(), s1.knots());
                 assert_eq!(s0.weights(), s1.weights());
                 let nv = s0.count()[1];
@@ -169,7 +171,7 @@ fn viewer_edits_an_obj_model_and_saves_obj() {
                     }
                 }
             }
-            _ => assert_eq!(a.shape, b.shape, "{} must be unchanged", a.name),
+            _ => assert_eq!(a.model, b.model, "{} must be unchanged", a.name),
         }
     }
     assert!(shot.is_file(), "{err}");

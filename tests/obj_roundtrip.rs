@@ -8,9 +8,12 @@ mod common;
 use common::Rng;
 use glam::DVec3;
 use prespline::geom::{BFunctionKind, BSplineCurve, ErbsCurve, ErbsSurface, TensorSurface};
+use prespline::model::{
+    CurveModel, ErbsCurveModel, ErbsSurfaceModel, Model, SplineForm, SurfaceModel,
+};
 use prespline::scene::obj::model::{Basis, FreeForm};
 use prespline::scene::obj::{parse_obj, read_elements, scene_to_obj};
-use prespline::scene::{Samples, Scene, SceneObject, Shape, parse_scene, scene_to_json};
+use prespline::scene::{Scene, SceneObject, parse_scene, scene_to_json};
 use std::path::Path;
 
 fn example(name: &str) -> String {
@@ -101,38 +104,37 @@ fn random_object(rng: &mut Rng, i: usize) -> SceneObject {
     let n = d + 1 + rng.range(0, 5);
     let [du, dv] = [rng.range(1, 4), rng.range(1, 4)];
     let [nu, nv] = [du + 1 + rng.range(0, 3), dv + 1 + rng.range(0, 3)];
-    let (shape, samples) = match rng.range(0, 4) {
+    let model = match rng.range(0, 4) {
         0 => {
             let p = points(rng, d + 1);
             let w = weights(rng, d + 1);
             let k = prespline::geom::KnotVector::bezier(d, 0.0, 1.0).into_vec();
             let c = BSplineCurve::new(d, k, p, w).unwrap();
-            (Shape::BezierCurve(c), Samples::Curve(rng.range(2, 300)))
+            Model::Curve(CurveModel::new(SplineForm::Bezier, c, rng.range(2, 300)).unwrap())
         }
         1 => {
             let c =
                 BSplineCurve::new(d, knots(rng, d, n), points(rng, n), weights(rng, n)).unwrap();
-            (Shape::BSplineCurve(c), Samples::Curve(rng.range(2, 300)))
+            Model::Curve(CurveModel::new(SplineForm::BSpline, c, rng.range(2, 300)).unwrap())
         }
         2 => {
             let m = (du + 1) * (dv + 1);
             let s =
                 TensorSurface::bezier([du + 1, dv + 1], points(rng, m), weights(rng, m)).unwrap();
-            (Shape::BezierSurface(s), Samples::Surface([5, 7]))
+            Model::Surface(SurfaceModel::new(SplineForm::Bezier, s, [5, 7]).unwrap())
         }
         _ => {
             let k = [knots(rng, du, nu), knots(rng, dv, nv)];
             let m = nu * nv;
             let s = TensorSurface::bspline([du, dv], k, [nu, nv], points(rng, m), weights(rng, m))
                 .unwrap();
-            (Shape::BSplineSurface(s), Samples::Surface([9, 4]))
+            Model::Surface(SurfaceModel::new(SplineForm::BSpline, s, [9, 4]).unwrap())
         }
     };
     let names = ["c", "surface", "a b c", "été", "x.2", "curve"];
     SceneObject {
         name: format!("{}{i}", names[rng.range(0, names.len())]),
-        shape,
-        samples,
+        model,
         color: (rng.range(0, 2) == 1).then_some([0.25, 1.0, 0.0]),
     }
 }
@@ -267,14 +269,15 @@ fn hand_written_obj_keeps_its_control_data_through_json() {
         .scene
         .objects
         .iter()
-        .map(|o| o.shape.type_name())
+        .map(|o| o.model.type_name())
         .collect();
     assert_eq!(types, ["bezier_surface", "bspline_curve", "bspline_curve"]);
     // Cut to [2, 4] of the degree-1 curve's domain [1, 6], where it passes through vertices
     // 2, 3 and 4 at the knots 2, 3 and 4.
-    let Shape::BSplineCurve(tail) = &imported.scene.objects[2].shape else {
+    let Model::Curve(tail) = &imported.scene.objects[2].model else {
         unreachable!()
     };
+    let tail = tail.curve();
     assert_eq!(tail.domain(), (2.0, 4.0));
     assert_eq!(tail.knots().as_slice(), [2.0, 2.0, 3.0, 4.0, 4.0]);
     let expect = [[1.0, 0.0, 0.5], [2.0, 0.0, 0.0], [0.0, 1.0, 0.25]].map(DVec3::from_array);
@@ -308,36 +311,45 @@ const TOL: f64 = 1e-12;
 fn erbs_curve(bf: BFunctionKind) -> SceneObject {
     let scene = parse_scene(&example("erbs_curve.json")).unwrap();
     let mut o = scene.objects[0].clone();
-    let Shape::ErbsCurve(c) = &o.shape else {
+    let Model::ErbsCurve(c) = &o.model else {
         panic!("erbs_curve.json holds an ERBS curve first")
     };
-    o.shape = Shape::ErbsCurve(
-        ErbsCurve::new(c.knots().to_vec(), c.local_curves().to_vec(), bf).unwrap(),
-    );
+    let c = c.curve();
+    let e = ErbsCurve::new(c.knots().to_vec(), c.local_curves().to_vec(), bf).unwrap();
+    o.model = Model::ErbsCurve(ErbsCurveModel::new(e, o.model.sample_dims()[0]).unwrap());
     o
 }
 
 fn erbs_surface(bf: BFunctionKind) -> SceneObject {
     let scene = parse_scene(&example("erbs_surface.json")).unwrap();
     let mut o = scene.objects[0].clone();
-    let Shape::ErbsSurface(s) = &o.shape else {
+    let Model::ErbsSurface(s) = &o.model else {
         panic!("erbs_surface.json holds an ERBS surface first")
     };
-    o.shape = Shape::ErbsSurface(
-        ErbsSurface::new(s.knots().clone(), s.count(), s.local_patches().to_vec(), bf).unwrap(),
-    );
+    let s = s.surface();
+    let e = ErbsSurface::new(s.knots().clone(), s.count(), s.local_patches().to_vec(), bf).unwrap();
+    o.model = Model::ErbsSurface(ErbsSurfaceModel::new(e, o.model.sample_dims()).unwrap());
     o
 }
 
 /// Exports one object and reads it back.
-fn exported(o: &SceneObject) -> Shape {
+fn exported(o: &SceneObject) -> Model {
     let obj = scene_to_obj(&Scene {
         objects: vec![o.clone()],
     })
     .unwrap();
     let back = parse_obj(&obj).unwrap().scene;
-    assert_eq!(back.objects[0].samples, o.samples);
-    back.objects[0].shape.clone()
+    assert_eq!(back.objects[0].model.sample_dims(), o.model.sample_dims());
+    back.objects[0].model.clone()
+}
+
+/// The exported B-spline curve of an ERBS curve object.
+fn exported_curve(o: &SceneObject) -> BSplineCurve {
+    let Model::Curve(b) = exported(o) else {
+        panic!("expected a bspline_curve")
+    };
+    assert_eq!(b.form(), SplineForm::BSpline);
+    b.curve().clone()
 }
 
 fn params(a: f64, b: f64, n: usize) -> impl Iterator<Item = f64> {
@@ -368,12 +380,11 @@ fn erbs_curves_with_polynomial_and_rational_blends_export_exactly() {
         BFunctionKind::Rational,
     ] {
         let o = erbs_curve(bf);
-        let Shape::ErbsCurve(e) = &o.shape else {
+        let Model::ErbsCurve(e) = &o.model else {
             unreachable!()
         };
-        let Shape::BSplineCurve(b) = exported(&o) else {
-            panic!("{bf:?}: expected a bspline_curve")
-        };
+        let e = e.curve();
+        let b = exported_curve(&o);
         assert_eq!(b.is_rational(), bf == BFunctionKind::Rational);
         let (lo, hi) = e.domain();
         assert_eq!(b.domain(), (lo, hi));
@@ -396,12 +407,15 @@ fn erbs_surfaces_with_polynomial_and_rational_blends_export_exactly() {
         BFunctionKind::Rational,
     ] {
         let o = erbs_surface(bf);
-        let Shape::ErbsSurface(e) = &o.shape else {
+        let Model::ErbsSurface(e) = &o.model else {
             unreachable!()
         };
-        let Shape::BSplineSurface(b) = exported(&o) else {
+        let e = e.surface();
+        let Model::Surface(b) = exported(&o) else {
             panic!("{bf:?}: expected a bspline_surface")
         };
+        assert_eq!(b.form(), SplineForm::BSpline);
+        let b = b.surface();
         let [(u0, u1), (v0, v1)] = e.domain();
         assert_eq!(b.domain(), e.domain());
         let mut pairs = [Vec::new(), Vec::new(), Vec::new()];
@@ -443,12 +457,11 @@ fn erbs_without_a_rational_form_is_refused_in_one_line() {
 #[test]
 fn the_erbs_comparison_catches_a_perturbation() {
     let o = erbs_curve(BFunctionKind::Smoothstep);
-    let Shape::ErbsCurve(e) = &o.shape else {
+    let Model::ErbsCurve(e) = &o.model else {
         unreachable!()
     };
-    let Shape::BSplineCurve(b) = exported(&o) else {
-        unreachable!()
-    };
+    let e = e.curve();
+    let b = exported_curve(&o);
     let mut p = b.points().to_vec();
     let mid = p.len() / 2;
     p[mid] += DVec3::splat(1e-9);
@@ -507,8 +520,13 @@ fn convert_goes_both_ways_exactly_and_applies_samples() {
     ]);
     assert!(out.status.success());
     let resampled = Scene::load(&json).unwrap();
-    assert_eq!(resampled.objects[0].samples, Samples::Curve(33));
-    assert_eq!(resampled.objects[0].shape, original.objects[0].shape);
+    let (Model::Curve(a), Model::Curve(b)) =
+        (&resampled.objects[0].model, &original.objects[0].model)
+    else {
+        panic!("nurbs_circle.json holds a curve")
+    };
+    assert_eq!(a.samples(), 33);
+    assert_eq!(a.curve(), b.curve());
 }
 
 #[test]
@@ -627,9 +645,11 @@ fn spec_trimming_example_reads_with_warnings_and_an_exact_cut() {
     );
 
     // The cut curve is the Bézier curve on [0.2, 0.9], to rounding.
-    let Shape::BSplineCurve(cut) = &objects[0].shape else {
-        panic!("{:?}", objects[0].shape)
+    let Model::Curve(cut) = &objects[0].model else {
+        panic!("{:?}", objects[0].model)
     };
+    assert_eq!(cut.form(), SplineForm::BSpline);
+    let cut = cut.curve();
     assert_eq!(cut.domain(), (0.2, 0.9));
     let full = prespline::geom::BezierCurve::new(
         [
@@ -648,9 +668,10 @@ fn spec_trimming_example_reads_with_warnings_and_an_exact_cut() {
     assert!(worst(&pairs) <= TOL, "{:e}", worst(&pairs));
 
     // The surface keeps its data: 3 × 3, weights from the fourth coordinates, u fastest.
-    let Shape::BSplineSurface(s) = &objects[1].shape else {
-        panic!("{:?}", objects[1].shape)
+    let Model::Surface(s) = &objects[1].model else {
+        panic!("{:?}", objects[1].model)
     };
+    let s = s.surface();
     assert_eq!(s.count(), [3, 3]);
     assert_eq!(s.domain(), [(-1.0, 2.5), (-2.0, 2.0)]);
     assert_eq!(s.point(1, 0), DVec3::new(0.130, -1.030, 0.432));

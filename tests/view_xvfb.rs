@@ -7,8 +7,9 @@ mod common;
 
 use glam::DVec3;
 use prespline::gpu::Pixels;
+use prespline::model::Model;
+use prespline::scene::Scene;
 use prespline::scene::demo::demo_scene;
-use prespline::scene::{Scene, Shape};
 use std::process::Command;
 
 const SCRIPT: &str = r#"[
@@ -65,8 +66,9 @@ fn scripted_session_saves_exact_edits_and_matches_the_golden() {
     assert_eq!(before.objects.len(), after.objects.len());
     for (a, b) in before.objects.iter().zip(&after.objects) {
         assert_eq!(a.name, b.name);
-        match (a.name.as_str(), &a.shape, &b.shape) {
-            ("bspline_surface", Shape::BSplineSurface(s0), Shape::BSplineSurface(s1)) => {
+        match (a.name.as_str(), &a.model, &b.model) {
+            ("bspline_surface", Model::Surface(s0), Model::Surface(s1)) => {
+                let (s0, s1) = (s0.surface(), s1.surface());
                 for (k, (p, q)) in s0.points().iter().zip(s1.points()).enumerate() {
                     if k == 3 * 8 + 4 {
                         assert_eq!((p.x, p.y), (q.x, q.y), "the drag was constrained to z");
@@ -76,7 +78,8 @@ fn scripted_session_saves_exact_edits_and_matches_the_golden() {
                     }
                 }
             }
-            ("nurbs_circle", Shape::BSplineCurve(c0), Shape::BSplineCurve(c1)) => {
+            ("nurbs_circle", Model::Curve(c0), Model::Curve(c1)) => {
+                let (c0, c1) = (c0.curve(), c1.curve());
                 let mut expect = c0.points().to_vec();
                 expect[2] += DVec3::new(0.0, 0.0, 0.5);
                 assert_eq!(
@@ -87,7 +90,7 @@ fn scripted_session_saves_exact_edits_and_matches_the_golden() {
                 assert_eq!(c0.weights(), c1.weights());
             }
             _ => assert_eq!(
-                a.shape, b.shape,
+                a.model, b.model,
                 "object {} must be unchanged (the rotation was undone)",
                 a.name
             ),

@@ -2,8 +2,9 @@
 //! `--samples` override, and `prespline convert`.
 
 use super::CliError;
+use crate::model::{CurveModel, ErbsCurveModel, ErbsSurfaceModel, Model, SurfaceModel};
 use crate::scene::obj::{Format, load_obj, save_scene_file};
-use crate::scene::{MAX_CURVE_SAMPLES, MAX_SURFACE_SAMPLES, Samples, Scene};
+use crate::scene::{MAX_CURVE_SAMPLES, MAX_SURFACE_SAMPLES, Scene};
 use std::path::Path;
 
 /// `--samples N` (every curve) and `--samples NxM` (every surface); the flag may be repeated.
@@ -64,14 +65,27 @@ impl SampleOverride {
         o
     }
 
-    pub fn apply(&self, scene: &mut Scene) {
+    /// Gives every curve and surface of the scene the overriding counts (checked on parsing).
+    pub fn apply(&self, scene: &mut Scene) -> Result<(), CliError> {
         for o in &mut scene.objects {
-            match (&mut o.samples, self.curve, self.surface) {
-                (Samples::Curve(m), Some(n), _) => *m = n,
-                (Samples::Surface(m), _, Some(n)) => *m = n,
-                _ => {}
-            }
+            let model = match (&o.model, self.curve, self.surface) {
+                (Model::Curve(m), Some(n), _) => {
+                    CurveModel::new(m.form(), m.curve().clone(), n).map(Model::Curve)
+                }
+                (Model::ErbsCurve(m), Some(n), _) => {
+                    ErbsCurveModel::new(m.curve().clone(), n).map(Model::ErbsCurve)
+                }
+                (Model::Surface(m), _, Some(n)) => {
+                    SurfaceModel::new(m.form(), m.surface().clone(), n).map(Model::Surface)
+                }
+                (Model::ErbsSurface(m), _, Some(n)) => {
+                    ErbsSurfaceModel::new(m.surface().clone(), n).map(Model::ErbsSurface)
+                }
+                _ => continue,
+            };
+            o.model = model.map_err(|e| CliError(format!("--samples: {e}")))?;
         }
+        Ok(())
     }
 }
 
@@ -87,7 +101,7 @@ pub fn load_scene(path: &Path, samples: &SampleOverride) -> Result<Scene, CliErr
         }
         _ => Scene::load(path).map_err(|e| CliError::in_file(path, e))?,
     };
-    samples.apply(&mut scene);
+    samples.apply(&mut scene)?;
     Ok(scene)
 }
 

@@ -5,6 +5,7 @@ use super::files::{SampleOverride, load_scene};
 use crate::gpu::{Renderer, RendererDesc, ValidationMode};
 use crate::render::offscreen::{Shot, render_document};
 use crate::render::{Document, OrbitCamera, ViewOptions};
+use crate::scene::SceneError;
 use crate::scene::edit::parse_edits;
 use std::path::Path;
 use std::time::Instant;
@@ -52,7 +53,8 @@ pub fn load_document(
         let text = std::fs::read_to_string(path)
             .map_err(|e| CliError(format!("cannot read {}: {e}", path.display())))?;
         for e in parse_edits(&text, &scene).map_err(|e| CliError::in_file(path, e))? {
-            doc.apply(&e);
+            doc.apply(&e)
+                .map_err(|err| CliError::in_file(path, SceneError(err.to_string())))?;
         }
     }
     Ok(doc)

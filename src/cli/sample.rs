@@ -3,7 +3,6 @@
 
 use super::CliError;
 use crate::sampling::{SampleMode, SampledObject};
-use crate::scene::Shape;
 use crate::scene::edit::{apply_all, parse_edits};
 use std::fmt::Write;
 use std::path::Path;
@@ -40,40 +39,35 @@ pub fn run(args: &SampleArgs) -> Result<String, CliError> {
         None => Vec::new(),
     };
     let mode = SampleMode::Derivatives(args.derivatives);
-    let objects: Vec<SampledObject> = if args.full {
-        apply_all(&mut scene, &edits);
-        scene
-            .objects
-            .iter()
-            .map(|o| SampledObject::new(&o.shape, o.samples, mode))
-            .collect()
-    } else {
-        let mut objects: Vec<SampledObject> = scene
-            .objects
-            .iter()
-            .map(|o| SampledObject::new(&o.shape, o.samples, mode))
-            .collect();
-        for e in &edits {
-            objects[e.object].apply(&e.op);
+    if args.full {
+        apply_all(&mut scene, &edits).map_err(|e| CliError(e.to_string()))?;
+    }
+    let mut objects: Vec<SampledObject> = scene
+        .objects
+        .iter()
+        .map(|o| SampledObject::new(&o.model, mode))
+        .collect();
+    if !args.full {
+        for (k, e) in edits.iter().enumerate() {
+            objects[e.object].apply(&e.edit).map_err(|err| {
+                CliError(format!(
+                    "edit {k} (object '{}'): {err}",
+                    scene.objects[e.object].name
+                ))
+            })?;
         }
-        objects
-    };
+    }
     let mut out = String::with_capacity(1 << 16);
     out.push_str("{\"objects\": [\n");
     for (i, (meta, obj)) in scene.objects.iter().zip(&objects).enumerate() {
-        write_object(&mut out, &meta.name, &meta.shape, obj)?;
+        write_object(&mut out, &meta.name, obj)?;
         out.push_str(if i + 1 < objects.len() { ",\n" } else { "\n" });
     }
     out.push_str("]}\n");
     Ok(out)
 }
 
-fn write_object(
-    out: &mut String,
-    name: &str,
-    shape: &Shape,
-    obj: &SampledObject,
-) -> Result<(), CliError> {
+fn write_object(out: &mut String, name: &str, obj: &SampledObject) -> Result<(), CliError> {
     let grid = obj.grid();
     if let Some(bad) = grid.data.iter().position(|v| !v.is_finite()) {
         return Err(CliError(format!(
@@ -85,11 +79,11 @@ fn write_object(
     let _ = write!(
         out,
         "  {{\"name\": {name_json}, \"type\": \"{}\", \"params\": ",
-        shape.type_name()
+        obj.type_name()
     );
     let params = obj.params();
     let g = grid.partials.max_order() + 1;
-    if shape.is_surface() {
+    if obj.model().is_surface() {
         out.push('[');
         numbers(out, params[0]);
         out.push_str(", ");

@@ -7,6 +7,7 @@ use super::bspline::de_boor;
 use super::error::{GeomError, GeomResult};
 use super::knots::KnotVector;
 use super::point::{binomial, homogeneous, to_homogeneous};
+use super::refine::{HomSpline, curve_knot_ins, degree_elevate, refine_net};
 use glam::{DVec3, DVec4};
 
 /// S(u,v) = Σ_i Σ_j P_ij N_i(u) N_j(v). Control points are row-major, `points[i * nv + j]`, with
@@ -180,6 +181,58 @@ impl TensorSurface {
     /// Homogeneous control points (w P, w), row-major.
     pub fn homogeneous_points(&self) -> Vec<DVec4> {
         homogeneous(&self.points, self.weights.as_deref())
+    }
+
+    /// SurfaceKnotIns (NURBS Book A5.3): inserts `t` `times` times in direction `dir` (0: u,
+    /// 1: v) by CurveKnotIns on every line of the net; the surface is unchanged. `t` must lie
+    /// in the domain and the final multiplicity may not exceed that direction's degree.
+    pub fn insert_knot(&self, dir: usize, t: f64, times: usize) -> GeomResult<Self> {
+        let (a, b) = self.domain()[dir];
+        if !(t >= a && t < b) {
+            return Err(GeomError::new(
+                "parameter",
+                format!("{t} is not in [{a}, {b})"),
+            ));
+        }
+        let p = self.degree[dir];
+        let s = self.knots[dir].multiplicity(t);
+        if s + times > p {
+            return Err(GeomError::new(
+                "parameter",
+                format!(
+                    "inserting {t} {times} times would give multiplicity {} > degree {p}",
+                    s + times
+                ),
+            ));
+        }
+        Ok(self.refined(dir, |c| curve_knot_ins(c, t, times)))
+    }
+
+    /// Degree elevation by `by` in direction `dir` (NURBS Book A5.10: DegreeElevateCurve on
+    /// every line of the net). An unclamped direction comes back clamped on its domain.
+    #[must_use]
+    pub fn elevate_degree(&self, dir: usize, by: usize) -> Self {
+        self.refined(dir, |c| degree_elevate(c, by))
+    }
+
+    fn refined(&self, dir: usize, refine: impl Fn(&HomSpline) -> HomSpline) -> Self {
+        let (line, count, net) = refine_net(
+            self.degree[dir],
+            &self.knots[dir],
+            self.count,
+            &self.homogeneous_points(),
+            dir,
+            refine,
+        );
+        let mut out = self.clone();
+        out.degree[dir] = line.degree;
+        out.knots[dir] = KnotVector::new(line.knots).expect("refinement keeps knots sorted");
+        out.count = count;
+        out.points = net.iter().map(|h| h.truncate() / h.w).collect();
+        if self.weights.is_some() {
+            out.weights = Some(net.iter().map(|h| h.w).collect());
+        }
+        out
     }
 
     /// Parameter domains [(u0, u1), (v0, v1)].

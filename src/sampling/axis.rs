@@ -22,6 +22,8 @@ pub struct HermiteTable {
     m: Vec<f64>,
     /// Per control point k: samples whose span i satisfies i−d ≤ k ≤ i (may be empty).
     ranges: Vec<Range<usize>>,
+    /// The knots tabulated, so a refinement can tell whether this direction changed.
+    knots: KnotVector,
 }
 
 impl HermiteTable {
@@ -74,7 +76,14 @@ impl HermiteTable {
             order,
             m,
             ranges,
+            knots: knots.clone(),
         }
+    }
+
+    /// Whether this table is the pre-evaluation of a degree-`degree` B-spline with `n` control
+    /// points on `knots`.
+    pub fn tabulates(&self, knots: &KnotVector, degree: usize, n: usize) -> bool {
+        self.degree == degree && self.ranges.len() == n && self.knots == *knots
     }
 
     pub fn degree(&self) -> usize {

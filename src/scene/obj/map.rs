@@ -6,7 +6,8 @@ use super::erbs;
 use super::model::{Basis, Direction, FreeForm};
 use crate::geom::error::GeomResult;
 use crate::geom::{BSplineCurve, GeomError, TensorSurface};
-use crate::scene::{Samples, SceneError, SceneObject, Shape};
+use crate::model::{CurveModel, EditError, Model, ModelRef, SplineForm, SurfaceModel};
+use crate::scene::{SceneError, SceneObject};
 use glam::DVec3;
 
 /// An OBJ element as a scene object. A single Bézier segment on [0, 1] stays a Bézier object;
@@ -15,14 +16,21 @@ use glam::DVec3;
 pub fn element_to_object(e: &FreeForm, name: String) -> Result<SceneObject, ObjError> {
     let weights = e.rational.then(|| e.weights.clone());
     let err = |g: GeomError| ObjError::new(e.line, format!("{}: {}", e.keyword(), g.message));
-    let shape = if let [u] = e.dirs.as_slice() {
+    let invalid = |m: EditError| ObjError::new(e.line, format!("{}: {}", e.keyword(), m.message));
+    let form = if is_unit_bezier(e) {
+        SplineForm::Bezier
+    } else {
+        SplineForm::BSpline
+    };
+    let model = if let [u] = e.dirs.as_slice() {
         let c = BSplineCurve::new(u.degree, u.knots(e.basis), e.points.clone(), weights)
             .map_err(err)?;
-        if is_unit_bezier(e) {
-            Shape::BezierCurve(c)
-        } else {
-            Shape::BSplineCurve(restrict_curve(c, u.range).map_err(err)?)
-        }
+        let c = restrict_curve(c, u.range).map_err(err)?;
+        let m = e
+            .samples
+            .as_ref()
+            .map_or_else(|| default_curve_samples(&c), |m| m[0]);
+        Model::Curve(CurveModel::new(form, c, m).map_err(invalid)?)
     } else {
         let (u, v) = (&e.dirs[0], &e.dirs[1]);
         let (nu, nv) = (u.count, v.count);
@@ -33,22 +41,17 @@ pub fn element_to_object(e: &FreeForm, name: String) -> Result<SceneObject, ObjE
         let knots = [u.knots(e.basis), v.knots(e.basis)];
         let s = TensorSurface::bspline([u.degree, v.degree], knots, [nu, nv], points, weights)
             .map_err(err)?;
-        if is_unit_bezier(e) {
-            Shape::BezierSurface(s)
-        } else {
-            let s = restrict_surface(s, 0, u.range).map_err(err)?;
-            Shape::BSplineSurface(restrict_surface(s, 1, v.range).map_err(err)?)
-        }
-    };
-    let samples = match e.samples.as_deref() {
-        Some(&[m]) => Samples::Curve(m),
-        Some(&[mu, mv]) => Samples::Surface([mu, mv]),
-        _ => default_samples(&shape),
+        let s = restrict_surface(s, 0, u.range).map_err(err)?;
+        let s = restrict_surface(s, 1, v.range).map_err(err)?;
+        let m = e
+            .samples
+            .as_ref()
+            .map_or_else(|| default_surface_samples(&s), |m| [m[0], m[1]]);
+        Model::Surface(SurfaceModel::new(form, s, m).map_err(invalid)?)
     };
     Ok(SceneObject {
         name,
-        shape,
-        samples,
+        model,
         color: e.color,
     })
 }
@@ -58,59 +61,57 @@ pub fn element_to_object(e: &FreeForm, name: String) -> Result<SceneObject, ObjE
 pub fn object_to_element(o: &SceneObject) -> Result<FreeForm, SceneError> {
     let at = |msg: String| SceneError(format!("object '{}': {msg}", o.name));
     check_name(&o.name).map_err(at)?;
-    let mut e = match &o.shape {
-        Shape::BezierCurve(c) => curve_element(c, Basis::Bezier),
-        Shape::BSplineCurve(c) => curve_element(c, Basis::BSpline),
-        Shape::ErbsCurve(c) => {
-            curve_element(&erbs::curve_to_bspline(c).map_err(at)?, Basis::BSpline)
-        }
-        Shape::BezierSurface(s) => surface_element(s, Basis::Bezier),
-        Shape::BSplineSurface(s) => surface_element(s, Basis::BSpline),
-        Shape::ErbsSurface(s) => {
-            surface_element(&erbs::surface_to_bspline(s).map_err(at)?, Basis::BSpline)
-        }
+    let basis = |form| match form {
+        SplineForm::Bezier => Basis::Bezier,
+        SplineForm::BSpline => Basis::BSpline,
     };
+    let mut e = match o.model.as_ref() {
+        ModelRef::Curve(m) => curve_element(m.curve(), basis(m.form())),
+        ModelRef::Surface(m) => surface_element(m.surface(), basis(m.form())),
+        ModelRef::ErbsCurve(m) => curve_element(
+            &erbs::curve_to_bspline(m.curve()).map_err(at)?,
+            Basis::BSpline,
+        ),
+        ModelRef::ErbsSurface(m) => surface_element(
+            &erbs::surface_to_bspline(m.surface()).map_err(at)?,
+            Basis::BSpline,
+        ),
+    };
+    let dims = o.model.sample_dims();
     e.name = Some(o.name.clone());
-    e.samples = Some(match o.samples {
-        Samples::Curve(m) => vec![m],
-        Samples::Surface([mu, mv]) => vec![mu, mv],
+    e.samples = Some(if o.model.is_surface() {
+        dims.to_vec()
+    } else {
+        vec![dims[0]]
     });
     e.color = o.color;
     Ok(e)
 }
 
-/// Sample counts of an imported object without `# prespline samples`: per knot span 32 along
-/// curves (129 to 4097 in all) and 8 per surface direction (17 to 257), so a Bézier patch gets
-/// 17 × 17 and dense nets stay responsive.
-pub fn default_samples(shape: &Shape) -> Samples {
-    let spans = |k: &[f64], (a, b): (f64, f64)| {
-        let mut n = 0usize;
-        let mut last = a;
-        for &t in k.iter().filter(|&&t| t > a && t <= b) {
-            if t > last {
-                n += 1;
-                last = t;
-            }
-        }
-        n.max(1)
-    };
-    match shape {
-        Shape::BezierCurve(c) | Shape::BSplineCurve(c) => {
-            Samples::Curve((32 * spans(c.knots(), c.domain()) + 1).clamp(129, 4097))
-        }
-        Shape::BezierSurface(s) | Shape::BSplineSurface(s) => {
-            let dom = s.domain();
-            let m = |d: usize| (8 * spans(&s.knots()[d], dom[d]) + 1).clamp(17, 257);
-            Samples::Surface([m(0), m(1)])
-        }
-        Shape::ErbsCurve(c) => {
-            Samples::Curve((32 * (c.local_curves().len() - 1) + 1).clamp(129, 4097))
-        }
-        Shape::ErbsSurface(s) => {
-            let m = |d: usize| (8 * (s.count()[d] - 1) + 1).clamp(17, 257);
-            Samples::Surface([m(0), m(1)])
+/// Samples of an imported curve without `# prespline samples`: 32 per knot span, 129 to 4097
+/// in all.
+pub fn default_curve_samples(c: &BSplineCurve) -> usize {
+    (32 * spans(c.knots(), c.domain()) + 1).clamp(129, 4097)
+}
+
+/// Samples of an imported surface without `# prespline samples`: 8 per knot span in each
+/// direction, 17 to 257, so a Bézier patch gets 17 × 17 and dense nets stay responsive.
+pub fn default_surface_samples(s: &TensorSurface) -> [usize; 2] {
+    let dom = s.domain();
+    [0, 1].map(|d| (8 * spans(&s.knots()[d], dom[d]) + 1).clamp(17, 257))
+}
+
+/// Non-empty knot spans in [a, b].
+fn spans(knots: &[f64], (a, b): (f64, f64)) -> usize {
+    let mut n = 0usize;
+    let mut last = a;
+    for &t in knots.iter().filter(|&&t| t > a && t <= b) {
+        if t > last {
+            n += 1;
+            last = t;
         }
     }
+    n.max(1)
 }
 
 /// One Bézier segment per direction on [0, 1]: a `bezier_curve` / `bezier_surface`.
@@ -121,7 +122,8 @@ fn is_unit_bezier(e: &FreeForm) -> bool {
             .all(|d| d.parm == [0.0, 1.0] && d.range == [0.0, 1.0])
 }
 
-/// The part of `c` on [a, b] ⊆ its domain, by splitting (CurveKnotIns) at a and b.
+/// The part of `c` on [a, b] ⊆ its domain, by splitting (CurveKnotIns) at a and b; `c` itself
+/// when [a, b] is the domain.
 fn restrict_curve(c: BSplineCurve, [a, b]: [f64; 2]) -> GeomResult<BSplineCurve> {
     let (lo, hi) = c.domain();
     let c = if a > lo { c.split(a)?.1 } else { c };

@@ -12,7 +12,7 @@ pub mod model;
 mod read;
 mod write;
 
-pub use map::default_samples;
+pub use map::{default_curve_samples, default_surface_samples};
 
 use super::{Scene, SceneError};
 use model::FreeForm;
