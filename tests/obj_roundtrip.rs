@@ -447,7 +447,8 @@ fn erbs_without_a_rational_form_is_refused_in_one_line() {
             .to_string();
             assert!(!e.contains('\n'), "{e}");
             assert!(e.starts_with(&format!("object '{}': ", o.name)), "{e}");
-            assert!(e.contains("no exact rational B-spline form"), "{e}");
+            assert!(e.contains("cannot be written to OBJ"), "{e}");
+            assert!(e.contains("no rational B-spline equals this ERBS"), "{e}");
             assert!(e.contains(bf.name()), "{e}");
         }
     }

@@ -46,7 +46,7 @@ impl Blend {
                 rational: true,
             }),
             BFunctionKind::ExpoRational | BFunctionKind::Trigonometric => Err(format!(
-                "the {} B-function is not a rational function, so this ERBS has no exact rational B-spline form and cannot be written to OBJ (keep it in JSON, or use bfunction smoothstep, smootherstep or rational, which export exactly)",
+                "cannot be written to OBJ: the {} B-function is not a rational function, so no rational B-spline equals this ERBS (B-functions smoothstep, smootherstep and rational export exactly; or keep it in JSON)",
                 kind.name()
             )),
         }
@@ -62,7 +62,10 @@ pub fn curve_to_bspline(c: &ErbsCurve) -> Result<BSplineCurve, String> {
     let blend = Blend::of(c.bfunction())?;
     let local = c.local_curves();
     if local.iter().any(BezierCurve::is_rational) {
-        return Err("rational local curves have no exact B-spline export".into());
+        return Err(
+            "cannot be written to OBJ: the exact export handles polynomial local curves only"
+                .into(),
+        );
     }
     let d = local.iter().map(BezierCurve::degree).max().unwrap_or(0);
     let p = degree(d, &blend)?;
@@ -142,7 +145,7 @@ fn degree(local: usize, blend: &Blend) -> Result<usize, String> {
     let p = local + blend.degree();
     if p > MAX_DEGREE {
         return Err(format!(
-            "the exact B-spline form has degree {p}, above the supported maximum {MAX_DEGREE}"
+            "cannot be written to OBJ: its exact B-spline form has degree {p}, above the supported maximum {MAX_DEGREE}"
         ));
     }
     Ok(p)
