@@ -5,6 +5,7 @@
 //! Everything a user can rely on — which constructs map, how exactly, what is refused — is in
 //! docs/obj.md.
 
+mod check;
 mod erbs;
 mod lex;
 mod map;
@@ -16,7 +17,7 @@ pub use map::{default_curve_samples, default_surface_samples};
 
 use super::{Scene, SceneError};
 use model::FreeForm;
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 use std::path::Path;
 
 /// A problem with an OBJ file, at a (1-based) line.
@@ -170,4 +171,55 @@ fn unique_name(e: &FreeForm, used: &mut HashSet<String>) -> String {
     }
     used.insert(name.clone());
     name
+}
+
+/// Warnings grouped by kind: one line per kind, at its first occurrence, with a count.
+#[derive(Debug, Default)]
+struct Warnings {
+    kinds: Vec<Warned>,
+    /// Kind key → index into `kinds`.
+    index: HashMap<String, usize>,
+}
+
+/// One kind of warning.
+#[derive(Debug)]
+struct Warned {
+    /// Line of the first occurrence.
+    line: usize,
+    count: usize,
+    message: String,
+}
+
+impl Warnings {
+    /// Counts an occurrence of `key`; the message is made once, for the first.
+    fn add(&mut self, key: &str, line: usize, message: impl FnOnce() -> String) {
+        match self.index.get(key) {
+            Some(&i) => self.kinds[i].count += 1,
+            None => {
+                self.index.insert(key.to_string(), self.kinds.len());
+                self.kinds.push(Warned {
+                    line,
+                    count: 1,
+                    message: message(),
+                });
+            }
+        }
+    }
+
+    fn into_list(self) -> Vec<ObjWarning> {
+        let mut out: Vec<ObjWarning> = self
+            .kinds
+            .into_iter()
+            .map(|w| ObjWarning {
+                line: w.line,
+                message: if w.count > 1 {
+                    format!("{} ({} times, first here)", w.message, w.count)
+                } else {
+                    w.message
+                },
+            })
+            .collect();
+        out.sort_by_key(|w| w.line);
+        out
+    }
 }

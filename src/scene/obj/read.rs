@@ -2,9 +2,10 @@
 //! current name) and checks every element when its `end` arrives; vertex numbers are checked
 //! once the whole file is read, since a positive number may name a vertex written later.
 
+use super::check;
 use super::lex::{Statement, Token};
-use super::model::{Basis, Direction, FreeForm};
-use super::{ObjError, ObjWarning};
+use super::model::{Basis, FreeForm};
+use super::{ObjError, ObjWarning, Warnings};
 use crate::scene::{MAX_CURVE_SAMPLES, MAX_DEGREE, MAX_SURFACE_SAMPLES};
 use glam::DVec3;
 
@@ -639,45 +640,18 @@ impl Reader {
             ));
         }
         let ndirs = if surface { 2 } else { 1 };
-        let mut dirs = Vec::with_capacity(ndirs);
-        for (d, parm) in open.parm.iter().take(ndirs).enumerate() {
-            let uv = ["u", "v"][d];
-            let (parm, parm_line) = parm.clone().ok_or_else(|| {
-                ObjError::new(line, format!("{word} has no parm {uv} before its end"))
-            })?;
-            dirs.push(Direction {
-                degree: degrees.values[d],
-                range: open.ranges[d],
-                parm,
-                count: 0,
-                parm_line,
-            });
-        }
-        let n = open.refs.len();
-        if surface {
-            for (d, dir) in dirs.iter_mut().enumerate() {
-                dir.count = surface_count(basis, dir, ["u", "v"][d])?;
-            }
-            let (nu, nv) = (dirs[0].count, dirs[1].count);
-            if n != nu * nv {
-                return Err(ObjError::new(
-                    line,
-                    format!(
-                        "surf lists {n} control vertices, but parm u and parm v with deg {} {} describe {nu} × {nv} = {}",
-                        dirs[0].degree,
-                        dirs[1].degree,
-                        nu * nv
-                    ),
-                ));
-            }
-        } else {
-            dirs[0].count = n;
-            curve_count(basis, &dirs[0], line)?;
-        }
-        for (d, dir) in dirs.iter().enumerate() {
-            check_parm(basis, dir, ["u", "v"][d])?;
-            self.check_range(basis, dir, word, line, ["u", "v"][d])?;
-        }
+        let dirs = check::directions(
+            &check::Body {
+                keyword: word,
+                line,
+                basis,
+                degrees: &degrees.values,
+                ranges: &open.ranges,
+                parm: &open.parm[..ndirs],
+                vertices: open.refs.len(),
+            },
+            &mut self.warnings,
+        )?;
         let samples = match open.pending.samples {
             Some((s, _)) if s.len() == ndirs => Some(s),
             Some((s, l)) => {
@@ -705,48 +679,6 @@ impl Reader {
             },
             refs: open.refs,
         }))
-    }
-
-    /// The range must lie in the domain; a proper part of it is cut out on import (warned).
-    fn check_range(
-        &mut self,
-        basis: Basis,
-        dir: &Direction,
-        word: &str,
-        line: usize,
-        uv: &str,
-    ) -> Result<(), ObjError> {
-        let [a, b] = dir.range;
-        let [lo, hi] = dir.domain(basis);
-        let what = if uv == "u" && word == "curv" {
-            "range".to_string()
-        } else {
-            format!("{uv} range")
-        };
-        if a >= b {
-            return Err(ObjError::new(
-                line,
-                format!("{word} {what} [{a}, {b}] is empty or reversed"),
-            ));
-        }
-        if a < lo || b > hi {
-            return Err(ObjError::new(
-                line,
-                format!(
-                    "{word} {what} [{a}, {b}] reaches outside the domain [{lo}, {hi}] of parm {uv} (line {})",
-                    dir.parm_line
-                ),
-            ));
-        }
-        if dir.is_restricted(basis) {
-            self.warnings.add(&format!("range {line} {uv}"), line, || {
-                format!(
-                    "{word} {what} [{a}, {b}] is part of the domain [{lo}, {hi}] of parm {uv}: the {} is cut to it by knot insertion (control points recomputed)",
-                    if word == "curv" { "curve" } else { "surface" }
-                )
-            });
-        }
-        Ok(())
     }
 
     fn finish(mut self) -> Result<Parsed, ObjError> {
@@ -829,132 +761,6 @@ impl Reader {
     }
 }
 
-/// Control vertices along a surface direction, from its `parm` vector.
-fn surface_count(basis: Basis, dir: &Direction, uv: &str) -> Result<usize, ObjError> {
-    let (k, d) = (dir.parm.len(), dir.degree);
-    match basis {
-        Basis::BSpline if k < 2 * d + 2 => Err(ObjError::new(
-            dir.parm_line,
-            format!(
-                "parm {uv} has {k} knots; degree {d} needs at least {} (control vertices + degree + 1, with at least degree + 1 control vertices)",
-                2 * d + 2
-            ),
-        )),
-        Basis::BSpline => Ok(k - d - 1),
-        Basis::Bezier => Ok((k - 1) * d + 1),
-    }
-}
-
-/// A curve's control vertex count must fit its degree and `parm` vector.
-fn curve_count(basis: Basis, dir: &Direction, line: usize) -> Result<(), ObjError> {
-    let (n, d, k) = (dir.count, dir.degree, dir.parm.len());
-    match basis {
-        Basis::BSpline => {
-            if n <= d {
-                return Err(ObjError::new(
-                    line,
-                    format!(
-                        "curv lists {n} control vertices; degree {d} needs at least {}",
-                        d + 1
-                    ),
-                ));
-            }
-            if k != n + d + 1 {
-                return Err(ObjError::new(
-                    dir.parm_line,
-                    format!(
-                        "parm u has {k} knots; a degree-{d} B-spline with {n} control vertices needs {} (control vertices + degree + 1)",
-                        n + d + 1
-                    ),
-                ));
-            }
-        }
-        Basis::Bezier => {
-            if n <= d || (n - 1) % d != 0 {
-                return Err(ObjError::new(
-                    line,
-                    format!(
-                        "curv lists {n} control vertices; a Bézier curve of degree {d} needs k·{d} + 1 ({}, {}, …)",
-                        d + 1,
-                        2 * d + 1
-                    ),
-                ));
-            }
-            let segments = (n - 1) / d;
-            if k != segments + 1 {
-                return Err(ObjError::new(
-                    dir.parm_line,
-                    format!(
-                        "parm u has {k} values; {segments} Bézier segment(s) need {} breakpoints",
-                        segments + 1
-                    ),
-                ));
-            }
-        }
-    }
-    Ok(())
-}
-
-/// Knots non-decreasing with multiplicity ≤ degree + 1 and a non-empty domain; Bézier
-/// breakpoints strictly increasing.
-fn check_parm(basis: Basis, dir: &Direction, uv: &str) -> Result<(), ObjError> {
-    let p = &dir.parm;
-    let line = dir.parm_line;
-    for i in 1..p.len() {
-        let bad = match basis {
-            Basis::BSpline => p[i] < p[i - 1],
-            Basis::Bezier => p[i] <= p[i - 1],
-        };
-        if bad {
-            let rule = match basis {
-                Basis::BSpline => "knots must be non-decreasing",
-                Basis::Bezier => "Bézier breakpoints must increase strictly",
-            };
-            return Err(ObjError::new(
-                line,
-                format!(
-                    "parm {uv}: value {} ({}) follows value {i} ({}): {rule}",
-                    i + 1,
-                    p[i],
-                    p[i - 1]
-                ),
-            ));
-        }
-    }
-    if basis == Basis::BSpline {
-        let d = dir.degree;
-        let mut start = 0;
-        while start < p.len() {
-            let end = start + p[start..].iter().take_while(|&&t| t == p[start]).count();
-            if end - start > d + 1 {
-                return Err(ObjError::new(
-                    line,
-                    format!(
-                        "parm {uv}: knot {} appears {} times, more than degree + 1 = {}",
-                        p[start],
-                        end - start,
-                        d + 1
-                    ),
-                ));
-            }
-            start = end;
-        }
-        if p[d] >= p[dir.count] {
-            return Err(ObjError::new(
-                line,
-                format!(
-                    "parm {uv}: empty domain: knot {} ({}) must be smaller than knot {} ({})",
-                    d + 1,
-                    p[d],
-                    dir.count + 1,
-                    p[dir.count]
-                ),
-            ));
-        }
-    }
-    Ok(())
-}
-
 /// A finite number; `what` names it in the message.
 fn number(t: &Token, what: &str) -> Result<f64, ObjError> {
     match t.text.parse::<f64>() {
@@ -972,36 +778,4 @@ fn number(t: &Token, what: &str) -> Result<f64, ObjError> {
 
 fn join(tokens: &[Token]) -> String {
     tokens.iter().map(|t| t.text).collect::<Vec<_>>().join(" ")
-}
-
-/// Warnings grouped by kind: one line per kind, at its first occurrence, with a count.
-#[derive(Debug, Default)]
-struct Warnings {
-    list: Vec<(String, usize, usize, String)>,
-}
-
-impl Warnings {
-    fn add(&mut self, key: &str, line: usize, message: impl FnOnce() -> String) {
-        match self.list.iter_mut().find(|w| w.0 == key) {
-            Some(w) => w.2 += 1,
-            None => self.list.push((key.to_string(), line, 1, message())),
-        }
-    }
-
-    fn into_list(self) -> Vec<ObjWarning> {
-        let mut out: Vec<ObjWarning> = self
-            .list
-            .into_iter()
-            .map(|(_, line, count, message)| ObjWarning {
-                line,
-                message: if count > 1 {
-                    format!("{message} ({count} times, first here)")
-                } else {
-                    message
-                },
-            })
-            .collect();
-        out.sort_by_key(|w| w.line);
-        out
-    }
 }
