@@ -1,11 +1,12 @@
 //! `prespline render`: draws a scene headless into a PNG file.
 
 use super::CliError;
+use super::files::{SampleOverride, load_scene};
 use crate::gpu::{Renderer, RendererDesc, ValidationMode};
 use crate::render::offscreen::{Shot, render_document};
 use crate::render::{Document, OrbitCamera, ViewOptions};
+use crate::scene::SceneError;
 use crate::scene::edit::parse_edits;
-use crate::scene::{Scene, SceneError};
 use std::path::Path;
 use std::time::Instant;
 
@@ -40,9 +41,13 @@ pub fn validation_mode() -> ValidationMode {
     }
 }
 
-/// Loads a scene and applies an edits file (through the delta path).
-pub fn load_document(scene_path: &Path, edits: Option<&Path>) -> Result<Document, CliError> {
-    let scene = Scene::load(scene_path).map_err(|e| CliError::in_file(scene_path, e))?;
+/// Loads a scene (JSON or OBJ) and applies an edits file (through the delta path).
+pub fn load_document(
+    scene_path: &Path,
+    edits: Option<&Path>,
+    samples: &SampleOverride,
+) -> Result<Document, CliError> {
+    let scene = load_scene(scene_path, samples)?;
     let mut doc = Document::new(&scene);
     if let Some(path) = edits {
         let text = std::fs::read_to_string(path)

@@ -3,7 +3,6 @@
 
 use super::CliError;
 use crate::sampling::{SampleMode, SampledObject};
-use crate::scene::Scene;
 use crate::scene::edit::{apply_all, parse_edits};
 use std::fmt::Write;
 use std::path::Path;
@@ -30,7 +29,7 @@ pub fn run(args: &SampleArgs) -> Result<String, CliError> {
             args.derivatives
         )));
     }
-    let mut scene = Scene::load(args.scene).map_err(|e| CliError::in_file(args.scene, e))?;
+    let mut scene = super::files::load_scene(args.scene, &Default::default())?;
     let edits = match args.edits {
         Some(path) => {
             let text = std::fs::read_to_string(path)

@@ -1,8 +1,8 @@
 //! `prespline view`: the interactive viewer.
 
 use super::CliError;
+use super::files::{SampleOverride, load_scene};
 use crate::profile::{RunInfo, Summary, write_all};
-use crate::scene::Scene;
 use crate::scene::demo::demo_scene;
 use crate::view::app::{self, ViewArgs};
 use crate::view::script::parse_script;
@@ -17,6 +17,8 @@ pub struct ViewOptions<'a> {
     pub script: Option<&'a Path>,
     pub save_as: Option<&'a Path>,
     pub profile: Option<&'a Path>,
+    /// `--samples` overrides for the loaded scene.
+    pub samples: SampleOverride,
 }
 
 pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
@@ -27,7 +29,7 @@ pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
     }
     let (scene, title, default_save) = match opts.scene {
         Some(p) => (
-            Scene::load(p).map_err(|e| CliError::in_file(p, e))?,
+            load_scene(p, &opts.samples)?,
             p.display().to_string(),
             p.to_path_buf(),
         ),

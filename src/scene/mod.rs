@@ -4,6 +4,7 @@
 pub mod demo;
 pub mod edit;
 mod json;
+pub mod obj;
 mod parse;
 mod write;
 

@@ -847,11 +847,11 @@ impl Session {
         }
     }
 
-    /// Writes the scene (exact control data) to the save path.
+    /// Writes the scene (exact control data) to the save path, as OBJ when it ends in `.obj`.
     pub fn save(&mut self) {
         self.apply_pending();
         let scene = self.doc.to_scene();
-        match scene.save(&self.save_path) {
+        match crate::scene::obj::save_scene_file(&scene, &self.save_path) {
             Ok(()) => self.set_status(format!("saved {}", self.save_path.display())),
             Err(e) => self.set_status(format!("save failed: {e}")),
         }
