@@ -171,10 +171,10 @@ fn structural(
             let t = as_f64(at, "insert_knot", "parameter", v)?;
             return Ok(CurveEdit::InsertKnot { t, times }.into_object());
         }
-        let dirs = as_object(at, "insert_knot", v)?;
-        let (dir, t) = match (dirs.get("u"), dirs.get("v"), dirs.len()) {
-            (Some(t), None, 1) => (0, t),
-            (None, Some(t), 1) => (1, t),
+        let one = |key: &str| v.as_object().filter(|d| d.len() == 1).and_then(|d| d.get(key));
+        let (dir, t) = match (one("u"), one("v")) {
+            (Some(t), _) => (0, t),
+            (_, Some(t)) => (1, t),
             _ => {
                 return Err(at.err(
                     "insert_knot",
