@@ -21,7 +21,7 @@ pub use basis::HermiteMatrix;
 pub use bezier::BezierCurve;
 pub use bfunction::{BFunction, BFunctionKind};
 pub use bspline::BSplineCurve;
-pub use erbs::{ErbsCurve, ErbsSurface};
+pub use erbs::{ErbsCurve, ErbsSurface, LocalCurve, LocalPatch};
 pub use error::GeomError;
 pub use knots::KnotVector;
 pub use surface::{Partials, TensorSurface};

@@ -1,7 +1,9 @@
 //! The edit vocabulary shared by every layer: one trait per-kind edits implement, the sum over
 //! kinds, and the frame-merging of edits.
 
-use super::{CurveEdit, ErbsCurveEdit, ErbsSurfaceEdit, Index2, Model, ModelRef, SurfaceEdit};
+use super::{
+    CurveEdit, ErbsCurveEdit, ErbsSurfaceEdit, Index2, LocalPath, Model, ModelRef, SurfaceEdit,
+};
 use std::fmt::Debug;
 
 /// A rejected edit: which field of the edit is wrong and why (callers add the object and the
@@ -30,8 +32,8 @@ impl EditError {
 pub enum Target {
     Point(Index2),
     Weight(Index2),
-    /// An ERBS local curve or patch (its transform and its control points).
-    Local(Index2),
+    /// An ERBS local curve or patch (its transform and its control points), by path.
+    Local(LocalPath<Index2>),
     Structure,
 }
 

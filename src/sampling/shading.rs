@@ -495,8 +495,8 @@ mod tests {
     use super::*;
     use crate::geom::{BFunctionKind, BSplineCurve, ErbsSurface, TensorSurface};
     use crate::model::{
-        CurveEdit, CurveModel, ErbsSurfaceEdit, ErbsSurfaceModel, LocalEdit, PointEdit, SplineForm,
-        SurfaceEdit, SurfaceModel,
+        CurveEdit, CurveModel, ErbsSurfaceEdit, ErbsSurfaceModel, LocalEdit, LocalPath, PointEdit,
+        SplineForm, SurfaceEdit, SurfaceModel,
     };
     use crate::sampling::erbs_surface::ErbsSurfaceSampler;
     use crate::sampling::grid::{PartialSet, SampleGrid};
@@ -659,14 +659,14 @@ mod tests {
             let d = difference(fast.grid(), generic.grid());
             assert!(d < 1e-13, "case {case}: {d:e}");
             for _ in 0..10 {
-                let local = [rng.below(count[0]), rng.below(count[1])];
+                let local = LocalPath::top([rng.below(count[0]), rng.below(count[1])]);
                 let edit = if rng.below(2) == 0 {
                     let matrix = DMat4::from_translation(rng.vec(1.0))
                         * DMat4::from_axis_angle(rng.vec(1.0).normalize(), rng.range(-1.0, 1.0));
                     LocalEdit::Transform { local, matrix }
                 } else {
-                    let patch = fast.model().surface().local_patch(local[0], local[1]);
-                    let [da, db] = patch.degree();
+                    let [k, l] = local.steps()[0];
+                    let [da, db] = fast.model().surface().local_patch(k, l).degree();
                     let point = [rng.below(da + 1), rng.below(db + 1)];
                     let delta = rng.vec(1.0);
                     LocalEdit::MovePoint {

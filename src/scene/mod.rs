@@ -6,6 +6,7 @@ pub mod edit;
 mod json;
 pub mod obj;
 mod parse;
+mod parse_erbs;
 mod write;
 
 pub use crate::model::{Index2, MAX_CURVE_SAMPLES, MAX_DEGREE, MAX_SURFACE_SAMPLES, Model};

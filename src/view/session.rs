@@ -11,7 +11,9 @@ use super::script::Action;
 use super::tools::{Axis, Drag, Transform, TransformKind, View};
 use super::undo::UndoStack;
 use crate::gpu::{Frame, GpuResult, Renderer};
-use crate::model::{CurveEdit, Edit, Index2, KindEdit, ModelRef, SurfaceEdit, merge_edits};
+use crate::model::{
+    CurveEdit, Edit, Index2, KindEdit, LocalPath, ModelRef, SurfaceEdit, merge_edits,
+};
 use crate::render::overlays::overlay_lines;
 use crate::render::{
     Bounds, Document, GpuScene, Handle, Highlight, NetMode, OrbitCamera, Palette, UploadStats,
@@ -26,7 +28,7 @@ use std::time::Instant;
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Target {
     Point(Handle),
-    Local(usize, Index2),
+    Local(usize, LocalPath<Index2>),
 }
 
 #[derive(Debug, Clone)]
@@ -69,7 +71,7 @@ pub struct Session {
     hovered: Option<Projected>,
     hovered_object: Option<usize>,
     selected: Option<Handle>,
-    selected_local: Option<(usize, Index2)>,
+    selected_local: Option<(usize, LocalPath<Index2>)>,
     mode: Mode,
     pending: Vec<Edit>,
     undo: UndoStack,
@@ -164,7 +166,7 @@ impl Session {
         self.selected
     }
 
-    pub fn selected_local(&self) -> Option<(usize, Index2)> {
+    pub fn selected_local(&self) -> Option<(usize, LocalPath<Index2>)> {
         self.selected_local
     }
 
@@ -526,7 +528,7 @@ impl Session {
             Handle::LocalPoint { local, point, .. } => {
                 format!(
                     "{name}: local {} point {} (G/R/S transform the local)",
-                    index_text(local),
+                    path_text(local),
                     index_text(point)
                 )
             }
@@ -913,6 +915,11 @@ fn default_nets(doc: &Document) -> NetMode {
     } else {
         NetMode::Focused
     }
+}
+
+fn path_text(path: LocalPath<Index2>) -> String {
+    let steps: Vec<String> = path.steps().iter().map(|&i| index_text(i)).collect();
+    steps.join(" → ")
 }
 
 fn index_text(i: Index2) -> String {
