@@ -3,6 +3,7 @@
 use clap::{Args, Parser, Subcommand};
 use prespline::cli::{self, CliError};
 use prespline::render::{NetMode, OrbitCamera, ViewOptions, Wire};
+use prespline::sampling::budget::{self, MemoryBudget};
 use prespline::view::scenario::Scenario;
 use std::io::Write;
 use std::path::PathBuf;
@@ -34,6 +35,8 @@ enum Command {
         /// Apply the edits to the model and re-sample from scratch instead of the delta path.
         #[arg(long)]
         full: bool,
+        #[command(flatten)]
+        memory: MemoryArgs,
     },
     /// Open the interactive viewer on a scene (the built-in demo scene without SCENE).
     View {
@@ -56,6 +59,8 @@ enum Command {
         /// summary, Chrome trace, SVG plots) into DIR when the window closes.
         #[arg(long, value_name = "DIR")]
         profile: Option<PathBuf>,
+        #[command(flatten)]
+        memory: MemoryArgs,
     },
     /// Run a scripted, reproducible editing session and report where every millisecond goes.
     Bench {
@@ -86,6 +91,8 @@ enum Command {
         /// MSAA samples (1, 2, 4, 8); 0 picks 4 where supported.
         #[arg(long, default_value_t = 0)]
         msaa: u32,
+        #[command(flatten)]
+        memory: MemoryArgs,
     },
     /// Render a scene headless (no display needed) into a PNG image.
     Render {
@@ -109,7 +116,24 @@ enum Command {
         msaa: u32,
         #[command(flatten)]
         display: DisplayArgs,
+        #[command(flatten)]
+        memory: MemoryArgs,
     },
+}
+
+/// How much memory pre-evaluation may take.
+#[derive(Args, Clone, Copy)]
+struct MemoryArgs {
+    /// Refuse scenes whose pre-evaluated tables, samples and GPU mirrors would need more than
+    /// this (bytes, or with K, M, G, T: 512M, 4G). Default: half of physical memory.
+    #[arg(long, value_name = "SIZE", value_parser = budget::parse_size)]
+    memory_limit: Option<u64>,
+}
+
+impl MemoryArgs {
+    fn budget(self) -> MemoryBudget {
+        MemoryBudget::from_flag(self.memory_limit)
+    }
 }
 
 /// What to draw besides curves and shaded surfaces.
@@ -161,12 +185,14 @@ fn main() -> ExitCode {
             derivatives,
             edits,
             full,
+            memory,
         } => {
             let args = cli::sample::SampleArgs {
                 scene: &scene,
                 derivatives,
                 edits: edits.as_deref(),
                 full,
+                memory: memory.budget(),
             };
             cli::sample::run(&args).and_then(|text| print(&text))
         }
@@ -177,6 +203,7 @@ fn main() -> ExitCode {
             script,
             save_as,
             profile,
+            memory,
         } => cli::view::run(&cli::view::ViewOptions {
             scene: scene.as_deref(),
             size,
@@ -184,6 +211,7 @@ fn main() -> ExitCode {
             script: script.as_deref(),
             save_as: save_as.as_deref(),
             profile: profile.as_deref(),
+            memory: memory.budget(),
         }),
         Command::Bench {
             scene,
@@ -195,6 +223,7 @@ fn main() -> ExitCode {
             naive,
             out,
             msaa,
+            memory,
         } => {
             let args = cli::bench::BenchArgs {
                 scene,
@@ -206,6 +235,7 @@ fn main() -> ExitCode {
                 naive,
                 out,
                 msaa,
+                memory: memory.budget(),
             };
             cli::bench::run(&args).map(|line| eprintln!("{line}"))
         }
@@ -217,7 +247,8 @@ fn main() -> ExitCode {
             edits,
             msaa,
             display,
-        } => cli::render::load_document(&scene, edits.as_deref())
+            memory,
+        } => cli::render::load_document(&scene, edits.as_deref(), &memory.budget())
             .and_then(|doc| {
                 cli::render::run(&doc, &out, size.0, size.1, camera, display.options(), msaa)
             })

@@ -95,7 +95,7 @@ fn scripted_session_saves_exact_edits_and_matches_the_golden() {
     }
 
     let pixels = Pixels::read_png(&shot).unwrap();
-    common::assert_golden("view_session", &pixels, 2, 0.002);
+    common::assert_golden("view_session", &pixels);
 }
 
 fn display() -> bool {

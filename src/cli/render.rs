@@ -4,6 +4,8 @@ use super::CliError;
 use crate::gpu::{Renderer, RendererDesc, ValidationMode};
 use crate::render::offscreen::{Shot, render_document};
 use crate::render::{Document, OrbitCamera, ViewOptions};
+use crate::sampling::SampleMode;
+use crate::sampling::budget::{MemoryBudget, Uses, check_scene};
 use crate::scene::Scene;
 use crate::scene::edit::parse_edits;
 use std::path::Path;
@@ -40,9 +42,29 @@ pub fn validation_mode() -> ValidationMode {
     }
 }
 
-/// Loads a scene and applies an edits file (through the delta path).
-pub fn load_document(scene_path: &Path, edits: Option<&Path>) -> Result<Document, CliError> {
+/// What drawing commands (`render`, `view`, `bench`) keep per object.
+pub const DRAW_USES: Uses = Uses {
+    gpu: true,
+    json_text: false,
+};
+
+/// Refuses a scene whose pre-evaluation and GPU mirrors would not fit `budget` (one line naming
+/// the object and the estimate).
+pub fn check_drawable(scene: &Scene, path: &Path, budget: &MemoryBudget) -> Result<(), CliError> {
+    check_scene(scene, SampleMode::Render, DRAW_USES, budget)
+        .map(|_| ())
+        .map_err(|e| CliError::in_file(path, e))
+}
+
+/// Loads a scene, checks it against the memory budget and applies an edits file (through the
+/// delta path).
+pub fn load_document(
+    scene_path: &Path,
+    edits: Option<&Path>,
+    budget: &MemoryBudget,
+) -> Result<Document, CliError> {
     let scene = Scene::load(scene_path).map_err(|e| CliError::in_file(scene_path, e))?;
+    check_drawable(&scene, scene_path, budget)?;
     let mut doc = Document::new(&scene);
     if let Some(path) = edits {
         let text = std::fs::read_to_string(path)

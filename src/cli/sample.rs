@@ -2,6 +2,7 @@
 //! DESIGN.md JSON contract on stdout.
 
 use super::CliError;
+use crate::sampling::budget::{MemoryBudget, Uses, check_scene};
 use crate::sampling::{SampleMode, SampledObject};
 use crate::scene::edit::{apply_all, parse_edits};
 use crate::scene::{Scene, Shape};
@@ -19,6 +20,8 @@ pub struct SampleArgs<'a> {
     pub edits: Option<&'a Path>,
     /// Apply edits to the model and re-sample from scratch instead of the delta path.
     pub full: bool,
+    /// What pre-evaluation and the output text may take.
+    pub memory: MemoryBudget,
 }
 
 /// Runs the command and returns the complete output text (nothing is printed on error, so a
@@ -40,8 +43,16 @@ pub fn run(args: &SampleArgs) -> Result<String, CliError> {
         None => Vec::new(),
     };
     let mode = SampleMode::Derivatives(args.derivatives);
+    let uses = Uses {
+        gpu: false,
+        json_text: true,
+    };
+    check_scene(&scene, mode, uses, &args.memory).map_err(|e| CliError::in_file(args.scene, e))?;
     let objects: Vec<SampledObject> = if args.full {
         apply_all(&mut scene, &edits);
+        // Edits may refine the model: budget what is actually sampled.
+        check_scene(&scene, mode, uses, &args.memory)
+            .map_err(|e| CliError::in_file(args.scene, e))?;
         scene
             .objects
             .iter()

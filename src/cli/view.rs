@@ -2,6 +2,7 @@
 
 use super::CliError;
 use crate::profile::{RunInfo, Summary, write_all};
+use crate::sampling::budget::MemoryBudget;
 use crate::scene::Scene;
 use crate::scene::demo::demo_scene;
 use crate::view::app::{self, ViewArgs};
@@ -17,14 +18,11 @@ pub struct ViewOptions<'a> {
     pub script: Option<&'a Path>,
     pub save_as: Option<&'a Path>,
     pub profile: Option<&'a Path>,
+    /// What pre-evaluation and the GPU mirrors may take.
+    pub memory: MemoryBudget,
 }
 
 pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
-    if !app::display_available() {
-        return Err(CliError(
-            "no display: DISPLAY is not set (prespline view needs X11 or XWayland; headless: `prespline render` or `prespline bench`, or `make run` which falls back to a headless demo)".into(),
-        ));
-    }
     let (scene, title, default_save) = match opts.scene {
         Some(p) => (
             Scene::load(p).map_err(|e| CliError::in_file(p, e))?,
@@ -37,6 +35,12 @@ pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
             Path::new("prespline-demo.json").to_path_buf(),
         ),
     };
+    super::render::check_drawable(&scene, Path::new(&title), &opts.memory)?;
+    if !app::display_available() {
+        return Err(CliError(
+            "no display: DISPLAY is not set (prespline view needs X11 or XWayland; headless: `prespline render` or `prespline bench`, or `make run` which falls back to a headless demo)".into(),
+        ));
+    }
     let script = match opts.script {
         Some(p) => {
             let text = std::fs::read_to_string(p)
