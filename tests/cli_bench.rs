@@ -9,7 +9,7 @@ fn prespline() -> Command {
     let icd = prespline::gpu::LAVAPIPE_ICD;
     c.env("VK_DRIVER_FILES", icd)
         .env("VK_ICD_FILENAMES", icd)
-        .env("PRESPLINE_VALIDATION", "1");
+        .env("PRESPLINE_VALIDATION", "required");
     c
 }
 

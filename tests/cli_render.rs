@@ -8,7 +8,7 @@ fn prespline() -> Command {
     let icd = "/usr/share/vulkan/icd.d/lvp_icd.x86_64.json";
     c.env("VK_DRIVER_FILES", icd)
         .env("VK_ICD_FILENAMES", icd)
-        .env("PRESPLINE_VALIDATION", "1");
+        .env("PRESPLINE_VALIDATION", "required");
     c
 }
 

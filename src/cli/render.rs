@@ -31,10 +31,12 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
 }
 
 /// Validation layer policy for interactive commands: on in debug builds or with
-/// `PRESPLINE_VALIDATION=1`, when the layer is installed.
+/// `PRESPLINE_VALIDATION=1`, when the layer is installed; `PRESPLINE_VALIDATION=required`
+/// refuses to run without it (tests must not pass unvalidated); `0` turns it off.
 pub fn validation_mode() -> ValidationMode {
     let env = std::env::var("PRESPLINE_VALIDATION").ok();
     match env.as_deref() {
+        Some("required") => ValidationMode::Required,
         Some("1") => ValidationMode::IfAvailable,
         Some("0") => ValidationMode::Off,
         _ if cfg!(debug_assertions) => ValidationMode::IfAvailable,

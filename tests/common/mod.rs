@@ -244,9 +244,15 @@ impl Scratch {
         use std::sync::atomic::{AtomicUsize, Ordering};
         static NEXT: AtomicUsize = AtomicUsize::new(0);
         let n = NEXT.fetch_add(1, Ordering::Relaxed);
-        let path = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-            .join(format!("{label}-{}-{n}", std::process::id()));
-        // A reused process id must not find an earlier run's results.
+        Self::at(
+            PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+                .join(format!("{label}-{}-{n}", std::process::id())),
+        )
+    }
+
+    /// The scratch directory `path`, emptied first: a reused process id must not find an
+    /// earlier run's results.
+    pub fn at(path: PathBuf) -> Self {
         let _ = std::fs::remove_dir_all(&path);
         std::fs::create_dir_all(&path)
             .unwrap_or_else(|e| panic!("cannot create {}: {e}", path.display()));
