@@ -59,6 +59,10 @@ enum Command {
         /// summary, Chrome trace, SVG plots) into DIR when the window closes.
         #[arg(long, value_name = "DIR")]
         profile: Option<PathBuf>,
+        /// Open the unsaved edits an earlier session left in NAME.autosave.json (beside
+        /// NAME.json; demo.autosave.json for the demo) instead of the scene.
+        #[arg(long)]
+        recover: bool,
         #[command(flatten)]
         memory: MemoryArgs,
     },
@@ -203,6 +207,7 @@ fn main() -> ExitCode {
             script,
             save_as,
             profile,
+            recover,
             memory,
         } => cli::view::run(&cli::view::ViewOptions {
             scene: scene.as_deref(),
@@ -212,6 +217,7 @@ fn main() -> ExitCode {
             save_as: save_as.as_deref(),
             profile: profile.as_deref(),
             memory: memory.budget(),
+            recover,
         }),
         Command::Bench {
             scene,

@@ -213,6 +213,7 @@ fn run_window(
         warmup: args.warmup,
         max_frames: Some(args.warmup + args.frames),
         naive,
+        autosave: None,
     })
     .map_err(CliError)?;
     Ok((run.frames, run.device))
