@@ -6,6 +6,8 @@
 //! environment points the loader at a driver manifest that does not exist: it runs under
 //! `make test` and CI like anywhere else, and never skips.
 
+mod common;
+
 use prespline::gpu::{GpuError, Renderer, RendererDesc};
 use std::process::Command;
 
