@@ -1,4 +1,5 @@
 //! The `prespline` command line.
+#![deny(unsafe_code)]
 
 use clap::{Args, Parser, Subcommand};
 use prespline::cli::{self, CliError};

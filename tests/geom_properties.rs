@@ -61,7 +61,7 @@ fn close(a: DVec3, b: DVec3, tol: f64) -> bool {
 
 /// The seed every run starts from: the same cases each time, so a failure reproduces (set
 /// `PROPTEST_RNG_SEED` to explore others).
-const SEED: u64 = 0x5eed_0f_9e0;
+const SEED: u64 = 0x0005_eed0_f9e0;
 /// Committed next to this file; proptest replays its cases before generating new ones and
 /// appends any new failure to it (commit it then).
 const REGRESSIONS: &str = "proptest-regressions";

@@ -274,7 +274,7 @@ pub fn estimate(extent: &Extent, mode: SampleMode, uses: Uses) -> Estimate {
             format!("{samples_text} × {orders} × ~80 characters"),
         );
     }
-    e.parts.sort_by(|a, b| b.bytes.cmp(&a.bytes));
+    e.parts.sort_by_key(|p| std::cmp::Reverse(p.bytes));
     e
 }
 

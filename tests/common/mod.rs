@@ -181,9 +181,8 @@ pub fn assert_golden(name: &str, actual: &Pixels) {
     let actual_path = dir.join(format!("{name}-actual.png"));
     let diff_path = dir.join(format!("{name}-diff.png"));
     let outcome = compare_images(&golden, actual, GOLDEN.channel).and_then(|diff| {
-        diff.check(&GOLDEN).map_err(|why| {
+        diff.check(&GOLDEN).inspect_err(|_| {
             diff.picture.write_png(&diff_path).expect("write diff");
-            why
         })
     });
     if let Err(why) = outcome {

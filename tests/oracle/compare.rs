@@ -215,7 +215,7 @@ fn compare_object(object: &Object, n: usize, entry: &Value, rel_tol: f64, report
                 report.compared += 1;
                 let relative = if err == 0.0 { 0.0 } else { err / scale };
                 report.max_relative_error = nan_max(report.max_relative_error, relative);
-                if !(err <= rel_tol * scale) {
+                if err.is_nan() || err > rel_tol * scale {
                     report.mismatch_count += 1;
                     if listed < MAX_LISTED {
                         listed += 1;
