@@ -116,3 +116,44 @@ fn required_validation_fails_without_the_layer() {
     let r = render("1");
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
 }
+
+/// The display flags draw what the goldens of `render_golden` show: `--normals --wire 1`,
+/// `--frenet` and `--no-local` run the way a user runs them, against the same golden images.
+#[test]
+fn display_flags_draw_what_the_goldens_show() {
+    let scratch = common::Scratch::new("cli-render");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for (example, flags, golden) in [
+        (
+            "bspline_surface.json",
+            &["--normals", "--wire", "1"][..],
+            "bspline_surface_normals_wire",
+        ),
+        ("helix.json", &["--frenet"][..], "helix_frenet"),
+        (
+            "erbs_surface.json",
+            &["--no-local"][..],
+            "erbs_surface_no_local",
+        ),
+    ] {
+        let out = scratch.join(&format!("{golden}.png"));
+        let r = prespline()
+            .arg("render")
+            .arg(root.join("examples").join(example))
+            .args(["--size", "640x400", "--msaa", "4"])
+            .args(flags)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        let expected =
+            prespline::gpu::Pixels::read_png(&root.join(format!("tests/golden/{golden}.png")))
+                .unwrap();
+        let actual = prespline::gpu::Pixels::read_png(&out).unwrap();
+        common::compare_images(&expected, &actual, common::GOLDEN.channel)
+            .unwrap()
+            .check(&common::GOLDEN)
+            .unwrap_or_else(|e| panic!("{example} {flags:?} against {golden}: {e}"));
+    }
+}

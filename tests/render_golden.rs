@@ -96,13 +96,6 @@ fn erbs_surface_with_local_patches() {
     common::assert_golden("erbs_surface_local", &px);
 }
 
-/// A helix: its Frenet frames turn around the axis, so a wrong frame shows.
-const HELIX: &str = r#"{"objects": [{"name": "helix", "type": "bspline_curve", "degree": 3,
-  "knots": [0, 0, 0, 0, 1, 2, 3, 4, 5, 6, 6, 6, 6],
-  "points": [[2, 0, 0], [2, 1.5, 0.3], [0, 2.4, 0.8], [-2.2, 1.2, 1.3], [-2.2, -1.2, 1.8],
-             [0, -2.4, 2.3], [2.2, -1.2, 2.8], [2.2, 1.2, 3.3], [0, 2, 3.8]],
-  "samples": 200}]}"#;
-
 #[test]
 fn surface_normals_and_full_wireframe() {
     let px = render(
@@ -118,9 +111,9 @@ fn surface_normals_and_full_wireframe() {
 
 #[test]
 fn curve_with_frenet_frames() {
-    let px = render_scene(
-        &parse_scene(HELIX).unwrap(),
-        None,
+    // A helix-like curve: its Frenet frames turn around the axis, so a wrong frame shows.
+    let px = render(
+        "helix.json",
         ViewOptions {
             frenet: true,
             ..ViewOptions::default()
