@@ -403,3 +403,38 @@ fn without_a_display_strict_runs_fail() {
         }
     }
 }
+
+/// An error that ends the viewer (here a screenshot that cannot be written) still keeps the
+/// unsaved edits and says where.
+#[test]
+fn an_error_exit_keeps_the_unsaved_edits() {
+    if !common::display() {
+        return;
+    }
+    let dir = Scratch::new("view-xvfb");
+    let out = run(prespline(&dir)
+        .args(["view", "--size", "320x240", "--script"])
+        .arg(dir.file(
+            "script.json",
+            r#"[{"frame": 3, "move_to": {"object": "nurbs_circle", "point": 2}},
+                {"frame": 4, "press": "left"}, {"frame": 5, "release": "left"},
+                {"frame": 6, "key": "g"}, {"frame": 7, "key": "x"}, {"frame": 8, "type": "2"},
+                {"frame": 9, "key": "enter"},
+                {"frame": 11, "screenshot": "/nonexistent/directory/shot.png"},
+                {"frame": 30, "quit": true}]"#,
+        )));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success(),
+        "the screenshot cannot succeed: {err}"
+    );
+    assert!(err.contains("/nonexistent/directory/shot.png"), "{err}");
+    assert!(
+        err.contains("unsaved edits kept in demo.autosave.json"),
+        "{err}"
+    );
+    assert_ne!(
+        Scene::load(&dir.join("demo.autosave.json")).unwrap(),
+        demo_scene()
+    );
+}
