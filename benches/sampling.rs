@@ -1,7 +1,8 @@
 //! Pre-evaluation benchmarks on the DESIGN.md "Performance model" workload:
 //! a bicubic clamped uniform surface with 100×100 control points sampled 512×512 with S, Su, Sv
 //! and normals; a cubic curve with 1000 control points sampled 100 000 times with C, C'; edits of
-//! one interior point, one boundary point, ten random points, and an ERBS local-patch rotation.
+//! one interior point, one boundary point, ten random points, and an ERBS local-patch rotation;
+//! structural edits of the surface (knot insertion, degree elevation), each with its undo.
 //!
 //! `cargo bench --bench sampling` runs criterion and then prints a summary table (full sampling
 //! time, M samples/s, µs per edit, samples touched, edit/full ratio) from criterion's estimates.
@@ -9,15 +10,18 @@
 use criterion::{BenchmarkId, Criterion, Throughput};
 use glam::{DMat4, DVec3};
 use prespline::geom::{BFunctionKind, BSplineCurve, ErbsSurface, KnotVector, TensorSurface};
+use prespline::model::{
+    CurveEdit, CurveModel, ErbsSurfaceEdit, ErbsSurfaceModel, KindEdit, LocalEdit, Model,
+    ObjectEdit, PointEdit, SplineForm, SurfaceEdit, SurfaceModel,
+};
 use prespline::sampling::{SampleMode, SampledObject};
-use prespline::scene::{EditOp, Index2, Samples, Shape};
 use std::hint::black_box;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 const SURFACE_SAMPLES: usize = 512;
 const CURVE_SAMPLES: usize = 100_000;
 
-fn surface() -> Shape {
+fn surface() -> Model {
     let n = 100;
     let pts = (0..n * n)
         .map(|k| {
@@ -26,29 +30,22 @@ fn surface() -> Shape {
         })
         .collect();
     let k = KnotVector::clamped_uniform(3, n, 0.0, 1.0).into_vec();
-    Shape::BSplineSurface(
-        TensorSurface::bspline([3, 3], [k.clone(), k], [n, n], pts, None).unwrap(),
-    )
+    let s = TensorSurface::bspline([3, 3], [k.clone(), k], [n, n], pts, None).unwrap();
+    Model::Surface(SurfaceModel::new(SplineForm::BSpline, s, [SURFACE_SAMPLES; 2]).unwrap())
 }
 
-fn curve() -> Shape {
+fn curve() -> Model {
     let n = 1000;
     let pts = (0..n)
         .map(|i| DVec3::new(i as f64, (0.1 * i as f64).sin(), 0.0))
         .collect();
-    Shape::BSplineCurve(
-        BSplineCurve::new(
-            3,
-            KnotVector::clamped_uniform(3, n, 0.0, 1.0).into_vec(),
-            pts,
-            None,
-        )
-        .unwrap(),
-    )
+    let k = KnotVector::clamped_uniform(3, n, 0.0, 1.0).into_vec();
+    let c = BSplineCurve::new(3, k, pts, None).unwrap();
+    Model::Curve(CurveModel::new(SplineForm::BSpline, c, CURVE_SAMPLES).unwrap())
 }
 
 /// 10 × 10 bicubic local patches tiling [0, 10]².
-fn erbs_surface() -> Shape {
+fn erbs_surface() -> Model {
     let n = 10;
     let knots: Vec<f64> = std::iter::once(0.0)
         .chain((0..n).map(|i| i as f64))
@@ -69,15 +66,14 @@ fn erbs_surface() -> Shape {
             patches.push(TensorSurface::bezier([4, 4], pts, None).unwrap());
         }
     }
-    Shape::ErbsSurface(
-        ErbsSurface::new(
-            [knots.clone(), knots],
-            [n, n],
-            patches,
-            BFunctionKind::ExpoRational,
-        )
-        .unwrap(),
+    let e = ErbsSurface::new(
+        [knots.clone(), knots],
+        [n, n],
+        patches,
+        BFunctionKind::ExpoRational,
     )
+    .unwrap();
+    Model::ErbsSurface(ErbsSurfaceModel::new(e, [SURFACE_SAMPLES; 2]).unwrap())
 }
 
 fn rotation_about(centre: DVec3, angle: f64) -> DMat4 {
@@ -86,11 +82,14 @@ fn rotation_about(centre: DVec3, angle: f64) -> DMat4 {
         * DMat4::from_translation(-centre)
 }
 
-/// The edit scenarios: (name, object, edit batch).
-fn scenarios() -> Vec<(&'static str, &'static str, Vec<EditOp>)> {
-    let mv = |i, j| EditOp::TranslatePoint {
-        point: Index2::Two(i, j),
-        delta: DVec3::new(0.0, 0.0, 1e-3),
+/// The edit scenarios: (name, object, edit batch). Batches repeat as they are.
+fn scenarios() -> Vec<(&'static str, &'static str, Vec<ObjectEdit>)> {
+    let mv = |i, j| {
+        SurfaceEdit::Point(PointEdit::Move {
+            point: [i, j],
+            delta: DVec3::new(0.0, 0.0, 1e-3),
+        })
+        .into_object()
     };
     let mut state = 12345u64;
     let mut next = move || {
@@ -107,39 +106,68 @@ fn scenarios() -> Vec<(&'static str, &'static str, Vec<EditOp>)> {
         (
             "curve point",
             "curve",
-            vec![EditOp::TranslatePoint {
-                point: Index2::One(500),
-                delta: DVec3::new(0.0, 1e-3, 0.0),
-            }],
+            vec![
+                CurveEdit::Point(PointEdit::Move {
+                    point: 500,
+                    delta: DVec3::new(0.0, 1e-3, 0.0),
+                })
+                .into_object(),
+            ],
         ),
         (
             "ERBS patch rotation",
             "erbs",
-            vec![EditOp::TransformLocal {
-                local: Index2::Two(4, 5),
-                matrix: rotation_about(DVec3::new(4.5, 5.5, 0.0), 1e-3),
-            }],
+            vec![
+                ErbsSurfaceEdit::Local(LocalEdit::Transform {
+                    local: [4, 5],
+                    matrix: rotation_about(DVec3::new(4.5, 5.5, 0.0), 1e-3),
+                })
+                .into_object(),
+            ],
         ),
     ]
 }
 
-fn objects() -> Vec<(&'static str, Shape, Samples)> {
+/// Structural edits of the surface: (name, edit). Each is timed alone; its undo runs between
+/// iterations, untimed, so every iteration refines the same 100 × 100 net.
+fn structural() -> Vec<(&'static str, SurfaceEdit)> {
     vec![
-        ("surface", surface(), Samples::Surface([SURFACE_SAMPLES; 2])),
-        ("curve", curve(), Samples::Curve(CURVE_SAMPLES)),
         (
-            "erbs",
-            erbs_surface(),
-            Samples::Surface([SURFACE_SAMPLES; 2]),
+            "insert u knot",
+            SurfaceEdit::InsertKnot {
+                dir: 0,
+                t: 0.5037,
+                times: 1,
+            },
         ),
+        (
+            "insert v knot",
+            SurfaceEdit::InsertKnot {
+                dir: 1,
+                t: 0.5037,
+                times: 1,
+            },
+        ),
+        (
+            "elevate u degree",
+            SurfaceEdit::ElevateDegree { by: [1, 0] },
+        ),
+    ]
+}
+
+fn objects() -> Vec<(&'static str, Model)> {
+    vec![
+        ("surface", surface()),
+        ("curve", curve()),
+        ("erbs", erbs_surface()),
     ]
 }
 
 fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("full");
     g.sample_size(20).measurement_time(Duration::from_secs(4));
-    for (name, shape, samples) in objects() {
-        let mut obj = SampledObject::new(&shape, samples, SampleMode::Render);
+    for (name, model) in objects() {
+        let mut obj = SampledObject::new(&model, SampleMode::Render);
         g.throughput(Throughput::Elements(obj.sample_count() as u64));
         g.bench_function(BenchmarkId::from_parameter(name), |b| {
             b.iter(|| {
@@ -154,35 +182,38 @@ fn bench(c: &mut Criterion) {
     g.measurement_time(Duration::from_secs(3));
     let objs = objects();
     for (name, target, batch) in scenarios() {
-        let (_, shape, samples) = objs.iter().find(|o| o.0 == target).unwrap();
-        let mut obj = SampledObject::new(shape, *samples, SampleMode::Render);
-        // Alternate the sign so the object does not wander off over millions of iterations.
-        let back: Vec<EditOp> = batch.iter().map(invert).collect();
-        let mut flip = false;
+        let (_, model) = objs.iter().find(|o| o.0 == target).unwrap();
+        let mut obj = SampledObject::new(model, SampleMode::Render);
         g.bench_function(BenchmarkId::from_parameter(name), |b| {
             b.iter(|| {
-                flip = !flip;
-                for op in if flip { &batch } else { &back } {
-                    black_box(obj.apply(op));
+                for e in &batch {
+                    black_box(obj.apply(e).expect("the bench's edits fit their objects"));
                 }
             })
         });
     }
-    g.finish();
-}
-
-fn invert(op: &EditOp) -> EditOp {
-    match op {
-        EditOp::TranslatePoint { point, delta } => EditOp::TranslatePoint {
-            point: *point,
-            delta: -*delta,
-        },
-        EditOp::TransformLocal { local, matrix } => EditOp::TransformLocal {
-            local: *local,
-            matrix: matrix.inverse(),
-        },
-        other => other.clone(),
+    let surface = surface();
+    let Model::Surface(model) = &surface else {
+        unreachable!("the surface workload is a B-spline surface")
+    };
+    let mut obj = SampledObject::new(&surface, SampleMode::Render);
+    for (name, edit) in structural() {
+        let undo = edit.inverse(model).into_object();
+        let edit = edit.into_object();
+        g.bench_function(BenchmarkId::from_parameter(name), |b| {
+            b.iter_custom(|iters| {
+                let mut timed = Duration::ZERO;
+                for _ in 0..iters {
+                    let start = Instant::now();
+                    black_box(obj.apply(&edit).expect("valid refinement"));
+                    timed += start.elapsed();
+                    obj.apply(&undo).expect("valid undo");
+                }
+                timed
+            })
+        });
     }
+    g.finish();
 }
 
 /// Reads criterion's mean estimate (ns) for a benchmark id. Criterion keeps spaces in its
@@ -199,8 +230,8 @@ fn summary() {
     println!("| workload | samples | full sampling | M samples/s |");
     println!("|---|---:|---:|---:|");
     let objs = objects();
-    for (name, shape, samples) in &objs {
-        let n = SampledObject::new(shape, *samples, SampleMode::Render).sample_count();
+    for (name, model) in &objs {
+        let n = SampledObject::new(model, SampleMode::Render).sample_count();
         match mean_ns("full", name) {
             Some(ns) => println!(
                 "| {name} | {n} | {:.3} ms | {:.1} |",
@@ -213,9 +244,12 @@ fn summary() {
     println!("\n| edit | object | µs per edit batch | samples touched | edit / full |");
     println!("|---|---|---:|---:|---:|");
     for (name, target, batch) in scenarios() {
-        let (_, shape, samples) = objs.iter().find(|o| o.0 == target).unwrap();
-        let mut obj = SampledObject::new(shape, *samples, SampleMode::Render);
-        let touched: usize = batch.iter().map(|op| obj.apply(op).samples()).sum();
+        let (_, model) = objs.iter().find(|o| o.0 == target).unwrap();
+        let mut obj = SampledObject::new(model, SampleMode::Render);
+        let touched: usize = batch
+            .iter()
+            .map(|e| obj.apply(e).map_or(0, |r| r.samples()))
+            .sum();
         // A row whose estimate is missing still prints, so a broken lookup cannot hide it.
         match (mean_ns("edit", name), mean_ns("full", target)) {
             (Some(e), Some(f)) => println!(
@@ -229,6 +263,17 @@ fn summary() {
     }
 }
 
+fn structural_summary() {
+    println!("\n| structural edit (100 × 100 surface, 512² samples) | µs |");
+    println!("|---|---:|");
+    for (name, _) in structural() {
+        match mean_ns("edit", name) {
+            Some(ns) => println!("| {name} | {:.1} |", ns / 1e3),
+            None => println!("| {name} | not measured |"),
+        }
+    }
+}
+
 fn main() {
     let mut c = Criterion::default().configure_from_args();
     bench(&mut c);
@@ -237,5 +282,6 @@ fn main() {
     // leaves fresh estimates to summarise.
     if std::env::args().any(|a| a == "--bench") {
         summary();
+        structural_summary();
     }
 }

@@ -9,6 +9,7 @@ pub mod cli;
 pub mod geom;
 #[allow(unsafe_code)]
 pub mod gpu;
+pub mod model;
 pub mod profile;
 pub mod render;
 pub mod sampling;

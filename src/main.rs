@@ -2,6 +2,7 @@
 #![deny(unsafe_code)]
 
 use clap::{Args, Parser, Subcommand};
+use prespline::cli::files::{SampleOverride, SamplesArg};
 use prespline::cli::{self, CliError};
 use prespline::render::{NetMode, OrbitCamera, ViewOptions, Wire};
 use prespline::sampling::budget::{self, MemoryBudget};
@@ -25,7 +26,7 @@ struct Cli {
 enum Command {
     /// Sample every object of a scene and print positions and derivatives as JSON on stdout.
     Sample {
-        /// Scene file (JSON, see README "Scene files").
+        /// Scene file (JSON, see README "Scene files"; or Wavefront OBJ, see docs/obj.md).
         scene: PathBuf,
         /// Highest derivative order N: curves get c..c^(N), surfaces every ∂^{a+b}S with a, b ≤ N.
         #[arg(long, short = 'd', default_value_t = 1, value_name = "N")]
@@ -41,8 +42,8 @@ enum Command {
     },
     /// Open the interactive viewer on a scene (the built-in demo scene without SCENE).
     View {
-        /// Scene file (JSON); without it, the demo: B-spline surface, ERBS surface and curve,
-        /// NURBS circle, Utah teapot.
+        /// Scene file (JSON, or Wavefront OBJ by its .obj extension); without it, the demo:
+        /// B-spline surface, ERBS surface and curve, NURBS circle, Utah teapot.
         scene: Option<PathBuf>,
         /// Window size.
         #[arg(long, default_value = "1280x720", value_parser = cli::render::parse_size, value_name = "WxH")]
@@ -53,9 +54,12 @@ enum Command {
         /// Replay timed input events from a JSON script (see README "Scripts").
         #[arg(long, value_name = "SCRIPT.json")]
         script: Option<PathBuf>,
-        /// Where Ctrl+S writes (default: the scene file, or prespline-demo.json for the demo).
+        /// Where Ctrl+S writes (default: the scene file, or prespline-demo.json for the demo);
+        /// a path ending in .obj is written as Wavefront OBJ.
         #[arg(long, value_name = "PATH")]
         save_as: Option<PathBuf>,
+        #[command(flatten)]
+        samples: SamplesArgs,
         /// Record per-frame phase timings while interacting and write the reports (CSV, JSON
         /// summary, Chrome trace, SVG plots) into DIR when the window closes.
         #[arg(long, value_name = "DIR")]
@@ -69,7 +73,7 @@ enum Command {
     },
     /// Run a scripted, reproducible editing session and report where every millisecond goes.
     Bench {
-        /// Scene file (JSON); the demo scene without it.
+        /// Scene file (JSON or OBJ); the demo scene without it.
         scene: Option<PathBuf>,
         /// What the scripted user does.
         #[arg(long, default_value = "drag", value_parser = Scenario::parse, value_name = "drag|erbs-rotate|orbit|idle")]
@@ -101,7 +105,7 @@ enum Command {
     },
     /// Render a scene headless (no display needed) into a PNG image.
     Render {
-        /// Scene file (JSON).
+        /// Scene file (JSON, or Wavefront OBJ by its .obj extension).
         scene: PathBuf,
         /// Output image (PNG).
         #[arg(long, short = 'o', value_name = "IMAGE.png")]
@@ -122,8 +126,37 @@ enum Command {
         #[command(flatten)]
         display: DisplayArgs,
         #[command(flatten)]
+        samples: SamplesArgs,
+        #[command(flatten)]
         memory: MemoryArgs,
     },
+    /// Convert a scene between JSON and Wavefront OBJ (direction from the extensions).
+    ///
+    /// IN and OUT end in .json (the scene format) or .obj (free-form curves and surfaces);
+    /// control data are kept bit for bit. docs/obj.md describes the exact mapping.
+    Convert {
+        /// Input scene (.json or .obj).
+        input: PathBuf,
+        /// Output scene (.json or .obj), written atomically.
+        output: PathBuf,
+        #[command(flatten)]
+        samples: SamplesArgs,
+    },
+}
+
+/// Sample counts that replace the file's (or, for OBJ without them, the default).
+#[derive(Args, Clone)]
+struct SamplesArgs {
+    /// Sample counts: N for every curve, NxM for every surface; repeat for both
+    /// (e.g. --samples 400 --samples 64x64).
+    #[arg(long, value_name = "N|NxM", value_parser = SamplesArg::parse)]
+    samples: Vec<SamplesArg>,
+}
+
+impl SamplesArgs {
+    fn counts(&self) -> SampleOverride {
+        SampleOverride::from_args(&self.samples)
+    }
 }
 
 /// How much memory pre-evaluation may take.
@@ -208,6 +241,7 @@ fn main() -> ExitCode {
             script,
             save_as,
             profile,
+            samples,
             recover,
             memory,
         } => cli::view::run(&cli::view::ViewOptions {
@@ -217,6 +251,7 @@ fn main() -> ExitCode {
             script: script.as_deref(),
             save_as: save_as.as_deref(),
             profile: profile.as_deref(),
+            samples: samples.counts(),
             memory: memory.budget(),
             recover,
         }),
@@ -254,12 +289,25 @@ fn main() -> ExitCode {
             edits,
             msaa,
             display,
+            samples,
             memory,
-        } => cli::render::load_document(&scene, edits.as_deref(), &memory.budget())
-            .and_then(|doc| {
-                cli::render::run(&doc, &out, size.0, size.1, camera, display.options(), msaa)
-            })
-            .map(|line| eprintln!("{line}")),
+        } => cli::render::load_document(
+            &scene,
+            edits.as_deref(),
+            &samples.counts(),
+            &memory.budget(),
+        )
+        .and_then(|doc| {
+            cli::render::run(&doc, &out, size.0, size.1, camera, display.options(), msaa)
+        })
+        .map(|line| eprintln!("{line}")),
+        Command::Convert {
+            input,
+            output,
+            samples,
+        } => {
+            cli::files::convert(&input, &output, &samples.counts()).map(|line| eprintln!("{line}"))
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -136,7 +136,7 @@ fn display_flags_draw_what_the_goldens_show() {
             "erbs_surface_no_local",
         ),
     ] {
-        let out = scratch.join(&format!("{golden}.png"));
+        let out = scratch.join(format!("{golden}.png"));
         let r = prespline()
             .arg("render")
             .arg(root.join("examples").join(example))

@@ -6,9 +6,12 @@ mod oracle;
 use glam::DVec3;
 use oracle::random::{Kind, Options, random_edits, random_scene};
 use oracle::rng::Rng;
+use prespline::model::{
+    CurveEdit, Edit, ErbsCurveEdit, ErbsSurfaceEdit, LocalEdit, ObjectEdit, PointEdit, SurfaceEdit,
+    merge_edits,
+};
 use prespline::sampling::{SampleGrid, SampleMode, SampledObject};
-use prespline::scene::edit::{merge_edits, parse_edits};
-use prespline::scene::{Edit, EditOp, Scene, parse_scene};
+use prespline::scene::{Scene, parse_edits, parse_scene};
 
 /// A random one-object scene of `kind` and `count` random edits for it, through the product's
 /// own parsers (so the edits are validated exactly as `prespline sample --edits` does).
@@ -44,12 +47,12 @@ fn delta_and_full(
     rebuild: Option<usize>,
 ) -> (SampleGrid, SampleGrid) {
     let o = &scene.objects[0];
-    let mut obj = SampledObject::new(&o.shape, o.samples, mode);
+    let mut obj = SampledObject::new(&o.model, mode);
     obj.set_rebuild_interval(rebuild);
     for e in edits {
-        obj.apply(&e.op);
+        obj.apply(&e.edit).expect("validated edits fit");
     }
-    let fresh = SampledObject::new(&obj.shape(), o.samples, mode);
+    let fresh = SampledObject::new(&obj.model().to_model(), mode);
     (obj.grid().clone(), fresh.grid().clone())
 }
 
@@ -180,19 +183,10 @@ fn a_nan_in_the_delta_path_is_caught() {
         // Through the delta path itself: an (unvalidated) edit with a NaN delta.
         let mut nan_edit = edits
             .iter()
-            .find(|e| {
-                matches!(
-                    e.op,
-                    EditOp::TranslatePoint { .. } | EditOp::TranslateLocalPoint { .. }
-                )
-            })
+            .find(|e| point_delta(&mut e.edit.clone()).is_some())
             .cloned()
             .unwrap_or_else(|| panic!("{kind:?}: no point translation among the random edits"));
-        if let EditOp::TranslatePoint { delta, .. } | EditOp::TranslateLocalPoint { delta, .. } =
-            &mut nan_edit.op
-        {
-            *delta = DVec3::new(0.0, f64::NAN, 0.0);
-        }
+        *point_delta(&mut nan_edit.edit).unwrap() = DVec3::new(0.0, f64::NAN, 0.0);
         let mut nan_edits = edits.clone();
         nan_edits.push(nan_edit);
         let (delta, full) = delta_and_full(&scene, &nan_edits, SampleMode::Derivatives(1), None);
@@ -212,9 +206,9 @@ fn merged_frame_edits_give_the_same_result() {
             assert!(merged.len() <= edits.len());
             let o = &scene.objects[0];
             let run = |list: &[Edit]| {
-                let mut obj = SampledObject::new(&o.shape, o.samples, SampleMode::Derivatives(1));
+                let mut obj = SampledObject::new(&o.model, SampleMode::Derivatives(1));
                 for e in list {
-                    obj.apply(&e.op);
+                    obj.apply(&e.edit).expect("validated edits fit");
                 }
                 obj
             };
@@ -233,4 +227,17 @@ fn merging_collapses_repeated_drags() {
     let merged = merge_edits(&drag);
     assert_eq!(merged.len(), 1, "50 moves of one point become one update");
     let _ = scene;
+}
+
+/// The translation of a point-moving edit.
+fn point_delta(edit: &mut ObjectEdit) -> Option<&mut DVec3> {
+    match edit {
+        ObjectEdit::Curve(CurveEdit::Point(PointEdit::Move { delta, .. }))
+        | ObjectEdit::Surface(SurfaceEdit::Point(PointEdit::Move { delta, .. }))
+        | ObjectEdit::ErbsCurve(ErbsCurveEdit::Local(LocalEdit::MovePoint { delta, .. }))
+        | ObjectEdit::ErbsSurface(ErbsSurfaceEdit::Local(LocalEdit::MovePoint { delta, .. })) => {
+            Some(delta)
+        }
+        _ => None,
+    }
 }

@@ -597,7 +597,7 @@ fn drawing_samples_and_the_shading_fast_path_agree_with_oracle() {
         let mut edited = scene.clone();
         apply_edits(&mut edited, &edits).unwrap();
         for (i, o) in product.objects.iter().enumerate() {
-            let mut sampled = SampledObject::new(&o.shape, o.samples, SampleMode::Render);
+            let mut sampled = SampledObject::new(&o.model, SampleMode::Render);
             fast += usize::from(takes_fast_path(&scene.objects[i]));
             let mut check = |what: &str, model: &oracle::scene::Object, s: &SampledObject| {
                 let (err, nerr, n) = render_grid_error(model, s);
@@ -615,7 +615,7 @@ fn drawing_samples_and_the_shading_fast_path_agree_with_oracle() {
             };
             check("as loaded", &scene.objects[i], &sampled);
             for e in product_edits.iter().filter(|e| e.object == i) {
-                sampled.apply(&e.op);
+                sampled.apply(&e.edit).expect("validated edits fit");
             }
             check("after edits", &edited.objects[i], &sampled);
         }

@@ -6,10 +6,11 @@ mod common;
 
 use glam::{DMat4, DVec3};
 use prespline::gpu::{OffscreenDesc, OffscreenTarget, Pixels, Renderer};
+use prespline::model::{CurveEdit, Edit, KindEdit, ModelRef, ObjectEdit, PointEdit, SurfaceEdit};
 use prespline::render::offscreen::{Shot, shot_camera};
 use prespline::render::{Document, GpuScene, Highlight, NetMode, ViewOptions, Wire};
+use prespline::scene::Scene;
 use prespline::scene::demo::demo_scene;
-use prespline::scene::{Edit, EditOp, Index2, Scene};
 
 /// The demo scene without the teapot (keeps the test fast): B-spline surface, ERBS surface,
 /// ERBS curve, NURBS circle.
@@ -36,10 +37,16 @@ impl Lcg {
     }
 }
 
-/// A random edit: a control point (or local control point) moved, or an ERBS local
-/// curve/patch rotated, scaled and translated.
+/// A random edit: a control point (or local control point) moved, an ERBS local curve/patch
+/// rotated, scaled and translated, or now and then a knot inserted or the degree elevated
+/// (which reallocates that object's control mirror).
 fn random_edit(doc: &Document, rng: &mut Lcg) -> Edit {
     let object = rng.below(doc.objects.len());
+    if rng.below(12) == 0
+        && let Some(edit) = structural_edit(doc.objects[object].sampled.model(), rng)
+    {
+        return Edit { object, edit };
+    }
     let handles = doc.handles(object);
     let pick = handles.get(rng.below(handles.len())).copied();
     if let (0, Some((prespline::render::Handle::LocalPoint { local, .. }, pos))) =
@@ -51,16 +58,52 @@ fn random_edit(doc: &Document, rng: &mut Lcg) -> Edit {
             * DMat4::from_translation(
                 -pos + DVec3::new(0.1 * rng.signed(), 0.1 * rng.signed(), 0.1 * rng.signed()),
             );
-        return Edit {
-            object,
-            op: EditOp::TransformLocal { local, matrix: m },
-        };
+        return doc.transform_local(object, local, m).unwrap();
     }
     let (h, _) = handles[rng.below(handles.len())];
-    Document::move_handle(
+    doc.move_handle(
         h,
         DVec3::new(0.2 * rng.signed(), 0.2 * rng.signed(), 0.4 * rng.signed()),
     )
+    .unwrap()
+}
+
+/// A knot insertion at a fresh parameter or a degree elevation (small degrees only).
+fn structural_edit(model: ModelRef<'_>, rng: &mut Lcg) -> Option<ObjectEdit> {
+    let s = 0.05 + 0.9 * (rng.below(1000) as f64 / 1000.0);
+    match model {
+        ModelRef::Curve(m) => {
+            let c = m.curve();
+            let (a, b) = c.domain();
+            Some(if rng.below(3) == 0 && c.degree() < 4 {
+                CurveEdit::ElevateDegree { by: 1 }.into_object()
+            } else {
+                CurveEdit::InsertKnot {
+                    t: a + (b - a) * s,
+                    times: 1,
+                }
+                .into_object()
+            })
+        }
+        ModelRef::Surface(m) => {
+            let su = m.surface();
+            let dir = rng.below(2);
+            let (a, b) = su.domain()[dir];
+            Some(if rng.below(3) == 0 && su.degree()[dir] < 4 {
+                let mut by = [0, 0];
+                by[dir] = 1;
+                SurfaceEdit::ElevateDegree { by }.into_object()
+            } else {
+                SurfaceEdit::InsertKnot {
+                    dir,
+                    t: a + (b - a) * s,
+                    times: 1,
+                }
+                .into_object()
+            })
+        }
+        _ => None,
+    }
 }
 
 fn options() -> ViewOptions {
@@ -141,7 +184,7 @@ fn incremental_mirrors_end_identical_to_a_fresh_upload() {
     for _ in 0..60 {
         for _ in 0..1 + rng.below(4) {
             let e = random_edit(&doc, &mut rng);
-            let region = doc.apply(&e);
+            let region = doc.apply(&e).unwrap();
             gs.note(&doc, &e, &region);
         }
         uploaded += draw_frame(&mut renderer, &mut target, &mut gs, &doc, &shot);
@@ -185,12 +228,13 @@ fn a_missed_update_is_detected() {
     // Lift the centre of the B-spline surface but do not tell the GPU scene.
     let e = Edit {
         object: 0,
-        op: EditOp::TranslatePoint {
-            point: Index2::Two(3, 4),
+        edit: SurfaceEdit::Point(PointEdit::Move {
+            point: [3, 4],
             delta: DVec3::new(0.0, 0.0, 3.0),
-        },
+        })
+        .into_object(),
     };
-    doc.apply(&e);
+    doc.apply(&e).unwrap();
     draw_frame(&mut renderer, &mut target, &mut gs, &doc, &shot);
     let stale = renderer.read_pixels(&target).unwrap();
     gs.destroy(&mut renderer);

@@ -6,8 +6,9 @@
 mod common;
 
 use glam::{DMat4, DVec3};
+use prespline::model::{Index2, Model};
 use prespline::render::Handle;
-use prespline::scene::{Index2, Scene, Shape, parse_scene};
+use prespline::scene::{Scene, parse_scene};
 use prespline::view::Session;
 use prespline::view::autosave::{AUTOSAVE_DELAY, Autosave};
 use prespline::view::input::{InputEvent, Key, Modifiers, MouseButton};
@@ -104,15 +105,15 @@ fn local_point(local: usize, point: usize) -> Handle {
 }
 
 fn local_points(scene: &Scene, local: usize) -> Vec<DVec3> {
-    match &scene.objects[0].shape {
-        Shape::ErbsCurve(c) => c.local_curves()[local].points().to_vec(),
+    match &scene.objects[0].model {
+        Model::ErbsCurve(c) => c.curve().local_curves()[local].points().to_vec(),
         other => panic!("not an ERBS curve: {other:?}"),
     }
 }
 
 fn spline_points(scene: &Scene) -> Vec<DVec3> {
-    match &scene.objects[1].shape {
-        Shape::BSplineCurve(c) => c.points().to_vec(),
+    match &scene.objects[1].model {
+        Model::Curve(c) => c.curve().points().to_vec(),
         other => panic!("not a B-spline curve: {other:?}"),
     }
 }
@@ -301,7 +302,7 @@ fn every_way_out_writes_the_autosave() {
     // Quit (window close, Ctrl+Q, a script's quit, an error exit all end in on_exit): the
     // edit of this very frame, not yet applied, is included.
     for fatal in [false, true] {
-        let path = scratch.join(&format!("scene-{fatal}.autosave.json"));
+        let path = scratch.join(format!("scene-{fatal}.autosave.json"));
         let mut v = Viewer::new(scratch.join("scene.json"));
         v.session.set_autosave(Some(Autosave::new(path.clone())));
         typed_move(&mut v, "-0.5");

@@ -39,7 +39,7 @@ pub fn run(args: &BenchArgs) -> Result<String, CliError> {
     }
     let (scene, scene_name) = match &args.scene {
         Some(p) => (
-            Scene::load(p).map_err(|e| CliError::in_file(p, e))?,
+            super::files::load_scene(p, &Default::default())?,
             p.display().to_string(),
         ),
         None => (demo_scene(), "demo".to_string()),

@@ -1,6 +1,7 @@
 //! Command implementations behind `src/main.rs`, kept in the library so tests can call them.
 
 pub mod bench;
+pub mod files;
 pub mod render;
 pub mod sample;
 pub mod view;

@@ -1,13 +1,14 @@
 //! `prespline render`: draws a scene headless into a PNG file.
 
 use super::CliError;
+use super::files::{SampleOverride, load_scene};
 use crate::gpu::{Renderer, RendererDesc, ValidationMode};
 use crate::render::offscreen::{Shot, render_document};
 use crate::render::{Document, OrbitCamera, ViewOptions};
 use crate::sampling::SampleMode;
 use crate::sampling::budget::{MemoryBudget, Uses, check_scene};
-use crate::scene::Scene;
-use crate::scene::edit::parse_edits;
+use crate::scene::edit::{apply_all, parse_edits};
+use crate::scene::{Scene, SceneError};
 use std::path::Path;
 use std::time::Instant;
 
@@ -58,22 +59,30 @@ pub fn check_drawable(scene: &Scene, path: &Path, budget: &MemoryBudget) -> Resu
         .map_err(|e| CliError::in_file(path, e))
 }
 
-/// Loads a scene, checks it against the memory budget and applies an edits file (through the
-/// delta path).
+/// Loads a scene (JSON or OBJ), checks it against the memory budget and applies an edits file
+/// (through the delta path; edits that refine the model are budgeted too).
 pub fn load_document(
     scene_path: &Path,
     edits: Option<&Path>,
+    samples: &SampleOverride,
     budget: &MemoryBudget,
 ) -> Result<Document, CliError> {
-    let scene = Scene::load(scene_path).map_err(|e| CliError::in_file(scene_path, e))?;
+    let scene = load_scene(scene_path, samples)?;
     check_drawable(&scene, scene_path, budget)?;
+    let Some(path) = edits else {
+        return Ok(Document::new(&scene));
+    };
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| CliError(format!("cannot read {}: {e}", path.display())))?;
+    let edits = parse_edits(&text, &scene).map_err(|e| CliError::in_file(path, e))?;
+    // Knot insertion and degree elevation grow the tables: budget the edited model too.
+    let mut refined = scene.clone();
+    apply_all(&mut refined, &edits).map_err(|e| CliError::in_file(path, e))?;
+    check_drawable(&refined, scene_path, budget)?;
     let mut doc = Document::new(&scene);
-    if let Some(path) = edits {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| CliError(format!("cannot read {}: {e}", path.display())))?;
-        for e in parse_edits(&text, &scene).map_err(|e| CliError::in_file(path, e))? {
-            doc.apply(&e);
-        }
+    for e in edits {
+        doc.apply(&e)
+            .map_err(|err| CliError::in_file(path, SceneError(err.to_string())))?;
     }
     Ok(doc)
 }

@@ -5,7 +5,6 @@ use super::CliError;
 use crate::sampling::budget::{MemoryBudget, Uses, check_scene};
 use crate::sampling::{SampleMode, SampledObject};
 use crate::scene::edit::{apply_all, parse_edits};
-use crate::scene::{Scene, Shape};
 use std::fmt::Write;
 use std::path::Path;
 
@@ -33,7 +32,7 @@ pub fn run(args: &SampleArgs) -> Result<String, CliError> {
             args.derivatives
         )));
     }
-    let mut scene = Scene::load(args.scene).map_err(|e| CliError::in_file(args.scene, e))?;
+    let mut scene = super::files::load_scene(args.scene, &Default::default())?;
     let edits = match args.edits {
         Some(path) => {
             let text = std::fs::read_to_string(path)
@@ -48,43 +47,42 @@ pub fn run(args: &SampleArgs) -> Result<String, CliError> {
         json_text: true,
     };
     check_scene(&scene, mode, uses, &args.memory).map_err(|e| CliError::in_file(args.scene, e))?;
-    let objects: Vec<SampledObject> = if args.full {
-        apply_all(&mut scene, &edits);
-        // Edits may refine the model: budget what is actually sampled.
-        check_scene(&scene, mode, uses, &args.memory)
+    if !edits.is_empty() {
+        // Knot insertion and degree elevation grow the tables: budget the edited model too.
+        let mut refined = scene.clone();
+        apply_all(&mut refined, &edits).map_err(|e| CliError(e.to_string()))?;
+        check_scene(&refined, mode, uses, &args.memory)
             .map_err(|e| CliError::in_file(args.scene, e))?;
-        scene
-            .objects
-            .iter()
-            .map(|o| SampledObject::new(&o.shape, o.samples, mode))
-            .collect()
-    } else {
-        let mut objects: Vec<SampledObject> = scene
-            .objects
-            .iter()
-            .map(|o| SampledObject::new(&o.shape, o.samples, mode))
-            .collect();
-        for e in &edits {
-            objects[e.object].apply(&e.op);
+        if args.full {
+            scene = refined;
         }
-        objects
-    };
+    }
+    let mut objects: Vec<SampledObject> = scene
+        .objects
+        .iter()
+        .map(|o| SampledObject::new(&o.model, mode))
+        .collect();
+    if !args.full {
+        for (k, e) in edits.iter().enumerate() {
+            objects[e.object].apply(&e.edit).map_err(|err| {
+                CliError(format!(
+                    "edit {k} (object '{}'): {err}",
+                    scene.objects[e.object].name
+                ))
+            })?;
+        }
+    }
     let mut out = String::with_capacity(1 << 16);
     out.push_str("{\"objects\": [\n");
     for (i, (meta, obj)) in scene.objects.iter().zip(&objects).enumerate() {
-        write_object(&mut out, &meta.name, &meta.shape, obj)?;
+        write_object(&mut out, &meta.name, obj)?;
         out.push_str(if i + 1 < objects.len() { ",\n" } else { "\n" });
     }
     out.push_str("]}\n");
     Ok(out)
 }
 
-fn write_object(
-    out: &mut String,
-    name: &str,
-    shape: &Shape,
-    obj: &SampledObject,
-) -> Result<(), CliError> {
+fn write_object(out: &mut String, name: &str, obj: &SampledObject) -> Result<(), CliError> {
     let grid = obj.grid();
     if let Some(bad) = grid.data.iter().position(|v| !v.is_finite()) {
         return Err(CliError(format!(
@@ -96,11 +94,11 @@ fn write_object(
     let _ = write!(
         out,
         "  {{\"name\": {name_json}, \"type\": \"{}\", \"params\": ",
-        shape.type_name()
+        obj.type_name()
     );
     let params = obj.params();
     let g = grid.partials.max_order() + 1;
-    if shape.is_surface() {
+    if obj.model().is_surface() {
         out.push('[');
         numbers(out, params[0]);
         out.push_str(", ");

@@ -1,6 +1,7 @@
 //! `prespline view`: the interactive viewer.
 
 use super::CliError;
+use super::files::{SampleOverride, load_scene};
 use crate::profile::{RunInfo, Summary, write_all};
 use crate::sampling::budget::MemoryBudget;
 use crate::scene::Scene;
@@ -22,6 +23,8 @@ pub struct ViewOptions<'a> {
     pub script: Option<&'a Path>,
     pub save_as: Option<&'a Path>,
     pub profile: Option<&'a Path>,
+    /// `--samples` overrides for the loaded scene.
+    pub samples: SampleOverride,
     /// What pre-evaluation and the GPU mirrors may take.
     pub memory: MemoryBudget,
     /// Open the scene's autosave (unsaved edits of an earlier session) instead of the scene.
@@ -47,7 +50,7 @@ pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
             (scene, format!("{title} (recovered)"), save)
         }
         Some(p) => (
-            Scene::load(p).map_err(|e| CliError::in_file(p, e))?,
+            load_scene(p, &opts.samples)?,
             p.display().to_string(),
             p.to_path_buf(),
         ),

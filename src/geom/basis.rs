@@ -67,9 +67,22 @@ impl HermiteMatrix {
 /// derivatives T'_k (entries ∓δ_{k,s}, δ_{k,s} = 1/(t_{s+k} − t_s)). Every knot interval used
 /// contains the non-empty span, so no division by zero can occur.
 pub fn hermite_into(knots: &[f64], degree: usize, span: usize, t: f64, out: &mut [f64]) {
+    hermite_rows_into(knots, degree, span, t, degree + 1, out);
+}
+
+/// The first `rows` rows of M_{d,i}(t) (derivative orders 0..rows), row-major into
+/// `out[..rows·(d+1)]`: what pre-evaluation keeps when fewer derivatives are wanted.
+pub fn hermite_rows_into(
+    knots: &[f64],
+    degree: usize,
+    span: usize,
+    t: f64,
+    rows: usize,
+    out: &mut [f64],
+) {
     let d = degree;
     let w = d + 1;
-    debug_assert_eq!(out.len(), w * w);
+    debug_assert!(rows <= w && out.len() >= rows * w);
     // Scratch: tri[k*w + j] = b_k[j] (degree-k values), plus two work rows for derivatives.
     let mut stack = [0.0f64; STACK_SCRATCH];
     let mut heap;
@@ -95,7 +108,7 @@ pub fn hermite_into(knots: &[f64], degree: usize, span: usize, t: f64, out: &mut
     }
     out[..w].copy_from_slice(&tri[d * w..d * w + w]);
     // Row r: start from b_{d−r} and apply T'_{d−r+1} … T'_d, then scale by d!/(d−r)!.
-    for r in 1..=d {
+    for r in 1..rows {
         let base = d - r;
         cur[..=base].copy_from_slice(&tri[base * w..base * w + base + 1]);
         let mut scale = 1.0;

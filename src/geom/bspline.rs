@@ -5,6 +5,7 @@ use super::bezier::{check_points, check_weights, combine_rows};
 use super::error::{GeomError, GeomResult};
 use super::knots::KnotVector;
 use super::point::{Point, homogeneous, rational_curve_derivs};
+use super::refine::{HomSpline, curve_knot_ins, degree_elevate};
 use glam::{DVec3, DVec4};
 
 /// c(t) = Σ c_i b_{d,i}(t) on [t_d, t_n]; with weights a NURBS curve evaluated in homogeneous
@@ -177,35 +178,25 @@ impl BSplineCurve {
                 ),
             ));
         }
-        let k = self.find_span(t);
-        let u = &self.knots;
-        let pw = self.homogeneous_points();
-        let np = pw.len();
-        let r = times;
-        let mut q = vec![DVec4::ZERO; np + r];
-        // Unaffected points keep their places (shifted by r after the affected block).
-        q[..=k - p].copy_from_slice(&pw[..=k - p]);
-        q[k - s + r..np + r].copy_from_slice(&pw[k - s..np]);
-        let keep = p + 1 - s;
-        let mut rw: Vec<DVec4> = (0..keep).map(|i| pw[k - p + i]).collect();
-        let mut l = k - p;
-        for j in 1..=r {
-            l = k - p + j;
-            for i in 0..keep - j {
-                let alpha = (t - u[l + i]) / (u[i + k + 1] - u[l + i]);
-                rw[i] = rw[i + 1] * alpha + rw[i] * (1.0 - alpha);
-            }
-            q[l] = rw[0];
-            q[k + r - j - s] = rw[keep - j - 1];
+        let r = curve_knot_ins(&self.homogeneous_spline(), t, times);
+        Ok(self.with_homogeneous(KnotVector::new(r.knots)?, r.points))
+    }
+
+    /// DegreeElevateCurve (NURBS Book A5.9): the same curve of degree d + `by`; every knot keeps
+    /// its continuity (its multiplicity grows by `by`). An unclamped curve comes back clamped
+    /// on its domain.
+    pub fn elevate_degree(&self, by: usize) -> GeomResult<Self> {
+        let e = degree_elevate(&self.homogeneous_spline(), by);
+        Ok(self.with_homogeneous(KnotVector::new(e.knots)?, e.points))
+    }
+
+    /// Degree, knots and homogeneous control points, for the refinement algorithms.
+    pub(crate) fn homogeneous_spline(&self) -> HomSpline {
+        HomSpline {
+            degree: self.degree,
+            knots: self.knots.to_vec(),
+            points: self.homogeneous_points(),
         }
-        if l + 1 < k - s {
-            q[l + 1..k - s].copy_from_slice(&rw[1..k - s - l]);
-        }
-        let mut knots = Vec::with_capacity(u.len() + r);
-        knots.extend_from_slice(&u[..=k]);
-        knots.extend(std::iter::repeat_n(t, r));
-        knots.extend_from_slice(&u[k + 1..]);
-        Ok(self.with_homogeneous(KnotVector::new(knots)?, q))
     }
 
     /// Splits at an interior parameter into two curves meeting at c(t); knots are inserted until
@@ -244,7 +235,8 @@ impl BSplineCurve {
     fn with_homogeneous(&self, knots: KnotVector, q: Vec<DVec4>) -> Self {
         let points = q.iter().map(|h| h.truncate() / h.w).collect();
         let weights = self.is_rational().then(|| q.iter().map(|h| h.w).collect());
-        Self::from_parts(self.degree, knots, points, weights)
+        let degree = knots.len() - q.len() - 1;
+        Self::from_parts(degree, knots, points, weights)
     }
 }
 
@@ -352,6 +344,39 @@ mod tests {
     }
 
     #[test]
+    fn elevation_clamps_unclamped_curves_and_keeps_jumps() {
+        let pts: Vec<DVec3> = (0..7)
+            .map(|i| DVec3::new(i as f64, (i as f64).cos(), 0.3 * i as f64))
+            .collect();
+        let uniform =
+            BSplineCurve::new(3, (0..11).map(f64::from).collect(), pts.clone(), None).unwrap();
+        let jump = BSplineCurve::new(
+            2,
+            vec![0., 0., 0., 1., 2., 2., 2., 3., 4., 4., 4.],
+            pts.iter().chain(&pts[..1]).copied().collect(),
+            Some(vec![1., 2., 0.5, 1., 1., 3., 1., 1.]),
+        )
+        .unwrap();
+        let constant = BSplineCurve::new(0, vec![0., 1., 2., 3.], pts[..3].to_vec(), None).unwrap();
+        for c in [uniform, jump, constant] {
+            let (a, b) = c.domain();
+            for by in [1, 2] {
+                let e = c.elevate_degree(by).unwrap();
+                assert_eq!(e.domain(), (a, b));
+                assert_eq!(e.knots().multiplicity(a), e.degree() + 1);
+                for i in 0..=60 {
+                    let x = a + (b - a) * i as f64 / 60.0;
+                    let (p, q) = (c.eval(x), e.eval(x));
+                    assert!(
+                        (p - q).length() < 1e-12 * (1.0 + p.length()),
+                        "{x}: {p} {q}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
     fn knot_insertion_and_split_leave_the_curve_unchanged() {
         for rational in [false, true] {
             let c = wavy(rational);
@@ -375,6 +400,28 @@ mod tests {
                     assert!((l.eval(x) - c.eval(x)).length() < 1e-12);
                     let y = t + (4.0 - t) * i as f64 / 20.0;
                     assert!((r.eval(y) - c.eval(y)).length() < 1e-12);
+                }
+            }
+            for by in [1, 2, 3] {
+                let e = c.elevate_degree(by).unwrap();
+                assert_eq!(e.degree(), c.degree() + by);
+                // Clamped, 4 distinct interior breakpoints (0.5, 1.5 twice, 2, 3): every knot's
+                // multiplicity grows by `by`.
+                for (t, m) in [(0.0, 4), (0.5, 1), (1.5, 2), (2.0, 1), (3.0, 1), (4.0, 4)] {
+                    assert_eq!(e.knots().multiplicity(t), m + by, "by {by}: knot {t}");
+                }
+                assert_eq!(e.points().len(), c.points().len() + by * 5);
+                for i in 0..=80 {
+                    let x = 4.0 * i as f64 / 80.0;
+                    let (a, b) = (c.derivatives(x, 2), e.derivatives(x, 2));
+                    for r in 0..3 {
+                        assert!(
+                            (a[r] - b[r]).length() < 1e-11 * (1.0 + a[r].length()),
+                            "elevate {by} at {x} r={r}: {:?} vs {:?}",
+                            a[r],
+                            b[r]
+                        );
+                    }
                 }
             }
             assert!(c.insert_knot(1.5, 2).is_err());

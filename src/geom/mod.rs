@@ -14,6 +14,7 @@ pub mod erbs;
 pub mod error;
 pub mod knots;
 pub mod point;
+pub mod refine;
 pub mod surface;
 
 pub use basis::HermiteMatrix;

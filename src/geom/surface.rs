@@ -6,7 +6,8 @@ use super::bezier::{check_points, check_weights};
 use super::bspline::de_boor;
 use super::error::{GeomError, GeomResult};
 use super::knots::KnotVector;
-use super::point::{binomial, homogeneous, to_homogeneous};
+use super::point::{Point, binomial, homogeneous, to_homogeneous};
+use super::refine::{KnotInsertion, Pack, Spline, degree_elevate, refine_net};
 use glam::{DVec3, DVec4};
 
 /// S(u,v) = Σ_i Σ_j P_ij N_i(u) N_j(v). Control points are row-major, `points[i * nv + j]`, with
@@ -18,6 +19,25 @@ pub struct TensorSurface {
     count: [usize; 2],
     points: Vec<DVec3>,
     weights: Option<Vec<f64>>,
+}
+
+/// Applies a knot insertion to a row-major net of `nv` columns: across rows (direction u,
+/// whole rows are the blocks) or within each row (direction v).
+fn insert_in_lines<P: Point>(
+    plan: &KnotInsertion,
+    dir: usize,
+    nv: usize,
+    old: &[P],
+    new: &mut [P],
+) {
+    if dir == 0 {
+        plan.apply(old, new, nv);
+    } else {
+        let grown = new.len() / (old.len() / nv);
+        for (o, n) in old.chunks_exact(nv).zip(new.chunks_exact_mut(grown)) {
+            plan.apply(o, n, 1);
+        }
+    }
 }
 
 /// All partial derivatives ∂^{a+b}S/∂u^a∂v^b for a, b ≤ n.
@@ -180,6 +200,94 @@ impl TensorSurface {
     /// Homogeneous control points (w P, w), row-major.
     pub fn homogeneous_points(&self) -> Vec<DVec4> {
         homogeneous(&self.points, self.weights.as_deref())
+    }
+
+    /// SurfaceKnotIns (NURBS Book A5.3): inserts `t` `times` times in direction `dir` (0: u,
+    /// 1: v) by CurveKnotIns on every line of the net; the surface is unchanged. `t` must lie
+    /// in the domain and the final multiplicity may not exceed that direction's degree.
+    pub fn insert_knot(&self, dir: usize, t: f64, times: usize) -> GeomResult<Self> {
+        let (a, b) = self.domain()[dir];
+        if !(t >= a && t < b) {
+            return Err(GeomError::new(
+                "parameter",
+                format!("{t} is not in [{a}, {b})"),
+            ));
+        }
+        let p = self.degree[dir];
+        let s = self.knots[dir].multiplicity(t);
+        if s + times > p {
+            return Err(GeomError::new(
+                "parameter",
+                format!(
+                    "inserting {t} {times} times would give multiplicity {} > degree {p}",
+                    s + times
+                ),
+            ));
+        }
+        Ok(self.with_knot(dir, t, times))
+    }
+
+    /// SurfaceKnotIns without the checks: Böhm's coefficients once, applied to whole rows of
+    /// the net (direction u: rows of control points are the blocks) or within each row
+    /// (direction v). Polynomial nets refine their points directly, rational ones in
+    /// homogeneous coordinates.
+    fn with_knot(&self, dir: usize, t: f64, r: usize) -> Self {
+        let [nu, nv] = self.count;
+        let plan = KnotInsertion::new(&self.knots[dir], self.degree[dir], self.count[dir], t, r);
+        let mut count = self.count;
+        count[dir] += r;
+        let (points, weights) = match &self.weights {
+            None => {
+                let mut new = vec![DVec3::ZERO; count[0] * count[1]];
+                insert_in_lines(&plan, dir, nv, &self.points, &mut new);
+                (new, None)
+            }
+            Some(_) => {
+                let mut new = vec![DVec4::ZERO; count[0] * count[1]];
+                insert_in_lines(&plan, dir, nv, &self.homogeneous_points(), &mut new);
+                let points = new.iter().map(|h| h.truncate() / h.w).collect();
+                (points, Some(new.iter().map(|h| h.w).collect()))
+            }
+        };
+        debug_assert_eq!(nu * nv + r * if dir == 0 { nv } else { nu }, points.len());
+        let mut knots = self.knots.clone();
+        knots[dir] = KnotVector::new(plan.knots).expect("insertion keeps knots sorted");
+        Self {
+            degree: self.degree,
+            knots,
+            count,
+            points,
+            weights,
+        }
+    }
+
+    /// Degree elevation by `by` in direction `dir` (NURBS Book A5.10: DegreeElevateCurve on
+    /// every line of the net). An unclamped direction comes back clamped on its domain.
+    #[must_use]
+    pub fn elevate_degree(&self, dir: usize, by: usize) -> Self {
+        self.refined(dir, |c| degree_elevate(c, by))
+    }
+
+    fn refined(&self, dir: usize, refine: impl Fn(&Spline<Pack>) -> Spline<Pack>) -> Self {
+        let r = refine_net(
+            self.degree[dir],
+            &self.knots[dir],
+            self.count,
+            (&self.points, self.weights.as_deref()),
+            dir,
+            refine,
+        );
+        let mut degree = self.degree;
+        let mut knots = self.knots.clone();
+        degree[dir] = r.degree;
+        knots[dir] = KnotVector::new(r.knots).expect("refinement keeps knots sorted");
+        Self {
+            degree,
+            knots,
+            count: r.count,
+            points: r.points,
+            weights: r.weights,
+        }
     }
 
     /// Parameter domains [(u0, u1), (v0, v1)].

@@ -208,6 +208,34 @@ impl<'a> Frame<'a> {
         mirror.writer(self.slot, atom, track, &mut self.flushes)
     }
 
+    /// Replaces `mirror` by a new one holding `data` in every slot (a layout change, such as
+    /// a refined control net). Never waits: the new buffers have never been used by the GPU,
+    /// so all their slots may be written now, and each old buffer is released when its slot's
+    /// fence next signals.
+    pub fn replace_mirror(
+        &mut self,
+        mirror: &mut Mirror,
+        name: &str,
+        data: &[f32],
+    ) -> GpuResult<()> {
+        let len = data.len().max(1);
+        let mut fresh = Mirror::new(&self.renderer.device, name, len)?;
+        let atom = self.renderer.device.caps.non_coherent_atom_size;
+        let mut flushes = Vec::new();
+        for slot in 0..super::FRAMES_IN_FLIGHT {
+            let track = self.renderer.always_flush || fresh.slot(slot).buffer.needs_flush();
+            let written = fresh.writer(slot, atom, track, &mut flushes).write(0, data);
+            if let Err(e) = written {
+                self.renderer.destroy_mirror(fresh);
+                return Err(e);
+            }
+        }
+        self.renderer.device.flush_ranges(&flushes)?;
+        let old = std::mem::replace(mirror, fresh);
+        self.renderer.destroy_mirror(old);
+        Ok(())
+    }
+
     /// Sets the camera used by subsequent 3D draws.
     pub fn set_camera(&mut self, camera: Camera) {
         self.camera = camera;

@@ -4,8 +4,12 @@
 use super::camera::Bounds;
 use crate::geom::knots::uniform_params;
 use crate::geom::{BezierCurve, TensorSurface};
-use crate::sampling::{DirtyRegion, ModelRef, SampleMode, SampledObject};
-use crate::scene::{Edit, EditOp, Index2, Samples, Scene, SceneObject};
+use crate::model::{
+    CurveEdit, Edit, EditError, ErbsCurveEdit, ErbsSurfaceEdit, Index2, KindEdit, LocalEdit,
+    ModelRef, ObjectEdit, PointEdit, SurfaceEdit,
+};
+use crate::sampling::{DirtyRegion, SampleMode, SampledObject};
+use crate::scene::{Scene, SceneObject};
 use glam::DVec3;
 
 /// Samples per ERBS local curve drawn in its own colour.
@@ -17,7 +21,6 @@ pub const LOCAL_PATCH_SAMPLES: usize = 9;
 #[derive(Debug, Clone)]
 pub struct DocObject {
     pub name: String,
-    pub samples: Samples,
     pub color: Option<[f64; 3]>,
     pub sampled: SampledObject,
 }
@@ -95,9 +98,8 @@ impl Document {
             .iter()
             .map(|o| DocObject {
                 name: o.name.clone(),
-                samples: o.samples,
                 color: o.color,
-                sampled: SampledObject::new(&o.shape, o.samples, SampleMode::Render),
+                sampled: SampledObject::new(&o.model, SampleMode::Render),
             })
             .collect();
         Self { objects }
@@ -111,8 +113,7 @@ impl Document {
                 .iter()
                 .map(|o| SceneObject {
                     name: o.name.clone(),
-                    shape: o.sampled.shape(),
-                    samples: o.samples,
+                    model: o.sampled.model().to_model(),
                     color: o.color,
                 })
                 .collect(),
@@ -120,8 +121,8 @@ impl Document {
     }
 
     /// Applies a validated edit through the delta path.
-    pub fn apply(&mut self, edit: &Edit) -> DirtyRegion {
-        self.objects[edit.object].sampled.apply(&edit.op)
+    pub fn apply(&mut self, edit: &Edit) -> Result<DirtyRegion, EditError> {
+        self.objects[edit.object].sampled.apply(&edit.edit)
     }
 
     /// Bounds of every sample and control point.
@@ -142,8 +143,9 @@ impl Document {
     /// Control structures of object `i`.
     pub fn controls(&self, i: usize) -> Controls {
         match self.objects[i].sampled.model() {
-            ModelRef::Curve(c) => Controls::Polygon(c.points().to_vec()),
+            ModelRef::Curve(c) => Controls::Polygon(c.curve().points().to_vec()),
             ModelRef::Surface(s) => {
+                let s = s.surface();
                 let [rows, cols] = s.count();
                 Controls::Net {
                     rows,
@@ -152,9 +154,10 @@ impl Document {
                 }
             }
             ModelRef::ErbsCurve(c) => {
-                Controls::LocalCurves(c.local_curves().iter().map(local_curve).collect())
+                Controls::LocalCurves(c.curve().local_curves().iter().map(local_curve).collect())
             }
             ModelRef::ErbsSurface(s) => {
+                let s = s.surface();
                 let [rows, cols] = s.count();
                 let patches = s.local_patches().iter().map(local_patch).collect();
                 Controls::LocalPatches {
@@ -171,6 +174,7 @@ impl Document {
         let object = i;
         match self.objects[i].sampled.model() {
             ModelRef::Curve(c) => c
+                .curve()
                 .points()
                 .iter()
                 .enumerate()
@@ -185,6 +189,7 @@ impl Document {
                 })
                 .collect(),
             ModelRef::Surface(s) => {
+                let s = s.surface();
                 let cols = s.count()[1];
                 s.points()
                     .iter()
@@ -201,6 +206,7 @@ impl Document {
                     .collect()
             }
             ModelRef::ErbsCurve(c) => c
+                .curve()
                 .local_curves()
                 .iter()
                 .enumerate()
@@ -218,6 +224,7 @@ impl Document {
                 })
                 .collect(),
             ModelRef::ErbsSurface(s) => {
+                let s = s.surface();
                 let cols = s.count()[1];
                 s.local_patches()
                     .iter()
@@ -248,26 +255,98 @@ impl Document {
             .collect()
     }
 
-    /// The edit that moves a handle by `delta`.
-    pub fn move_handle(handle: Handle, delta: DVec3) -> Edit {
-        match handle {
-            Handle::Point { object, point } => Edit {
-                object,
-                op: EditOp::TranslatePoint { point, delta },
-            },
-            Handle::LocalPoint {
-                object,
+    /// The edit that moves a handle by `delta` (`None` if the handle does not fit its object).
+    pub fn move_handle(&self, handle: Handle, delta: DVec3) -> Option<Edit> {
+        let model = self.objects.get(handle.object())?.sampled.model();
+        let edit = match (handle, model) {
+            (
+                Handle::Point {
+                    point: Index2::One(point),
+                    ..
+                },
+                ModelRef::Curve(_),
+            ) => CurveEdit::Point(PointEdit::Move { point, delta }).into_object(),
+            (
+                Handle::Point {
+                    point: Index2::Two(i, j),
+                    ..
+                },
+                ModelRef::Surface(_),
+            ) => SurfaceEdit::Point(PointEdit::Move {
+                point: [i, j],
+                delta,
+            })
+            .into_object(),
+            (
+                Handle::LocalPoint {
+                    local: Index2::One(local),
+                    point: Index2::One(point),
+                    ..
+                },
+                ModelRef::ErbsCurve(_),
+            ) => ErbsCurveEdit::Local(LocalEdit::MovePoint {
                 local,
                 point,
-            } => Edit {
-                object,
-                op: EditOp::TranslateLocalPoint {
-                    local,
-                    point,
-                    delta,
+                delta,
+            })
+            .into_object(),
+            (
+                Handle::LocalPoint {
+                    local: Index2::Two(k, l),
+                    point: Index2::Two(a, b),
+                    ..
                 },
-            },
+                ModelRef::ErbsSurface(_),
+            ) => ErbsSurfaceEdit::Local(LocalEdit::MovePoint {
+                local: [k, l],
+                point: [a, b],
+                delta,
+            })
+            .into_object(),
+            _ => return None,
+        };
+        Some(Edit {
+            object: handle.object(),
+            edit,
+        })
+    }
+
+    /// Every control point of an ERBS local curve or patch.
+    pub fn local_points(&self, object: usize, local: Index2) -> Option<Vec<DVec3>> {
+        match (self.objects.get(object)?.sampled.model(), local) {
+            (ModelRef::ErbsCurve(c), Index2::One(l)) => {
+                Some(c.curve().local_curves().get(l)?.points().to_vec())
+            }
+            (ModelRef::ErbsSurface(s), Index2::Two(k, l)) => {
+                let s = s.surface();
+                let [nu, nv] = s.count();
+                (k < nu && l < nv).then(|| s.local_patch(k, l).points().to_vec())
+            }
+            _ => None,
         }
+    }
+
+    /// The edit that maps an ERBS local curve or patch by the affine `matrix`.
+    pub fn transform_local(
+        &self,
+        object: usize,
+        local: Index2,
+        matrix: glam::DMat4,
+    ) -> Option<Edit> {
+        let edit: ObjectEdit = match (self.objects.get(object)?.sampled.model(), local) {
+            (ModelRef::ErbsCurve(_), Index2::One(l)) => {
+                ErbsCurveEdit::Local(LocalEdit::Transform { local: l, matrix }).into_object()
+            }
+            (ModelRef::ErbsSurface(_), Index2::Two(k, l)) => {
+                ErbsSurfaceEdit::Local(LocalEdit::Transform {
+                    local: [k, l],
+                    matrix,
+                })
+                .into_object()
+            }
+            _ => return None,
+        };
+        Some(Edit { object, edit })
     }
 }
 
@@ -283,10 +362,11 @@ impl Document {
     /// changes), without recomputing the others.
     pub fn local_controls(&self, i: usize, local: Index2) -> Option<LocalControls> {
         match (self.objects[i].sampled.model(), local) {
-            (ModelRef::ErbsCurve(c), Index2::One(l)) => {
-                Some(LocalControls::Curve(local_curve(c.local_curves().get(l)?)))
-            }
+            (ModelRef::ErbsCurve(c), Index2::One(l)) => Some(LocalControls::Curve(local_curve(
+                c.curve().local_curves().get(l)?,
+            ))),
             (ModelRef::ErbsSurface(s), Index2::Two(k, l)) => {
+                let s = s.surface();
                 let [nu, nv] = s.count();
                 (k < nu && l < nv).then(|| LocalControls::Patch(local_patch(s.local_patch(k, l))))
             }

@@ -10,8 +10,8 @@ use crate::gpu::{
     FRAMES_IN_FLIGHT, Frame, GpuResult, GridShape, Mirror, PointRun, PointStyle, PolylineStyle,
     Renderer, SurfaceGrid, SurfaceStyle,
 };
-use crate::sampling::{DirtyRegion, DirtySet, ModelRef};
-use crate::scene::{Edit, EditOp, Index2};
+use crate::model::{Edit, Index2, ModelRef, Target};
+use crate::sampling::{DirtyRegion, DirtySet};
 use glam::DVec3;
 
 /// Where an object's control structures sit in its control mirror (offsets in floats).
@@ -35,6 +35,7 @@ enum ControlLayout {
 }
 
 struct ObjectGpu {
+    name: String,
     samples: Mirror,
     /// Sample rows (surfaces) or samples (curves) each slot has not seen yet.
     dirty: [DirtySet; FRAMES_IN_FLIGHT],
@@ -43,6 +44,8 @@ struct ObjectGpu {
     /// local's floats and each slot copies only the float ranges it has not seen.
     controls_cache: Vec<f32>,
     controls_dirty: [DirtySet; FRAMES_IN_FLIGHT],
+    /// The control structures changed size: the next upload replaces the control mirror.
+    controls_resized: bool,
     layout: ControlLayout,
 }
 
@@ -98,11 +101,13 @@ impl GpuScene {
                 renderer.create_mirror(&format!("{} controls", o.name), data.len().max(3))?;
             renderer.fill_mirror(&mut controls, 0, &data)?;
             objects.push(ObjectGpu {
+                name: o.name.clone(),
                 samples,
                 dirty: Default::default(),
                 controls,
                 controls_cache: data,
                 controls_dirty: Default::default(),
+                controls_resized: false,
                 layout,
             });
         }
@@ -110,23 +115,15 @@ impl GpuScene {
     }
 
     /// Records what an applied edit changed: the sample rows of `region`, and the control
-    /// structures (only the edited local curve/patch for ERBS local edits).
+    /// structures its target says changed (one point, one ERBS local, or the whole layout).
     pub fn note(&mut self, doc: &Document, edit: &Edit, region: &DirtyRegion) {
         self.note_samples(edit.object, region);
-        let local = match &edit.op {
-            EditOp::TransformLocal { local, .. }
-            | EditOp::TranslateLocalPoint { local, .. }
-            | EditOp::SetLocalPoints { local, .. } => Some(*local),
-            _ => None,
-        };
-        match (local, &edit.op) {
-            (Some(l), _) => self.note_local(doc, edit.object, l),
-            (None, EditOp::TranslatePoint { point, .. } | EditOp::SetPoint { point, .. }) => {
-                self.note_point(doc, edit.object, *point)
-            }
+        match edit.edit.target() {
+            Target::Point(point) => self.note_point(doc, edit.object, point),
+            Target::Local(local) => self.note_local(doc, edit.object, local),
             // A weight moves no control point.
-            (None, EditOp::SetWeight { .. }) => {}
-            (None, _) => self.note_controls(doc, edit.object),
+            Target::Weight(_) => {}
+            Target::Structure => self.note_controls(doc, edit.object),
         }
     }
 
@@ -135,11 +132,11 @@ impl GpuScene {
         let o = &mut self.objects[object];
         let (index, p) = match (&o.layout, doc.objects[object].sampled.model()) {
             (ControlLayout::Polygon { .. }, ModelRef::Curve(c)) => match point {
-                Index2::One(k) => (k, c.points()[k]),
+                Index2::One(k) => (k, c.curve().points()[k]),
                 Index2::Two(..) => return,
             },
             (ControlLayout::Net { cols, .. }, ModelRef::Surface(s)) => match point {
-                Index2::Two(i, j) => (i * cols + j, s.point(i, j)),
+                Index2::Two(i, j) => (i * cols + j, s.surface().point(i, j)),
                 Index2::One(_) => return,
             },
             _ => return self.note_controls(doc, object),
@@ -154,16 +151,23 @@ impl GpuScene {
     /// Marks sample rows dirty for every slot.
     pub fn note_samples(&mut self, object: usize, region: &DirtyRegion) {
         for d in &mut self.objects[object].dirty {
-            d.insert(region.rows());
+            d.insert(region.rows.clone());
         }
     }
 
-    /// Recomputes all control structures of `object` and marks them dirty for every slot.
+    /// Recomputes all control structures of `object` and marks them dirty for every slot; when
+    /// their size changed (a refinement), the next upload replaces that object's control
+    /// mirror, and only that one.
     pub fn note_controls(&mut self, doc: &Document, object: usize) {
-        let (_, data) = control_floats(&doc.controls(object));
+        let (layout, data) = control_floats(&doc.controls(object));
         let o = &mut self.objects[object];
-        if data.len() == o.controls_cache.len() {
-            o.controls_cache = data;
+        let resized = data.len().max(3) != o.controls.len();
+        o.layout = layout;
+        o.controls_cache = data;
+        if resized {
+            o.controls_resized = true;
+            o.controls_dirty = Default::default();
+        } else {
             for d in &mut o.controls_dirty {
                 d.insert(0..o.controls_cache.len());
             }
@@ -228,6 +232,11 @@ impl GpuScene {
                     w.write(r.start * cols * per, &self.scratch)?;
                     stats.bytes += self.scratch.len() * 4;
                 }
+            }
+            if std::mem::take(&mut o.controls_resized) {
+                let name = format!("{} controls", o.name);
+                frame.replace_mirror(&mut o.controls, &name, &o.controls_cache)?;
+                stats.bytes += o.controls_cache.len() * 4 * FRAMES_IN_FLIGHT;
             }
             let ranges = o.controls_dirty[slot].take();
             if !ranges.is_empty() {

@@ -7,7 +7,7 @@ use super::style::ViewOptions;
 use crate::geom::differential::frenet_frame;
 use crate::geom::knots::uniform_params;
 use crate::gpu::LineVertex;
-use crate::sampling::ModelRef;
+use crate::model::ModelRef;
 use glam::DVec3;
 
 /// Frames drawn per curve.
@@ -40,15 +40,16 @@ pub fn overlay_lines(doc: &Document, opts: &ViewOptions, scale: f64) -> Vec<Line
                 }
             }
         }
-        let derivs: Box<dyn Fn(f64) -> Vec<DVec3>> = match o.sampled.model() {
-            ModelRef::Curve(c) => Box::new(move |t| c.derivatives(t, 3)),
-            ModelRef::ErbsCurve(c) => Box::new(move |t| c.derivatives(t, 3)),
+        let (derivs, (a, b)): (Box<dyn Fn(f64) -> Vec<DVec3>>, _) = match o.sampled.model() {
+            ModelRef::Curve(c) => (
+                Box::new(move |t| c.curve().derivatives(t, 3)),
+                c.curve().domain(),
+            ),
+            ModelRef::ErbsCurve(c) => (
+                Box::new(move |t| c.curve().derivatives(t, 3)),
+                c.curve().domain(),
+            ),
             _ => continue,
-        };
-        let (a, b) = match o.sampled.model() {
-            ModelRef::Curve(c) => c.domain(),
-            ModelRef::ErbsCurve(c) => c.domain(),
-            _ => unreachable!("curves only"),
         };
         if opts.frenet {
             let len = 0.05 * scale;

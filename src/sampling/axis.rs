@@ -1,6 +1,6 @@
 //! Pre-evaluation data of one parameter direction of a B-spline (the paper's S, I and M).
 
-use crate::geom::basis::hermite_into;
+use crate::geom::basis::hermite_rows_into;
 use crate::geom::knots::{KnotVector, uniform_params};
 use std::ops::Range;
 
@@ -22,6 +22,8 @@ pub struct HermiteTable {
     m: Vec<f64>,
     /// Per control point k: samples whose span i satisfies i−d ≤ k ≤ i (may be empty).
     ranges: Vec<Range<usize>>,
+    /// The knots tabulated, so a refinement can tell whether this direction changed.
+    knots: KnotVector,
 }
 
 impl HermiteTable {
@@ -43,29 +45,14 @@ impl HermiteTable {
     ) -> Self {
         let w = degree + 1;
         let rows = order.min(degree) + 1;
-        let mut m = Vec::with_capacity(params.len() * rows * w);
-        let mut full = vec![0.0; w * w];
+        let mut m = vec![0.0; params.len() * rows * w];
         let mut spans = Vec::with_capacity(params.len());
-        for &t in &params {
+        for (&t, out) in params.iter().zip(m.chunks_exact_mut(rows * w)) {
             let span = knots.find_span(degree, n, t);
-            hermite_into(knots, degree, span, t, &mut full);
-            m.extend_from_slice(&full[..rows * w]);
+            hermite_rows_into(knots, degree, span, t, rows, out);
             spans.push(span);
         }
-        // I_k: spans are non-decreasing in the sample index, so {j : span_j ∈ [k, k+d]} is an
-        // interval; found with two monotone cursors.
-        let mut ranges = Vec::with_capacity(n);
-        let (mut lo, mut hi) = (0usize, 0usize);
-        for k in 0..n {
-            while lo < spans.len() && spans[lo] < k {
-                lo += 1;
-            }
-            hi = hi.max(lo);
-            while hi < spans.len() && spans[hi] <= k + degree {
-                hi += 1;
-            }
-            ranges.push(lo..hi);
-        }
+        let ranges = influence_ranges(&spans, degree, n);
         Self {
             params,
             spans,
@@ -74,7 +61,54 @@ impl HermiteTable {
             order,
             m,
             ranges,
+            knots: knots.clone(),
         }
+    }
+
+    /// The table of the same parameters for a new basis (knots, degree, control count), as after
+    /// a knot insertion: a sample whose span has the same knot window t_{s−d+1} … t_{s+d} as
+    /// before keeps its matrix (the same arithmetic on the same values), so only the samples
+    /// near the changed knots are evaluated again.
+    #[must_use]
+    pub fn refit(&self, knots: &KnotVector, degree: usize, n: usize) -> Self {
+        if degree != self.degree {
+            return Self::at_params(knots, degree, n, self.params.clone(), self.order);
+        }
+        let w = degree + 1;
+        let per = self.rows * w;
+        let mut m = vec![0.0; self.m.len()];
+        let mut spans = Vec::with_capacity(self.params.len());
+        // M on span s reads the knots t_{s−d+1} … t_{s+d} (and t).
+        fn window(k: &[f64], s: usize, d: usize) -> &[f64] {
+            &k[s + 1 - d..s + d + 1]
+        }
+        for (j, (&t, out)) in self.params.iter().zip(m.chunks_exact_mut(per)).enumerate() {
+            let span = knots.find_span(degree, n, t);
+            let old = self.spans[j];
+            if window(knots, span, degree) == window(&self.knots, old, degree) {
+                out.copy_from_slice(&self.m[j * per..(j + 1) * per]);
+            } else {
+                hermite_rows_into(knots, degree, span, t, self.rows, out);
+            }
+            spans.push(span);
+        }
+        let ranges = influence_ranges(&spans, degree, n);
+        Self {
+            params: self.params.clone(),
+            spans,
+            degree,
+            rows: self.rows,
+            order: self.order,
+            m,
+            ranges,
+            knots: knots.clone(),
+        }
+    }
+
+    /// Whether this table is the pre-evaluation of a degree-`degree` B-spline with `n` control
+    /// points on `knots`.
+    pub fn tabulates(&self, knots: &KnotVector, degree: usize, n: usize) -> bool {
+        self.degree == degree && self.ranges.len() == n && self.knots == *knots
     }
 
     pub fn degree(&self) -> usize {
@@ -140,6 +174,24 @@ impl HermiteTable {
     pub fn range(&self, k: usize) -> Range<usize> {
         self.ranges[k].clone()
     }
+}
+
+/// I_k for every control point k: spans are non-decreasing in the sample index, so
+/// {j : span_j ∈ [k, k+d]} is an interval, found with two monotone cursors.
+fn influence_ranges(spans: &[usize], degree: usize, n: usize) -> Vec<Range<usize>> {
+    let mut ranges = Vec::with_capacity(n);
+    let (mut lo, mut hi) = (0usize, 0usize);
+    for k in 0..n {
+        while lo < spans.len() && spans[lo] < k {
+            lo += 1;
+        }
+        hi = hi.max(lo);
+        while hi < spans.len() && spans[hi] <= k + degree {
+            hi += 1;
+        }
+        ranges.push(lo..hi);
+    }
+    ranges
 }
 
 #[cfg(test)]

@@ -9,7 +9,8 @@
 //! [`MemoryBudget`] (by default half of physical memory; `--memory-limit` overrides).
 
 use super::object::SampleMode;
-use crate::scene::{Samples, Scene, Shape};
+use crate::model::Model;
+use crate::scene::Scene;
 use std::fmt::Write;
 
 /// Bytes of one f64 / `DVec3` / `DVec4` / f32.
@@ -37,39 +38,43 @@ pub struct Extent {
 }
 
 impl Extent {
-    /// The extent of a scene object.
+    /// The extent of an object's model.
     #[must_use]
-    pub fn of(shape: &Shape, samples: Samples) -> Self {
-        let samples = match samples {
-            Samples::Curve(m) => vec![m],
-            Samples::Surface(m) => m.to_vec(),
+    pub fn of(model: &Model) -> Self {
+        let samples = match model.sample_dims() {
+            [m, 1] if !model.is_surface() => vec![m],
+            dims => dims.to_vec(),
         };
-        match shape {
-            Shape::BezierCurve(c) | Shape::BSplineCurve(c) => Extent {
+        match model {
+            Model::Curve(m) => Extent {
                 samples,
-                degree: vec![c.degree()],
-                rational: c.is_rational(),
+                degree: vec![m.curve().degree()],
+                rational: m.curve().is_rational(),
                 erbs_locals: None,
             },
-            Shape::BezierSurface(s) | Shape::BSplineSurface(s) => Extent {
+            Model::Surface(m) => Extent {
                 samples,
-                degree: s.degree().to_vec(),
-                rational: s.is_rational(),
+                degree: m.surface().degree().to_vec(),
+                rational: m.surface().is_rational(),
                 erbs_locals: None,
             },
-            Shape::ErbsCurve(c) => Extent {
-                samples,
-                degree: vec![
-                    c.local_curves()
-                        .iter()
-                        .map(|l| l.degree())
-                        .max()
-                        .unwrap_or(0),
-                ],
-                rational: false,
-                erbs_locals: Some(vec![c.local_curves().len()]),
-            },
-            Shape::ErbsSurface(s) => {
+            Model::ErbsCurve(m) => {
+                let c = m.curve();
+                Extent {
+                    samples,
+                    degree: vec![
+                        c.local_curves()
+                            .iter()
+                            .map(|l| l.degree())
+                            .max()
+                            .unwrap_or(0),
+                    ],
+                    rational: false,
+                    erbs_locals: Some(vec![c.local_curves().len()]),
+                }
+            }
+            Model::ErbsSurface(m) => {
+                let s = m.surface();
                 let degree = s.local_patches().iter().fold(vec![0, 0], |d, p| {
                     let [a, b] = p.degree();
                     vec![d[0].max(a), d[1].max(b)]
@@ -369,7 +374,7 @@ pub fn check_scene(
     let mut total = 0u64;
     let mut largest: Option<(usize, u64)> = None;
     for (i, o) in scene.objects.iter().enumerate() {
-        let e = estimate(&Extent::of(&o.shape, o.samples), mode, uses);
+        let e = estimate(&Extent::of(&o.model), mode, uses);
         let bytes = e.bytes();
         if bytes > budget.bytes {
             return Err(format!(

@@ -1,52 +1,62 @@
 //! What changed since a mirror last saw it.
 //!
 //! An update reports a [`DirtyRegion`]; the renderer keeps one [`DirtySet`] per frame-in-flight
-//! mirror and, before recording frame k, copies exactly the rows in mirror k's set.
+//! mirror and, before recording frame k, copies exactly the rows in mirror k's set (whole rows
+//! of touched rectangles, which are contiguous in memory).
 
 use std::ops::Range;
 
-/// Samples an update touched: a span of curve samples, or a rectangle of surface samples.
+/// Samples an update touched: a rectangle of sample rows × columns (curves have one column).
+/// Empty when nothing changed.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub enum DirtyRegion {
-    Nothing,
-    Curve(Range<usize>),
-    Surface {
-        rows: Range<usize>,
-        cols: Range<usize>,
-    },
+pub struct DirtyRegion {
+    pub rows: Range<usize>,
+    pub cols: Range<usize>,
 }
 
 impl DirtyRegion {
-    /// Number of samples in the region.
-    pub fn samples(&self) -> usize {
-        match self {
-            DirtyRegion::Nothing => 0,
-            DirtyRegion::Curve(r) => r.len(),
-            DirtyRegion::Surface { rows, cols } => rows.len() * cols.len(),
+    pub const NOTHING: DirtyRegion = DirtyRegion {
+        rows: 0..0,
+        cols: 0..0,
+    };
+
+    /// A span of curve samples.
+    #[must_use]
+    pub fn curve(samples: Range<usize>) -> Self {
+        Self::surface(samples, 0..1)
+    }
+
+    /// A rectangle of surface samples.
+    #[must_use]
+    pub fn surface(rows: Range<usize>, cols: Range<usize>) -> Self {
+        if rows.is_empty() || cols.is_empty() {
+            Self::NOTHING
+        } else {
+            Self { rows, cols }
         }
     }
 
-    /// Rows a mirror must re-copy: whole rows of a touched rectangle (contiguous in memory),
-    /// samples of a curve.
-    pub fn rows(&self) -> Range<usize> {
-        match self {
-            DirtyRegion::Nothing => 0..0,
-            DirtyRegion::Curve(r) => r.clone(),
-            DirtyRegion::Surface { rows, .. } => rows.clone(),
-        }
+    pub fn is_empty(&self) -> bool {
+        self.rows.is_empty()
+    }
+
+    /// Number of samples in the region.
+    pub fn samples(&self) -> usize {
+        self.rows.len() * self.cols.len()
     }
 
     /// Smallest region containing both.
+    #[must_use]
     pub fn union(self, other: DirtyRegion) -> DirtyRegion {
-        use DirtyRegion::*;
-        match (self, other) {
-            (Nothing, r) | (r, Nothing) => r,
-            (Curve(a), Curve(b)) => Curve(a.start.min(b.start)..a.end.max(b.end)),
-            (Surface { rows: r1, cols: c1 }, Surface { rows: r2, cols: c2 }) => Surface {
-                rows: r1.start.min(r2.start)..r1.end.max(r2.end),
-                cols: c1.start.min(c2.start)..c1.end.max(c2.end),
-            },
-            (a, b) => panic!("cannot unite {a:?} and {b:?}: different object kinds"),
+        if self.is_empty() {
+            return other;
+        }
+        if other.is_empty() {
+            return self;
+        }
+        DirtyRegion {
+            rows: self.rows.start.min(other.rows.start)..self.rows.end.max(other.rows.end),
+            cols: self.cols.start.min(other.cols.start)..self.cols.end.max(other.cols.end),
         }
     }
 }

@@ -5,8 +5,9 @@ use super::axis::HermiteTable;
 use super::dirty::DirtyRegion;
 use super::erbs_axis::{ErbsAxis, leibniz_terms};
 use super::grid::{PartialSet, SampleGrid};
-use crate::geom::ErbsCurve;
+use super::object::Sampler;
 use crate::geom::knots::KnotVector;
+use crate::model::{ErbsCurveEdit, ErbsCurveModel, KindEdit, LocalEdit};
 use glam::{DMat4, DVec3};
 
 /// One local curve's pre-evaluation at the parent's parameters in its support: its
@@ -20,7 +21,7 @@ struct LocalSamples {
 
 #[derive(Debug, Clone)]
 pub struct ErbsCurveSampler {
-    curve: ErbsCurve,
+    model: ErbsCurveModel,
     axis: ErbsAxis,
     local: Vec<LocalSamples>,
     terms: Vec<Vec<(f64, usize, usize)>>,
@@ -28,7 +29,9 @@ pub struct ErbsCurveSampler {
 }
 
 impl ErbsCurveSampler {
-    pub fn new(curve: ErbsCurve, samples: usize, order: usize) -> Self {
+    pub fn new(model: ErbsCurveModel, order: usize) -> Self {
+        let curve = model.curve();
+        let samples = model.samples();
         let axis = ErbsAxis::new(curve.knots(), curve.bfunction(), samples, order);
         let knots = curve.knots();
         let local = curve
@@ -55,7 +58,7 @@ impl ErbsCurveSampler {
             .collect();
         let grid = SampleGrid::new([samples, 1], PartialSet::Curve(order), false);
         let mut s = Self {
-            curve,
+            model,
             axis,
             local,
             terms: leibniz_terms(order),
@@ -65,24 +68,12 @@ impl ErbsCurveSampler {
         s
     }
 
-    pub fn curve(&self) -> &ErbsCurve {
-        &self.curve
-    }
-
-    pub fn grid(&self) -> &SampleGrid {
-        &self.grid
-    }
-
-    pub fn params(&self) -> &[f64] {
-        &self.axis.params
-    }
-
     /// Exact sampling: every local curve from its control points, then the blend.
-    pub fn full(&mut self) -> DirtyRegion {
+    fn sample_all(&mut self) -> DirtyRegion {
         self.grid.data.fill(DVec3::ZERO);
         let g1 = self.grid.stride();
         for l in 0..self.local.len() {
-            let pts = self.curve.local_curves()[l].points();
+            let pts = self.model.curve().local_curves()[l].points();
             let loc = &mut self.local[l];
             for jl in 0..loc.table.len() {
                 for k in 0..g1 {
@@ -95,13 +86,12 @@ impl ErbsCurveSampler {
             let delta = loc.samples.clone();
             self.blend_in(l, &delta);
         }
-        DirtyRegion::Curve(0..self.grid.dims[0])
+        DirtyRegion::curve(0..self.grid.dims[0])
     }
 
     /// Affine map of local curve l: Δc = A·c − c on its pre-sampled data (positions as points,
     /// derivatives as vectors), blended into the parent with the Leibniz rule.
-    pub fn transform_local(&mut self, l: usize, a: &DMat4) -> DirtyRegion {
-        self.curve.transform_local(l, a);
+    fn transform_local(&mut self, l: usize, a: &DMat4) -> DirtyRegion {
         let g1 = self.grid.stride();
         let loc = &mut self.local[l];
         let mut delta = vec![DVec3::ZERO; loc.samples.len()];
@@ -117,9 +107,8 @@ impl ErbsCurveSampler {
         self.blend_in(l, &delta)
     }
 
-    /// Moves control point q of local curve l: Δc^(k) = M_l[k][q]·Δ, then the blend.
-    pub fn translate_local_point(&mut self, l: usize, q: usize, delta: DVec3) -> DirtyRegion {
-        self.curve.translate_local_point(l, q, delta);
+    /// Control point q of local curve l moved by Δ: Δc^(k) = M_l[k][q]·Δ, then the blend.
+    fn move_local_point(&mut self, l: usize, q: usize, delta: DVec3) -> DirtyRegion {
         let g1 = self.grid.stride();
         let loc = &mut self.local[l];
         let mut d = vec![DVec3::ZERO; loc.samples.len()];
@@ -131,19 +120,6 @@ impl ErbsCurveSampler {
             }
         }
         self.blend_in(l, &d)
-    }
-
-    /// Sets every control point of local curve l exactly (samples move by the differences).
-    pub fn set_local_points(&mut self, l: usize, points: &[DVec3]) -> DirtyRegion {
-        let current = self.curve.local_curves()[l].points().to_vec();
-        let mut region = DirtyRegion::Nothing;
-        for (q, (&new, &old)) in points.iter().zip(&current).enumerate() {
-            if new != old {
-                region = region.union(self.translate_local_point(l, q, new - old));
-            }
-        }
-        self.curve.set_local_points(l, points);
-        region
     }
 
     /// P^(r) += Σ_k C(r,k) W_l^(r−k) Δc_l^(k) over the support of local curve l.
@@ -163,6 +139,52 @@ impl ErbsCurveSampler {
                 out[r] += acc;
             }
         }
-        DirtyRegion::Curve(range)
+        DirtyRegion::curve(range)
+    }
+}
+
+impl Sampler for ErbsCurveSampler {
+    type Edit = ErbsCurveEdit;
+
+    fn model(&self) -> &ErbsCurveModel {
+        &self.model
+    }
+
+    fn grid(&self) -> &SampleGrid {
+        &self.grid
+    }
+
+    fn params(&self) -> Vec<&[f64]> {
+        vec![&self.axis.params]
+    }
+
+    fn apply(&mut self, edit: &ErbsCurveEdit) -> DirtyRegion {
+        let ErbsCurveEdit::Local(e) = edit;
+        let l = e.local();
+        let before = self.model.curve().local_curves()[l].points().to_vec();
+        edit.apply(&mut self.model);
+        match e {
+            LocalEdit::Transform { matrix, .. } => self.transform_local(l, matrix),
+            // Samples move by the model's exact change of each point.
+            LocalEdit::MovePoint { .. } | LocalEdit::SetPoints { .. } => {
+                let after = self.model.curve().local_curves()[l].points().to_vec();
+                let mut region = DirtyRegion::NOTHING;
+                for (q, (&new, &old)) in after.iter().zip(&before).enumerate() {
+                    if new != old {
+                        region = region.union(self.move_local_point(l, q, new - old));
+                    }
+                }
+                region
+            }
+        }
+    }
+
+    /// ERBS updates are local anyway: drift control re-samples everything.
+    fn rebuild(&mut self, _region: DirtyRegion) -> DirtyRegion {
+        self.sample_all()
+    }
+
+    fn full(&mut self) -> DirtyRegion {
+        self.sample_all()
     }
 }

@@ -6,11 +6,13 @@ use super::dirty::DirtyRegion;
 use super::erbs_axis::ErbsAxis;
 use super::grid::{PartialSet, SampleGrid};
 use super::normals::NormalSource;
+use super::object::Sampler;
 use super::shading::{self, ShadingGrid};
 use super::spline_surface::{Rect, two_pass};
 use crate::geom::ErbsSurface;
 use crate::geom::knots::KnotVector;
 use crate::geom::point::binomial;
+use crate::model::{ErbsSurfaceEdit, ErbsSurfaceModel, KindEdit, LocalEdit};
 use glam::{DMat4, DVec3};
 use std::ops::Range;
 
@@ -29,7 +31,7 @@ type BlendTerm = (f64, usize, usize, usize);
 
 #[derive(Debug, Clone)]
 pub struct ErbsSurfaceSampler {
-    surface: ErbsSurface,
+    model: ErbsSurfaceModel,
     axes: [ErbsAxis; 2],
     partials: Vec<(usize, usize)>,
     terms: Vec<Vec<BlendTerm>>,
@@ -41,8 +43,10 @@ pub struct ErbsSurfaceSampler {
 }
 
 impl ErbsSurfaceSampler {
-    pub fn new(surface: ErbsSurface, samples: [usize; 2], set: PartialSet, normals: bool) -> Self {
+    pub fn new(model: ErbsSurfaceModel, set: PartialSet, normals: bool) -> Self {
         let g = set.max_order();
+        let surface = model.surface();
+        let samples = model.samples();
         let [ku, kv] = surface.knots();
         let axes = [
             ErbsAxis::new(ku, surface.bfunction(), samples[0], g),
@@ -105,7 +109,7 @@ impl ErbsSurfaceSampler {
         }
         let grid = SampleGrid::new(samples, set, normals);
         let mut s = Self {
-            surface,
+            model,
             axes,
             partials,
             terms,
@@ -117,21 +121,9 @@ impl ErbsSurfaceSampler {
         s
     }
 
-    pub fn surface(&self) -> &ErbsSurface {
-        &self.surface
-    }
-
-    pub fn grid(&self) -> &SampleGrid {
-        &self.grid
-    }
-
-    pub fn params(&self) -> [&[f64]; 2] {
-        [&self.axes[0].params, &self.axes[1].params]
-    }
-
     /// Exact sampling: every local patch from its control points (two passes on its sub-grid),
     /// then the blend.
-    pub fn full(&mut self) -> DirtyRegion {
+    fn sample_all(&mut self) -> DirtyRegion {
         self.grid.data.fill(DVec3::ZERO);
         for idx in 0..self.patches.len() {
             self.sample_patch(idx);
@@ -142,15 +134,13 @@ impl ErbsSurfaceSampler {
         }
         let [mu, mv] = self.grid.dims;
         self.update_normals(0..mu, 0..mv);
-        DirtyRegion::Surface {
-            rows: 0..mu,
-            cols: 0..mv,
-        }
+        DirtyRegion::surface(0..mu, 0..mv)
     }
 
     fn sample_patch(&mut self, idx: usize) {
-        let nv = self.surface.count()[1];
-        let patch = self.surface.local_patch(idx / nv, idx % nv);
+        let surface = self.model.surface();
+        let nv = surface.count()[1];
+        let patch = surface.local_patch(idx / nv, idx % nv);
         let p = &mut self.patches[idx];
         let [tu, tv] = &p.tables;
         if self.grid.partials == PartialSet::Shading
@@ -186,9 +176,7 @@ impl ErbsSurfaceSampler {
 
     /// Affine map of local patch (k, l): Δs = A·s − s on its pre-sampled partials (positions as
     /// points, derivatives as vectors), blended into the parent.
-    pub fn transform_local(&mut self, k: usize, l: usize, a: &DMat4) -> DirtyRegion {
-        self.surface.transform_local(k, l, a);
-        let idx = k * self.surface.count()[1] + l;
+    fn transform_local(&mut self, idx: usize, a: &DMat4) -> DirtyRegion {
         let stride = self.partials.len();
         let p = &mut self.patches[idx];
         let mut delta = std::mem::take(&mut self.scratch);
@@ -210,17 +198,8 @@ impl ErbsSurfaceSampler {
         region
     }
 
-    /// Moves control point (qa, qb) of local patch (k, l): Δs^(ab) = Mu[a][qa] Mv[b][qb] Δ.
-    pub fn translate_local_point(
-        &mut self,
-        k: usize,
-        l: usize,
-        qa: usize,
-        qb: usize,
-        delta: DVec3,
-    ) -> DirtyRegion {
-        self.surface.translate_local_point(k, l, qa, qb, delta);
-        let idx = k * self.surface.count()[1] + l;
+    /// Control point (qa, qb) of local patch `idx` moved by Δ: Δs^(ab) = Mu[a][qa] Mv[b][qb] Δ.
+    fn move_local_point(&mut self, idx: usize, qa: usize, qb: usize, delta: DVec3) -> DirtyRegion {
         let stride = self.partials.len();
         let p = &mut self.patches[idx];
         let width = p.cols.len();
@@ -242,26 +221,6 @@ impl ErbsSurfaceSampler {
         region
     }
 
-    /// Sets every control point of local patch (k, l) exactly (samples move by the differences).
-    pub fn set_local_points(&mut self, k: usize, l: usize, points: &[DVec3]) -> DirtyRegion {
-        let patch = self.surface.local_patch(k, l);
-        let nb = patch.count()[1];
-        let current = patch.points().to_vec();
-        let mut region = DirtyRegion::Nothing;
-        for (q, (&new, &old)) in points.iter().zip(&current).enumerate() {
-            if new != old {
-                region = region.union(self.translate_local_point(k, l, q / nb, q % nb, new - old));
-            }
-        }
-        self.surface.set_local_points(k, l, points);
-        region
-    }
-
-    /// Exact re-evaluation of the whole object (drift control; ERBS updates are local anyway).
-    pub fn rebuild(&mut self) -> DirtyRegion {
-        self.full()
-    }
-
     fn finish(&mut self, idx: usize, delta: &[DVec3]) -> DirtyRegion {
         let region = self.blend_in(idx, delta);
         let (rows, cols) = (
@@ -274,7 +233,7 @@ impl ErbsSurfaceSampler {
 
     /// ∂^{ab}P += Σ C(a,a')C(b,b') Wu_k^(a−a') Wv_l^(b−b') Δs^(a'b') over the patch's support.
     fn blend_in(&mut self, idx: usize, delta: &[DVec3]) -> DirtyRegion {
-        let nv = self.surface.count()[1];
+        let nv = self.model.surface().count()[1];
         let (k, l) = (idx / nv, idx % nv);
         let p = &self.patches[idx];
         let stride = self.partials.len();
@@ -305,10 +264,7 @@ impl ErbsSurfaceSampler {
                     o[2] += d[0] * (wu0 * wv1) + d[2] * w00;
                 }
             }
-            return DirtyRegion::Surface {
-                rows: p.rows.clone(),
-                cols: p.cols.clone(),
-            };
+            return DirtyRegion::surface(p.rows.clone(), p.cols.clone());
         }
         for i in p.rows.clone() {
             let wu = self.axes[0].weights(i, k);
@@ -326,10 +282,7 @@ impl ErbsSurfaceSampler {
                 }
             }
         }
-        DirtyRegion::Surface {
-            rows: p.rows.clone(),
-            cols: p.cols.clone(),
-        }
+        DirtyRegion::surface(p.rows.clone(), p.cols.clone())
     }
 
     fn update_normals(&mut self, rows: Range<usize>, cols: Range<usize>) {
@@ -337,7 +290,56 @@ impl ErbsSurfaceSampler {
             self.axes[0].params.as_slice(),
             self.axes[1].params.as_slice(),
         ];
-        super::normals::update(&mut self.grid, rows, cols, params, &self.surface);
+        super::normals::update(&mut self.grid, rows, cols, params, self.model.surface());
+    }
+}
+
+impl Sampler for ErbsSurfaceSampler {
+    type Edit = ErbsSurfaceEdit;
+
+    fn model(&self) -> &ErbsSurfaceModel {
+        &self.model
+    }
+
+    fn grid(&self) -> &SampleGrid {
+        &self.grid
+    }
+
+    fn params(&self) -> Vec<&[f64]> {
+        vec![&self.axes[0].params, &self.axes[1].params]
+    }
+
+    fn apply(&mut self, edit: &ErbsSurfaceEdit) -> DirtyRegion {
+        let ErbsSurfaceEdit::Local(e) = edit;
+        let [k, l] = e.local();
+        let nb = self.model.surface().local_patch(k, l).count()[1];
+        let idx = k * self.model.surface().count()[1] + l;
+        let before = self.model.surface().local_patch(k, l).points().to_vec();
+        edit.apply(&mut self.model);
+        match e {
+            LocalEdit::Transform { matrix, .. } => self.transform_local(idx, matrix),
+            // Samples move by the model's exact change of each point.
+            LocalEdit::MovePoint { .. } | LocalEdit::SetPoints { .. } => {
+                let after = self.model.surface().local_patch(k, l).points().to_vec();
+                let mut region = DirtyRegion::NOTHING;
+                for (q, (&new, &old)) in after.iter().zip(&before).enumerate() {
+                    if new != old {
+                        region =
+                            region.union(self.move_local_point(idx, q / nb, q % nb, new - old));
+                    }
+                }
+                region
+            }
+        }
+    }
+
+    /// ERBS updates are local anyway: drift control re-samples everything.
+    fn rebuild(&mut self, _region: DirtyRegion) -> DirtyRegion {
+        self.sample_all()
+    }
+
+    fn full(&mut self) -> DirtyRegion {
+        self.sample_all()
     }
 }
 

@@ -23,4 +23,4 @@ pub mod spline_surface;
 pub use axis::HermiteTable;
 pub use dirty::{DirtyRegion, DirtySet};
 pub use grid::{PartialSet, SampleGrid};
-pub use object::{ModelRef, SampleMode, SampledObject};
+pub use object::{SampleMode, SampledObject, Sampler, Tracked};

@@ -495,10 +495,15 @@ mod tests {
     use super::*;
     use crate::geom::point::{Point, nan_max};
     use crate::geom::{BFunctionKind, BSplineCurve, ErbsSurface, TensorSurface};
+    use crate::model::{
+        CurveEdit, CurveModel, ErbsSurfaceEdit, ErbsSurfaceModel, LocalEdit, PointEdit, SplineForm,
+        SurfaceEdit, SurfaceModel,
+    };
     use crate::sampling::erbs_surface::ErbsSurfaceSampler;
     use crate::sampling::grid::{PartialSet, SampleGrid};
     use crate::sampling::spline_curve::SplineCurveSampler;
     use crate::sampling::spline_surface::SplineSurfaceSampler;
+    use crate::sampling::{DirtyRegion, Sampler};
     use glam::DMat4;
 
     struct Rng(u64);
@@ -586,32 +591,29 @@ mod tests {
                 for rational in [false, true] {
                     let s = surface(&mut rng, [du, dv], rational);
                     let samples = [2 + rng.below(30), 2 + rng.below(30)];
-                    let mut fast =
-                        SplineSurfaceSampler::new(s.clone(), samples, PartialSet::Shading, true);
-                    let mut generic =
-                        SplineSurfaceSampler::new(s, samples, PartialSet::Square(1), true);
+                    let m = SurfaceModel::new(SplineForm::BSpline, s, samples).unwrap();
+                    let mut fast = SplineSurfaceSampler::new(m.clone(), PartialSet::Shading, true);
+                    let mut generic = SplineSurfaceSampler::new(m, PartialSet::Square(1), true);
                     worst = nan_max(worst, difference(fast.grid(), generic.grid()));
-                    let [nu, nv] = fast.surface().count();
+                    let [nu, nv] = fast.model().surface().count();
                     for _ in 0..20 {
-                        let (k, l) = (rng.below(nu), rng.below(nv));
-                        if rational && rng.below(3) == 0 {
-                            let w = rng.range(0.3, 3.0);
-                            assert_eq!(fast.set_weight(k, l, w), generic.set_weight(k, l, w));
+                        let point = [rng.below(nu), rng.below(nv)];
+                        let edit = if rational && rng.below(3) == 0 {
+                            let weight = rng.range(0.3, 3.0);
+                            SurfaceEdit::Point(PointEdit::Weight { point, weight })
                         } else {
-                            let d = rng.vec(1.0);
-                            assert_eq!(
-                                fast.translate_point(k, l, d),
-                                generic.translate_point(k, l, d)
-                            );
-                        }
+                            let delta = rng.vec(1.0);
+                            SurfaceEdit::Point(PointEdit::Move { point, delta })
+                        };
+                        assert_eq!(fast.apply(&edit), generic.apply(&edit));
                         worst = nan_max(worst, difference(fast.grid(), generic.grid()));
                     }
                     let i0 = rng.below(samples[0]);
                     let j0 = rng.below(samples[1]);
                     let rows = i0..i0 + 1 + rng.below(samples[0] - i0);
                     let cols = j0..j0 + 1 + rng.below(samples[1] - j0);
-                    fast.rebuild(rows.clone(), cols.clone());
-                    generic.rebuild(rows, cols);
+                    fast.rebuild(DirtyRegion::surface(rows.clone(), cols.clone()));
+                    generic.rebuild(DirtyRegion::surface(rows, cols));
                     let d = difference(fast.grid(), generic.grid());
                     assert!(d < 1e-13, "degree ({du}, {dv}) rational {rational}: {d:e}");
                     worst = nan_max(worst, d);
@@ -652,24 +654,30 @@ mod tests {
             };
             let e = ErbsSurface::new(knots, count, patches, kind).unwrap();
             let samples = [2 + rng.below(40), 2 + rng.below(40)];
-            let mut fast = ErbsSurfaceSampler::new(e.clone(), samples, PartialSet::Shading, true);
-            let mut generic = ErbsSurfaceSampler::new(e, samples, PartialSet::Square(1), true);
+            let m = ErbsSurfaceModel::new(e, samples).unwrap();
+            let mut fast = ErbsSurfaceSampler::new(m.clone(), PartialSet::Shading, true);
+            let mut generic = ErbsSurfaceSampler::new(m, PartialSet::Square(1), true);
             let d = difference(fast.grid(), generic.grid());
             assert!(d < 1e-13, "case {case}: {d:e}");
             for _ in 0..10 {
-                let (k, l) = (rng.below(count[0]), rng.below(count[1]));
-                if rng.below(2) == 0 {
-                    let m = DMat4::from_translation(rng.vec(1.0))
+                let local = [rng.below(count[0]), rng.below(count[1])];
+                let edit = if rng.below(2) == 0 {
+                    let matrix = DMat4::from_translation(rng.vec(1.0))
                         * DMat4::from_axis_angle(rng.vec(1.0).normalize(), rng.range(-1.0, 1.0));
-                    fast.transform_local(k, l, &m);
-                    generic.transform_local(k, l, &m);
+                    LocalEdit::Transform { local, matrix }
                 } else {
-                    let [da, db] = fast.surface().local_patch(k, l).degree();
-                    let (qa, qb) = (rng.below(da + 1), rng.below(db + 1));
-                    let v = rng.vec(1.0);
-                    fast.translate_local_point(k, l, qa, qb, v);
-                    generic.translate_local_point(k, l, qa, qb, v);
-                }
+                    let patch = fast.model().surface().local_patch(local[0], local[1]);
+                    let [da, db] = patch.degree();
+                    let point = [rng.below(da + 1), rng.below(db + 1)];
+                    let delta = rng.vec(1.0);
+                    LocalEdit::MovePoint {
+                        local,
+                        point,
+                        delta,
+                    }
+                };
+                fast.apply(&ErbsSurfaceEdit::Local(edit.clone()));
+                generic.apply(&ErbsSurfaceEdit::Local(edit));
                 let d = difference(fast.grid(), generic.grid());
                 assert!(d < 1e-12, "case {case}: {d:e}");
             }
@@ -688,8 +696,9 @@ mod tests {
             for l in 1..nv {
                 s.translate_point(0, l, apex - s.point(0, l));
             }
-            let fast = SplineSurfaceSampler::new(s.clone(), [9, 13], PartialSet::Shading, true);
-            let generic = SplineSurfaceSampler::new(s, [9, 13], PartialSet::Square(1), true);
+            let m = SurfaceModel::new(SplineForm::BSpline, s, [9, 13]).unwrap();
+            let fast = SplineSurfaceSampler::new(m.clone(), PartialSet::Shading, true);
+            let generic = SplineSurfaceSampler::new(m, PartialSet::Square(1), true);
             let g = fast.grid();
             assert!(
                 (0..13).all(|j| regular_normal(g.sample(0, j)[1], g.sample(0, j)[2]).is_none()),
@@ -746,18 +755,20 @@ mod tests {
                 let weights = rational.then(|| (0..n).map(|_| rng.range(0.3, 3.0)).collect());
                 let c = BSplineCurve::new(d, knots(&mut rng, d, n), pts, weights).unwrap();
                 let m = 2 + rng.below(200);
-                let mut fast = SplineCurveSampler::new(c.clone(), m, 1);
-                let mut generic = SplineCurveSampler::new(c, m, 2);
+                let model = CurveModel::new(SplineForm::BSpline, c, m).unwrap();
+                let mut fast = SplineCurveSampler::new(model.clone(), 1);
+                let mut generic = SplineCurveSampler::new(model, 2);
                 for step in 0..=20 {
                     if step > 0 {
-                        let (k, v) = (rng.below(n), rng.vec(1.0));
-                        assert_eq!(fast.translate_point(k, v), generic.translate_point(k, v));
+                        let (point, delta) = (rng.below(n), rng.vec(1.0));
+                        let edit = CurveEdit::Point(PointEdit::Move { point, delta });
+                        assert_eq!(fast.apply(&edit), generic.apply(&edit));
                     }
                     if step == 20 {
                         let a = rng.below(m);
                         let r = a..a + 1 + rng.below(m - a);
-                        fast.rebuild(r.clone());
-                        generic.rebuild(r);
+                        fast.rebuild(DirtyRegion::curve(r.clone()));
+                        generic.rebuild(DirtyRegion::curve(r));
                     }
                     let (f, g) = (&fast.grid().data, &generic.grid().data);
                     for j in 0..m {

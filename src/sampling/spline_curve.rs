@@ -3,17 +3,19 @@
 use super::axis::HermiteTable;
 use super::dirty::DirtyRegion;
 use super::grid::{PartialSet, SampleGrid};
+use super::object::Sampler;
 use super::rational::QuotientRule;
 use super::shading;
 use crate::geom::BSplineCurve;
 use crate::geom::point::to_homogeneous;
+use crate::model::{CurveEdit, CurveModel, KindEdit, PointNet};
 use glam::{DVec3, DVec4};
 use std::ops::Range;
 
 /// A curve with its pre-evaluation data and canonical samples c^(r)(S_j), r ≤ g.
 #[derive(Debug, Clone)]
 pub struct SplineCurveSampler {
-    curve: BSplineCurve,
+    model: CurveModel,
     table: HermiteTable,
     grid: SampleGrid,
     /// Homogeneous samples of (w·c, w) for rational curves, same layout as the grid.
@@ -22,13 +24,14 @@ pub struct SplineCurveSampler {
 }
 
 impl SplineCurveSampler {
-    pub fn new(curve: BSplineCurve, samples: usize, order: usize) -> Self {
+    pub fn new(model: CurveModel, order: usize) -> Self {
+        let curve = model.curve();
         let n = curve.points().len();
-        let table = HermiteTable::new(curve.knots(), curve.degree(), n, samples, order);
+        let table = HermiteTable::new(curve.knots(), curve.degree(), n, model.samples(), order);
         let set = PartialSet::Curve(order);
-        let grid = SampleGrid::new([samples, 1], set.clone(), false);
+        let grid = SampleGrid::new([model.samples(), 1], set.clone(), false);
         let mut s = Self {
-            curve,
+            model,
             table,
             grid,
             hom: None,
@@ -38,41 +41,25 @@ impl SplineCurveSampler {
         s
     }
 
-    pub fn curve(&self) -> &BSplineCurve {
-        &self.curve
-    }
-
-    pub fn grid(&self) -> &SampleGrid {
-        &self.grid
-    }
-
-    pub fn params(&self) -> &[f64] {
-        &self.table.params
-    }
-
-    /// Full sampling from the pre-evaluated matrices: P_j = M_j · c.
-    pub fn full(&mut self) -> DirtyRegion {
-        self.hom = self
-            .curve
-            .is_rational()
-            .then(|| vec![DVec4::ZERO; self.grid.data.len()]);
-        self.rebuild(0..self.table.len())
+    fn curve(&self) -> &BSplineCurve {
+        self.model.curve()
     }
 
     /// Exact re-evaluation of samples `range` from the control points (bounds drift).
-    pub fn rebuild(&mut self, range: Range<usize>) -> DirtyRegion {
+    fn rebuild_range(&mut self, range: Range<usize>) -> DirtyRegion {
         let g = self.grid.stride();
+        let curve = self.model.curve();
         match &mut self.hom {
-            None if g == 2 && shading::curve_supported(self.curve.degree()) => {
+            None if g == 2 && shading::curve_supported(curve.degree()) => {
                 shading::sample_curve(
                     &self.table,
-                    self.curve.points(),
+                    curve.points(),
                     range.clone(),
                     &mut self.grid.data,
                 );
             }
             None => {
-                let pts = self.curve.points();
+                let pts = curve.points();
                 for j in range.clone() {
                     let first = self.table.first(j);
                     for r in 0..g {
@@ -84,7 +71,7 @@ impl SplineCurveSampler {
                 }
             }
             Some(hom) => {
-                let h = self.curve.homogeneous_points();
+                let h = curve.homogeneous_points();
                 for j in range.clone() {
                     let first = self.table.first(j);
                     for r in 0..g {
@@ -100,45 +87,34 @@ impl SplineCurveSampler {
                 }
             }
         }
-        DirtyRegion::Curve(range)
+        DirtyRegion::curve(range)
     }
 
-    /// Moves control point k by `delta`: P_j += M_j[·][k]·Δ over I_k only (homogeneous
-    /// (w_k Δ, 0) and re-projection for rational curves).
-    pub fn translate_point(&mut self, k: usize, delta: DVec3) -> DirtyRegion {
-        self.curve.translate_point(k, delta);
-        match self.curve.weights() {
-            None => {
-                self.add_polynomial(k, delta);
-                DirtyRegion::Curve(self.table.range(k))
+    /// A control point edit: P_j += M_j[·][k]·Δ over I_k only, Δ the change of point k
+    /// (homogeneous (Δ(w c), Δw) and re-projection for rational curves).
+    fn edit_point(&mut self, edit: &CurveEdit, k: usize) -> DirtyRegion {
+        let before = PointState::of(self.curve(), k);
+        edit.apply(&mut self.model);
+        let after = PointState::of(self.curve(), k);
+        match (before.weight, after.weight) {
+            (None, None) => {
+                self.add_polynomial(k, after.position - before.position);
+                DirtyRegion::curve(self.table.range(k))
             }
-            Some(w) => {
-                let dh = (delta * w[k]).extend(0.0);
+            (Some(_), Some(_)) => {
+                let dh = before.homogeneous_change(&after);
                 self.add_homogeneous(k, dh)
             }
+            // Becoming rational (or polynomial) needs homogeneous samples everywhere.
+            _ => self.full(),
         }
     }
 
-    /// Sets weight k: Δ(w c, w) = (Δw c_k, Δw) through the touched samples.
-    pub fn set_weight(&mut self, k: usize, w: f64) -> DirtyRegion {
-        let old = self.curve.weights().map_or(1.0, |ws| ws[k]);
-        let was_rational = self.curve.is_rational();
-        self.curve.set_weight(k, w);
-        if !was_rational {
-            // Becoming rational needs homogeneous samples everywhere: one full pass.
-            return self.full();
-        }
-        let dw = w - old;
-        let dh = to_homogeneous(self.curve.points()[k], dw);
-        self.add_homogeneous(k, dh)
-    }
-
-    /// Sets control point k exactly: the samples move by the difference, the model takes the
-    /// exact value (so undo restores it bit for bit).
-    pub fn set_point(&mut self, k: usize, p: DVec3) -> DirtyRegion {
-        let region = self.translate_point(k, p - self.curve.points()[k]);
-        self.curve.set_point(k, p);
-        region
+    /// After a change of knots or degree: a new Hermite table at the same parameters. The
+    /// shape (and so every sample) is unchanged.
+    fn retabulate(&mut self) {
+        let c = self.model.curve();
+        self.table = self.table.refit(c.knots(), c.degree(), c.points().len());
     }
 
     fn add_polynomial(&mut self, k: usize, delta: DVec3) {
@@ -160,10 +136,9 @@ impl SplineCurveSampler {
     fn add_homogeneous(&mut self, k: usize, dh: DVec4) -> DirtyRegion {
         let g = self.grid.stride();
         let rows = g.min(self.table.degree() + 1);
-        let hom = self
-            .hom
-            .as_mut()
-            .expect("rational curves keep homogeneous samples");
+        let Some(hom) = self.hom.as_mut() else {
+            return self.full();
+        };
         let range = self.table.range(k);
         for j in range.clone() {
             let col = k - self.table.first(j);
@@ -176,7 +151,86 @@ impl SplineCurveSampler {
                 &mut self.grid.data[j * g..(j + 1) * g],
             );
         }
-        DirtyRegion::Curve(range)
+        DirtyRegion::curve(range)
+    }
+}
+
+impl Sampler for SplineCurveSampler {
+    type Edit = CurveEdit;
+
+    fn model(&self) -> &CurveModel {
+        &self.model
+    }
+
+    fn grid(&self) -> &SampleGrid {
+        &self.grid
+    }
+
+    fn params(&self) -> Vec<&[f64]> {
+        vec![&self.table.params]
+    }
+
+    fn apply(&mut self, edit: &CurveEdit) -> DirtyRegion {
+        match edit {
+            CurveEdit::Point(p) => self.edit_point(edit, p.point()),
+            CurveEdit::InsertKnot { .. } | CurveEdit::ElevateDegree { .. } => {
+                edit.apply(&mut self.model);
+                self.retabulate();
+                DirtyRegion::NOTHING
+            }
+            CurveEdit::Restore { model, shape_kept } => {
+                let rational = self.curve().is_rational();
+                self.model = (**model).clone();
+                self.retabulate();
+                if *shape_kept && rational == self.curve().is_rational() {
+                    DirtyRegion::NOTHING
+                } else {
+                    self.full()
+                }
+            }
+        }
+    }
+
+    fn rebuild(&mut self, region: DirtyRegion) -> DirtyRegion {
+        self.rebuild_range(region.rows)
+    }
+
+    /// Full sampling from the pre-evaluated matrices: P_j = M_j · c.
+    fn full(&mut self) -> DirtyRegion {
+        self.hom = self
+            .curve()
+            .is_rational()
+            .then(|| vec![DVec4::ZERO; self.grid.data.len()]);
+        self.rebuild_range(0..self.table.len())
+    }
+}
+
+/// One control point as an edit sees it, before or after.
+pub(crate) struct PointState {
+    pub position: DVec3,
+    pub weight: Option<f64>,
+}
+
+impl PointState {
+    pub fn of<I>(net: &impl PointNet<I>, i: I) -> Self
+    where
+        I: Copy,
+    {
+        Self {
+            position: net.point(i),
+            weight: net.weight(i),
+        }
+    }
+
+    /// Δ(w·p, w) of a rational point. A point edit changes the position or the weight, never
+    /// both, so each case is formed without cancellation: (w Δp, 0) or (Δw p, Δw).
+    pub fn homogeneous_change(&self, after: &PointState) -> DVec4 {
+        let (w0, w1) = (self.weight.unwrap_or(1.0), after.weight.unwrap_or(1.0));
+        if w0 == w1 {
+            ((after.position - self.position) * w0).extend(0.0)
+        } else {
+            to_homogeneous(after.position, w1 - w0)
+        }
     }
 }
 

@@ -4,11 +4,13 @@ use super::axis::HermiteTable;
 use super::dirty::DirtyRegion;
 use super::grid::{PartialSet, SampleGrid};
 use super::normals::NormalSource;
+use super::object::Sampler;
 use super::rational::QuotientRule;
 use super::shading::{self, ShadingGrid};
+use super::spline_curve::PointState;
 use super::spline_curve::dot;
 use crate::geom::TensorSurface;
-use crate::geom::point::to_homogeneous;
+use crate::model::{KindEdit, SurfaceEdit, SurfaceModel};
 use glam::{DVec3, DVec4};
 use std::ops::Range;
 
@@ -16,7 +18,7 @@ use std::ops::Range;
 /// its canonical samples.
 #[derive(Debug, Clone)]
 pub struct SplineSurfaceSampler {
-    surface: TensorSurface,
+    model: SurfaceModel,
     tables: [HermiteTable; 2],
     grid: SampleGrid,
     /// (a, b) of each slot, cached.
@@ -28,13 +30,10 @@ pub struct SplineSurfaceSampler {
 impl SplineSurfaceSampler {
     /// Samples `samples = [mu, mv]` over the domain; `normals` adds unit normals (needs a set with
     /// first partials).
-    pub fn new(
-        surface: TensorSurface,
-        samples: [usize; 2],
-        set: PartialSet,
-        normals: bool,
-    ) -> Self {
+    pub fn new(model: SurfaceModel, set: PartialSet, normals: bool) -> Self {
         let g = set.max_order();
+        let samples = model.samples();
+        let surface = model.surface();
         let [nu, nv] = surface.count();
         let [du, dv] = surface.degree();
         let [ku, kv] = surface.knots();
@@ -46,7 +45,7 @@ impl SplineSurfaceSampler {
         let partials = set.list();
         let rule = QuotientRule::new(&set);
         let mut s = Self {
-            surface,
+            model,
             tables,
             grid,
             partials,
@@ -57,39 +56,23 @@ impl SplineSurfaceSampler {
         s
     }
 
-    pub fn surface(&self) -> &TensorSurface {
-        &self.surface
-    }
-
-    pub fn grid(&self) -> &SampleGrid {
-        &self.grid
-    }
-
-    pub fn params(&self) -> [&[f64]; 2] {
-        [&self.tables[0].params, &self.tables[1].params]
-    }
-
-    pub fn full(&mut self) -> DirtyRegion {
-        self.hom = self
-            .surface
-            .is_rational()
-            .then(|| vec![DVec4::ZERO; self.grid.data.len()]);
-        let [mu, mv] = self.grid.dims;
-        self.rebuild(0..mu, 0..mv)
+    fn surface(&self) -> &TensorSurface {
+        self.model.surface()
     }
 
     /// Exact re-evaluation of a rectangle from the control points, in two passes: first each
     /// sample row against every control column (Q_a = M_u[a]·C), then each sample in the row
     /// (S_ab = Q_a·M_v[b]ᵀ) — (d+1) products per output instead of (d+1)².
-    pub fn rebuild(&mut self, rows: Range<usize>, cols: Range<usize>) -> DirtyRegion {
-        let nv = self.surface.count()[1];
-        if self.fast_shading() && shading::surface_supported(self.surface.degree()) {
+    fn rebuild_rect(&mut self, rows: Range<usize>, cols: Range<usize>) -> DirtyRegion {
+        let surface = self.model.surface();
+        let nv = surface.count()[1];
+        if self.fast_shading() && shading::surface_supported(surface.degree()) {
             let mut degenerate = Vec::new();
             let [tu, tv] = &self.tables;
             shading::sample_surface(
                 tu,
                 tv,
-                self.surface.points(),
+                surface.points(),
                 nv,
                 rows.clone(),
                 cols.clone(),
@@ -97,7 +80,7 @@ impl SplineSurfaceSampler {
                 &mut degenerate,
             );
             self.resolve_degenerate(&degenerate);
-            return DirtyRegion::Surface { rows, cols };
+            return DirtyRegion::surface(rows, cols);
         }
         let stride = self.grid.stride();
         let mv = self.grid.dims[1];
@@ -113,7 +96,7 @@ impl SplineSurfaceSampler {
             None => two_pass(
                 tu,
                 tv,
-                self.surface.points(),
+                surface.points(),
                 nv,
                 &self.partials,
                 &target,
@@ -123,7 +106,7 @@ impl SplineSurfaceSampler {
                 two_pass(
                     tu,
                     tv,
-                    &self.surface.homogeneous_points(),
+                    &surface.homogeneous_points(),
                     nv,
                     &self.partials,
                     &target,
@@ -141,12 +124,26 @@ impl SplineSurfaceSampler {
             }
         }
         self.update_normals(rows.clone(), cols.clone());
-        DirtyRegion::Surface { rows, cols }
+        DirtyRegion::surface(rows, cols)
     }
 
-    /// Moves control point (k, l): S_ij += M_u[i][·][k] M_v[j][·][l] Δ over I_k × I_l only.
-    pub fn translate_point(&mut self, k: usize, l: usize, delta: DVec3) -> DirtyRegion {
-        self.surface.translate_point(k, l, delta);
+    /// A control point edit: S_ij += M_u[i][·][k] M_v[j][·][l] Δ over I_k × I_l only, Δ the
+    /// change of point (k, l) (homogeneous and re-projected for rational surfaces).
+    fn edit_point(&mut self, edit: &SurfaceEdit, [k, l]: [usize; 2]) -> DirtyRegion {
+        let before = PointState::of(self.surface(), [k, l]);
+        edit.apply(&mut self.model);
+        let after = PointState::of(self.surface(), [k, l]);
+        match (before.weight, after.weight) {
+            (None, None) => self.add_polynomial(k, l, after.position - before.position),
+            (Some(_), Some(_)) => {
+                let dh = before.homogeneous_change(&after);
+                self.add_homogeneous(k, l, dh)
+            }
+            _ => self.full(),
+        }
+    }
+
+    fn add_polynomial(&mut self, k: usize, l: usize, delta: DVec3) -> DirtyRegion {
         if self.fast_shading() {
             let mut degenerate = Vec::new();
             let [tu, tv] = &self.tables;
@@ -158,56 +155,39 @@ impl SplineSurfaceSampler {
                 &mut degenerate,
             );
             self.resolve_degenerate(&degenerate);
-            return DirtyRegion::Surface { rows, cols };
+            return DirtyRegion::surface(rows, cols);
         }
-        match self.surface.weights() {
-            None => {
-                let (rows, cols) = (self.tables[0].range(k), self.tables[1].range(l));
-                let [tu, tv] = &self.tables;
-                let stride = self.grid.stride();
-                let mv = self.grid.dims[1];
-                for i in rows.clone() {
-                    let cu = k - tu.first(i);
-                    for j in cols.clone() {
-                        let cv = l - tv.first(j);
-                        let out =
-                            &mut self.grid.data[(i * mv + j) * stride..(i * mv + j + 1) * stride];
-                        for (p, &(a, b)) in self.partials.iter().enumerate() {
-                            let c = tu.row(i, a).map_or(0.0, |r| r[cu])
-                                * tv.row(j, b).map_or(0.0, |r| r[cv]);
-                            out[p] += delta * c;
-                        }
-                    }
+        let (rows, cols) = (self.tables[0].range(k), self.tables[1].range(l));
+        let [tu, tv] = &self.tables;
+        let stride = self.grid.stride();
+        let mv = self.grid.dims[1];
+        for i in rows.clone() {
+            let cu = k - tu.first(i);
+            for j in cols.clone() {
+                let cv = l - tv.first(j);
+                let out = &mut self.grid.data[(i * mv + j) * stride..(i * mv + j + 1) * stride];
+                for (p, &(a, b)) in self.partials.iter().enumerate() {
+                    let c =
+                        tu.row(i, a).map_or(0.0, |r| r[cu]) * tv.row(j, b).map_or(0.0, |r| r[cv]);
+                    out[p] += delta * c;
                 }
-                self.update_normals(rows.clone(), cols.clone());
-                DirtyRegion::Surface { rows, cols }
-            }
-            Some(w) => {
-                let nv = self.surface.count()[1];
-                let dh = (delta * w[k * nv + l]).extend(0.0);
-                self.add_homogeneous(k, l, dh)
             }
         }
+        self.update_normals(rows.clone(), cols.clone());
+        DirtyRegion::surface(rows, cols)
     }
 
-    /// Sets control point (k, l) exactly (samples move by the difference).
-    pub fn set_point(&mut self, k: usize, l: usize, p: DVec3) -> DirtyRegion {
-        let region = self.translate_point(k, l, p - self.surface.point(k, l));
-        self.surface.set_point(k, l, p);
-        region
-    }
-
-    /// Sets weight (k, l): Δ(w P, w) = (Δw P_kl, Δw) on the touched samples, then re-projects.
-    pub fn set_weight(&mut self, k: usize, l: usize, w: f64) -> DirtyRegion {
-        let nv = self.surface.count()[1];
-        let old = self.surface.weights().map_or(1.0, |ws| ws[k * nv + l]);
-        let was_rational = self.surface.is_rational();
-        self.surface.set_weight(k, l, w);
-        if !was_rational {
-            return self.full();
+    /// After a change of knots or degree: new Hermite tables at the same parameters in the
+    /// directions whose basis changed; the other direction's table is reused. The shape (and
+    /// so every sample) is unchanged.
+    fn retabulate(&mut self) {
+        let s = self.model.surface();
+        for dir in 0..2 {
+            let t = &self.tables[dir];
+            if !t.tabulates(&s.knots()[dir], s.degree()[dir], s.count()[dir]) {
+                self.tables[dir] = t.refit(&s.knots()[dir], s.degree()[dir], s.count()[dir]);
+            }
         }
-        let dh = to_homogeneous(self.surface.point(k, l), w - old);
-        self.add_homogeneous(k, l, dh)
     }
 
     fn add_homogeneous(&mut self, k: usize, l: usize, dh: DVec4) -> DirtyRegion {
@@ -215,10 +195,9 @@ impl SplineSurfaceSampler {
         let [tu, tv] = &self.tables;
         let stride = self.grid.stride();
         let mv = self.grid.dims[1];
-        let hom = self
-            .hom
-            .as_mut()
-            .expect("rational surfaces keep homogeneous samples");
+        let Some(hom) = self.hom.as_mut() else {
+            return self.full();
+        };
         for i in rows.clone() {
             let cu = k - tu.first(i);
             for j in cols.clone() {
@@ -236,16 +215,17 @@ impl SplineSurfaceSampler {
             }
         }
         self.update_normals(rows.clone(), cols.clone());
-        DirtyRegion::Surface { rows, cols }
+        DirtyRegion::surface(rows, cols)
     }
 
     /// Whether the `shading` kernels apply: a polynomial surface of degree ≥ 1 both ways on a
     /// `Shading` grid with normals (what the renderer asks for).
     fn fast_shading(&self) -> bool {
-        !self.surface.is_rational()
+        let s = self.model.surface();
+        !s.is_rational()
             && self.grid.partials == PartialSet::Shading
             && self.grid.normals.is_some()
-            && self.surface.degree().iter().all(|&d| d >= 1)
+            && s.degree().iter().all(|&d| d >= 1)
     }
 
     fn resolve_degenerate(&mut self, samples: &[(usize, usize)]) {
@@ -253,7 +233,7 @@ impl SplineSurfaceSampler {
             self.tables[0].params.as_slice(),
             self.tables[1].params.as_slice(),
         ];
-        super::normals::resolve_degenerate(&mut self.grid, samples, params, &self.surface);
+        super::normals::resolve_degenerate(&mut self.grid, samples, params, self.model.surface());
     }
 
     fn update_normals(&mut self, rows: Range<usize>, cols: Range<usize>) {
@@ -261,7 +241,57 @@ impl SplineSurfaceSampler {
             self.tables[0].params.as_slice(),
             self.tables[1].params.as_slice(),
         ];
-        super::normals::update(&mut self.grid, rows, cols, params, &self.surface);
+        super::normals::update(&mut self.grid, rows, cols, params, self.model.surface());
+    }
+}
+
+impl Sampler for SplineSurfaceSampler {
+    type Edit = SurfaceEdit;
+
+    fn model(&self) -> &SurfaceModel {
+        &self.model
+    }
+
+    fn grid(&self) -> &SampleGrid {
+        &self.grid
+    }
+
+    fn params(&self) -> Vec<&[f64]> {
+        vec![&self.tables[0].params, &self.tables[1].params]
+    }
+
+    fn apply(&mut self, edit: &SurfaceEdit) -> DirtyRegion {
+        match edit {
+            SurfaceEdit::Point(p) => self.edit_point(edit, p.point()),
+            SurfaceEdit::InsertKnot { .. } | SurfaceEdit::ElevateDegree { .. } => {
+                edit.apply(&mut self.model);
+                self.retabulate();
+                DirtyRegion::NOTHING
+            }
+            SurfaceEdit::Restore { model, shape_kept } => {
+                let rational = self.surface().is_rational();
+                self.model = (**model).clone();
+                self.retabulate();
+                if *shape_kept && rational == self.surface().is_rational() {
+                    DirtyRegion::NOTHING
+                } else {
+                    self.full()
+                }
+            }
+        }
+    }
+
+    fn rebuild(&mut self, region: DirtyRegion) -> DirtyRegion {
+        self.rebuild_rect(region.rows, region.cols)
+    }
+
+    fn full(&mut self) -> DirtyRegion {
+        self.hom = self
+            .surface()
+            .is_rational()
+            .then(|| vec![DVec4::ZERO; self.grid.data.len()]);
+        let [mu, mv] = self.grid.dims;
+        self.rebuild_rect(0..mu, 0..mv)
     }
 }
 

@@ -2,10 +2,11 @@
 //! net, an ERBS surface with visible local patches, an ERBS curve with its local curves, an exact
 //! NURBS circle, and the Utah teapot.
 
-use super::{Samples, Scene, SceneObject, Shape, parse_scene};
+use super::{Model, Scene, SceneObject, parse_scene};
 use crate::geom::{
     BFunctionKind, BSplineCurve, BezierCurve, ErbsCurve, ErbsSurface, KnotVector, TensorSurface,
 };
+use crate::model::{CurveModel, ErbsCurveModel, ErbsSurfaceModel, SplineForm, SurfaceModel};
 use glam::DVec3;
 
 /// Newell's teapot (32 bicubic Bézier patches), the file shipped in `examples/`.
@@ -13,35 +14,46 @@ pub const TEAPOT_JSON: &str = include_str!("../../examples/teapot.json");
 
 /// Builds the demo scene. Objects are laid out side by side along x, z up.
 pub fn demo_scene() -> Scene {
+    let object = |name: &str, model, color| SceneObject {
+        name: name.into(),
+        model,
+        color: Some(color),
+    };
+    let valid = "the demo's sample counts are valid";
     let mut objects = vec![
-        SceneObject {
-            name: "bspline_surface".into(),
-            shape: Shape::BSplineSurface(bspline_surface()),
-            samples: Samples::Surface([96, 96]),
-            color: Some([0.80, 0.55, 0.30]),
-        },
-        SceneObject {
-            name: "erbs_surface".into(),
-            shape: Shape::ErbsSurface(erbs_surface()),
-            samples: Samples::Surface([96, 96]),
-            color: Some([0.35, 0.60, 0.85]),
-        },
-        SceneObject {
-            name: "erbs_curve".into(),
-            shape: Shape::ErbsCurve(erbs_curve()),
-            samples: Samples::Curve(400),
-            color: Some([0.90, 0.20, 0.20]),
-        },
-        SceneObject {
-            name: "nurbs_circle".into(),
-            shape: Shape::BSplineCurve(nurbs_circle(DVec3::new(0.0, -5.5, 0.0), 1.5)),
-            samples: Samples::Curve(256),
-            color: Some([0.95, 0.85, 0.20]),
-        },
+        object(
+            "bspline_surface",
+            Model::Surface(
+                SurfaceModel::new(SplineForm::BSpline, bspline_surface(), [96, 96]).expect(valid),
+            ),
+            [0.80, 0.55, 0.30],
+        ),
+        object(
+            "erbs_surface",
+            Model::ErbsSurface(ErbsSurfaceModel::new(erbs_surface(), [96, 96]).expect(valid)),
+            [0.35, 0.60, 0.85],
+        ),
+        object(
+            "erbs_curve",
+            Model::ErbsCurve(ErbsCurveModel::new(erbs_curve(), 400).expect(valid)),
+            [0.90, 0.20, 0.20],
+        ),
+        object(
+            "nurbs_circle",
+            Model::Curve(
+                CurveModel::new(
+                    SplineForm::BSpline,
+                    nurbs_circle(DVec3::new(0.0, -5.5, 0.0), 1.5),
+                    256,
+                )
+                .expect(valid),
+            ),
+            [0.95, 0.85, 0.20],
+        ),
     ];
     let mut teapot = parse_scene(TEAPOT_JSON).expect("the bundled teapot is valid");
     for o in &mut teapot.objects {
-        if let Shape::BezierSurface(s) = &mut o.shape {
+        if let Model::Surface(s) = &mut o.model {
             s.map_points(|p| p + DVec3::new(9.0, 0.0, 0.0));
         }
         o.color = Some([0.85, 0.85, 0.88]);

@@ -1,147 +1,18 @@
-//! Edits: what the `--edits` file, the viewer and undo/redo apply to objects.
+//! The edits file (docs/scene-format.md): a JSON list parsed into the model's edit vocabulary.
+//! Edits are validated in order against the model as the earlier edits leave it, so an edit
+//! after a knot insertion addresses the refined control net.
 
 use super::json::*;
-use super::{Scene, SceneError, Shape};
-use glam::{DMat4, DVec3};
-use serde_json::Value;
+use super::{Scene, SceneError};
+use crate::model::{
+    CurveEdit, Edit, EditError, ErbsCurveEdit, ErbsSurfaceEdit, KindEdit, LocalEdit, Model,
+    ModelRef, ObjectEdit, PointEdit, SurfaceEdit,
+};
+use glam::DMat4;
+use serde_json::{Map, Value};
 
-/// A control point or local curve/patch index: one index for curves, two for surfaces.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Index2 {
-    One(usize),
-    Two(usize, usize),
-}
-
-/// One edit of one object (`object` indexes `Scene::objects`).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Edit {
-    pub object: usize,
-    pub op: EditOp,
-}
-
-/// The edit operations of the DESIGN.md edit format.
-#[derive(Debug, Clone, PartialEq)]
-pub enum EditOp {
-    /// Translate a control point (for rational objects the Cartesian point; its weight stays).
-    TranslatePoint { point: Index2, delta: DVec3 },
-    /// Set a weight; a polynomial object becomes rational with all other weights 1.
-    SetWeight { point: Index2, weight: f64 },
-    /// Map every control point of an ERBS local curve/patch by p ↦ (A·[p;1]).xyz (A affine).
-    TransformLocal { local: Index2, matrix: DMat4 },
-    /// Translate one control point of an ERBS local curve/patch.
-    TranslateLocalPoint {
-        local: Index2,
-        point: Index2,
-        delta: DVec3,
-    },
-    /// Set a control point to an exact position (undo restores the model bit for bit). Not part
-    /// of the edits file format.
-    SetPoint { point: Index2, position: DVec3 },
-    /// Set every control point of an ERBS local curve/patch exactly (undo). Not part of the
-    /// edits file format.
-    SetLocalPoints { local: Index2, points: Vec<DVec3> },
-}
-
-impl EditOp {
-    /// Applies the edit to the model (control data). Indices must have been validated.
-    pub fn apply_to(&self, shape: &mut Shape) {
-        match (self, shape) {
-            (
-                EditOp::TranslatePoint {
-                    point: Index2::One(i),
-                    delta,
-                },
-                Shape::BezierCurve(c) | Shape::BSplineCurve(c),
-            ) => c.translate_point(*i, *delta),
-            (
-                EditOp::TranslatePoint {
-                    point: Index2::Two(i, j),
-                    delta,
-                },
-                Shape::BezierSurface(s) | Shape::BSplineSurface(s),
-            ) => s.translate_point(*i, *j, *delta),
-            (
-                EditOp::SetWeight {
-                    point: Index2::One(i),
-                    weight,
-                },
-                Shape::BezierCurve(c) | Shape::BSplineCurve(c),
-            ) => c.set_weight(*i, *weight),
-            (
-                EditOp::SetWeight {
-                    point: Index2::Two(i, j),
-                    weight,
-                },
-                Shape::BezierSurface(s) | Shape::BSplineSurface(s),
-            ) => s.set_weight(*i, *j, *weight),
-            (
-                EditOp::TransformLocal {
-                    local: Index2::One(l),
-                    matrix,
-                },
-                Shape::ErbsCurve(c),
-            ) => c.transform_local(*l, matrix),
-            (
-                EditOp::TransformLocal {
-                    local: Index2::Two(k, l),
-                    matrix,
-                },
-                Shape::ErbsSurface(s),
-            ) => s.transform_local(*k, *l, matrix),
-            (
-                EditOp::TranslateLocalPoint {
-                    local: Index2::One(l),
-                    point: Index2::One(q),
-                    delta,
-                },
-                Shape::ErbsCurve(c),
-            ) => c.translate_local_point(*l, *q, *delta),
-            (
-                EditOp::TranslateLocalPoint {
-                    local: Index2::Two(k, l),
-                    point: Index2::Two(a, b),
-                    delta,
-                },
-                Shape::ErbsSurface(s),
-            ) => s.translate_local_point(*k, *l, *a, *b, *delta),
-            (
-                EditOp::SetPoint {
-                    point: Index2::One(i),
-                    position,
-                },
-                Shape::BezierCurve(c) | Shape::BSplineCurve(c),
-            ) => c.set_point(*i, *position),
-            (
-                EditOp::SetPoint {
-                    point: Index2::Two(i, j),
-                    position,
-                },
-                Shape::BezierSurface(s) | Shape::BSplineSurface(s),
-            ) => s.set_point(*i, *j, *position),
-            (
-                EditOp::SetLocalPoints {
-                    local: Index2::One(l),
-                    points,
-                },
-                Shape::ErbsCurve(c),
-            ) => c.set_local_points(*l, points),
-            (
-                EditOp::SetLocalPoints {
-                    local: Index2::Two(k, l),
-                    points,
-                },
-                Shape::ErbsSurface(s),
-            ) => s.set_local_points(*k, *l, points),
-            (op, shape) => panic!(
-                "edit {op:?} does not fit a {} (validate first)",
-                shape.type_name()
-            ),
-        }
-    }
-}
-
-/// Parses an edits file (a JSON list) against `scene`, validating object names, kinds and
-/// indices. Nothing is applied.
+/// Parses an edits file against `scene`, validating names, kinds, indices and parameters in
+/// order. Nothing is applied to `scene`.
 pub fn parse_edits(text: &str, scene: &Scene) -> Result<Vec<Edit>, SceneError> {
     let v: Value =
         serde_json::from_str(text).map_err(|e| SceneError(format!("invalid JSON: {e}")))?;
@@ -151,13 +22,38 @@ pub fn parse_edits(text: &str, scene: &Scene) -> Result<Vec<Edit>, SceneError> {
             kind(&v)
         ))
     })?;
-    list.iter()
-        .enumerate()
-        .map(|(k, e)| parse_edit(k, e, scene))
-        .collect()
+    // Models as the edits so far leave them; cloned only for objects that are edited.
+    let mut edited: Vec<Option<Model>> = vec![None; scene.objects.len()];
+    let mut out = Vec::with_capacity(list.len());
+    for (k, e) in list.iter().enumerate() {
+        let (object, at, obj) = locate(k, e, scene)?;
+        let model = edited[object].get_or_insert_with(|| scene.objects[object].model.clone());
+        let edit = parse_edit(&at, obj, model.as_ref())?;
+        edit.validate(model.as_ref())
+            .and_then(|()| model.apply(&edit))
+            .map_err(|e| at.err(e.field, e.message))?;
+        out.push(Edit { object, edit });
+    }
+    Ok(out)
 }
 
-fn parse_edit(k: usize, v: &Value, scene: &Scene) -> Result<Edit, SceneError> {
+/// Applies validated edits to the scene's models in order (the `--full` reference path).
+pub fn apply_all(scene: &mut Scene, edits: &[Edit]) -> Result<(), SceneError> {
+    for (k, e) in edits.iter().enumerate() {
+        let o = &mut scene.objects[e.object];
+        o.model
+            .apply(&e.edit)
+            .map_err(|err| SceneError(format!("edit {k} (object '{}'): {err}", o.name)))?;
+    }
+    Ok(())
+}
+
+/// The edit's object index, its message prefix and its fields.
+fn locate<'a>(
+    k: usize,
+    v: &'a Value,
+    scene: &Scene,
+) -> Result<(usize, At, &'a Map<String, Value>), SceneError> {
     let at = At(format!("edit {k}"));
     let obj = v
         .as_object()
@@ -166,150 +62,186 @@ fn parse_edit(k: usize, v: &Value, scene: &Scene) -> Result<Edit, SceneError> {
     let object = scene
         .find(name)
         .ok_or_else(|| at.err("object", format!("unknown object '{name}'")))?;
-    let shape = &scene.objects[object].shape;
-    let at = At(format!("edit {k} (object '{name}')"));
-    let ty = shape.type_name();
-    let has = |f: &str| obj.contains_key(f);
-    let op = if has("local") {
-        let erbs_dims = match shape {
-            Shape::ErbsCurve(_) => 1,
-            Shape::ErbsSurface(_) => 2,
+    Ok((object, At(format!("edit {k} (object '{name}')")), obj))
+}
+
+fn parse_edit(
+    at: &At,
+    obj: &Map<String, Value>,
+    model: ModelRef<'_>,
+) -> Result<ObjectEdit, SceneError> {
+    if obj.contains_key("insert_knot") || obj.contains_key("elevate_degree") {
+        return structural(at, obj, model);
+    }
+    Ok(match model {
+        ModelRef::Curve(_) => {
+            CurveEdit::Point(point_edit(at, obj, |v| index(at, "point", v))?).into_object()
+        }
+        ModelRef::Surface(_) => {
+            SurfaceEdit::Point(point_edit(at, obj, |v| pair(at, "point", v))?).into_object()
+        }
+        ModelRef::ErbsCurve(_) => {
+            ErbsCurveEdit::Local(local_edit(at, obj, |f, v| index(at, f, v))?).into_object()
+        }
+        ModelRef::ErbsSurface(_) => {
+            ErbsSurfaceEdit::Local(local_edit(at, obj, |f, v| pair(at, f, v))?).into_object()
+        }
+    })
+}
+
+/// `{"point": i, "delta": [..]}` or `{"point": i, "weight": w}`.
+fn point_edit<I>(
+    at: &At,
+    obj: &Map<String, Value>,
+    index: impl Fn(&Value) -> Result<I, SceneError>,
+) -> Result<PointEdit<I>, SceneError> {
+    if obj.contains_key("local") {
+        return Err(at.err("local", "only ERBS objects have local curves or patches"));
+    }
+    let point = index(require(at, obj, "point")?)?;
+    if obj.contains_key("weight") {
+        check_fields(at, obj, &["object", "point", "weight"])?;
+        let weight = as_f64(at, "weight", "weight", require(at, obj, "weight")?)?;
+        return Ok(PointEdit::Weight { point, weight });
+    }
+    check_fields(at, obj, &["object", "point", "delta"])?;
+    let delta = as_point(at, "delta", "delta", require(at, obj, "delta")?)?;
+    Ok(PointEdit::Move { point, delta })
+}
+
+/// `{"local": l, "transform": [[4×4]]}` or `{"local": l, "point": q, "delta": [..]}`.
+fn local_edit<I>(
+    at: &At,
+    obj: &Map<String, Value>,
+    index: impl Fn(&'static str, &Value) -> Result<I, SceneError>,
+) -> Result<LocalEdit<I, I>, SceneError> {
+    let Some(l) = obj.get("local") else {
+        let field = if obj.contains_key("transform") {
+            "transform"
+        } else {
+            "point"
+        };
+        return Err(at.err(
+            field,
+            "an ERBS object is edited through its local curves: give \"local\" (with \"transform\", or \"point\" and \"delta\")",
+        ));
+    };
+    let local = index("local", l)?;
+    if obj.contains_key("transform") {
+        check_fields(at, obj, &["object", "local", "transform"])?;
+        let matrix = affine(at, require(at, obj, "transform")?)?;
+        return Ok(LocalEdit::Transform { local, matrix });
+    }
+    check_fields(at, obj, &["object", "local", "point", "delta"])?;
+    let point = index("point", require(at, obj, "point")?)?;
+    let delta = as_point(at, "delta", "delta", require(at, obj, "delta")?)?;
+    Ok(LocalEdit::MovePoint {
+        local,
+        point,
+        delta,
+    })
+}
+
+/// `insert_knot` (with optional `times`) and `elevate_degree`, per kind.
+fn structural(
+    at: &At,
+    obj: &Map<String, Value>,
+    model: ModelRef<'_>,
+) -> Result<ObjectEdit, SceneError> {
+    let ty = model.type_name();
+    if let ModelRef::ErbsCurve(_) | ModelRef::ErbsSurface(_) = model {
+        let field = if obj.contains_key("insert_knot") {
+            "insert_knot"
+        } else {
+            "elevate_degree"
+        };
+        return Err(at.err(
+            field,
+            format!("an {ty} is refined by its own ERBS refinement, not by B-spline {field} (not supported yet)"),
+        ));
+    }
+    let surface = model.is_surface();
+    if let Some(v) = obj.get("insert_knot") {
+        check_fields(at, obj, &["object", "insert_knot", "times"])?;
+        let times = match obj.get("times") {
+            Some(t) => positive(at, "times", t)?,
+            None => 1,
+        };
+        if !surface {
+            let t = as_f64(at, "insert_knot", "parameter", v)?;
+            return Ok(CurveEdit::InsertKnot { t, times }.into_object());
+        }
+        let one = |key: &str| {
+            v.as_object()
+                .filter(|d| d.len() == 1)
+                .and_then(|d| d.get(key))
+        };
+        let (dir, t) = match (one("u"), one("v")) {
+            (Some(t), _) => (0, t),
+            (_, Some(t)) => (1, t),
             _ => {
                 return Err(at.err(
-                    "local",
-                    format!("a {ty} has no local curves or patches (only ERBS objects do)"),
+                    "insert_knot",
+                    format!("a surface takes {{\"u\": t}} or {{\"v\": t}}, found {v}"),
                 ));
             }
         };
-        let local = index(&at, "local", require(&at, obj, "local")?, erbs_dims)?;
-        check_local(&at, shape, local)?;
-        if has("transform") {
-            check_fields(&at, obj, &["object", "local", "transform"])?;
-            EditOp::TransformLocal {
-                local,
-                matrix: affine(&at, require(&at, obj, "transform")?)?,
-            }
-        } else {
-            check_fields(&at, obj, &["object", "local", "point", "delta"])?;
-            let point = index(&at, "point", require(&at, obj, "point")?, erbs_dims)?;
-            check_local_point(&at, shape, local, point)?;
-            let delta = as_point(&at, "delta", "delta", require(&at, obj, "delta")?)?;
-            EditOp::TranslateLocalPoint {
-                local,
-                point,
-                delta,
-            }
-        }
-    } else {
-        let dims = match shape {
-            Shape::BezierCurve(_) | Shape::BSplineCurve(_) => 1,
-            Shape::BezierSurface(_) | Shape::BSplineSurface(_) => 2,
-            Shape::ErbsCurve(_) | Shape::ErbsSurface(_) => {
-                return Err(at.err(
-                    if has("transform") { "transform" } else { "point" },
-                    format!("an {ty} is edited through its local curves: give \"local\" (with \"transform\", or \"point\" and \"delta\")"),
-                ));
-            }
-        };
-        let point = index(&at, "point", require(&at, obj, "point")?, dims)?;
-        check_point(&at, shape, point)?;
-        if has("weight") {
-            check_fields(&at, obj, &["object", "point", "weight"])?;
-            let w = as_f64(&at, "weight", "weight", require(&at, obj, "weight")?)?;
-            if w <= 0.0 {
-                return Err(at.err("weight", format!("weight {w} must be positive")));
-            }
-            EditOp::SetWeight { point, weight: w }
-        } else {
-            check_fields(&at, obj, &["object", "point", "delta"])?;
-            let delta = as_point(&at, "delta", "delta", require(&at, obj, "delta")?)?;
-            EditOp::TranslatePoint { point, delta }
-        }
+        let t = as_f64(at, "insert_knot", "parameter", t)?;
+        return Ok(SurfaceEdit::InsertKnot { dir, t, times }.into_object());
+    }
+    check_fields(at, obj, &["object", "elevate_degree"])?;
+    let v = require(at, obj, "elevate_degree")?;
+    if !surface {
+        let by = positive(at, "elevate_degree", v)?;
+        return Ok(CurveEdit::ElevateDegree { by }.into_object());
+    }
+    let dirs = as_object(at, "elevate_degree", v)?;
+    check_fields(
+        &At(format!("{}: field 'elevate_degree'", at.0)),
+        dirs,
+        &["u", "v"],
+    )?;
+    let by = |d: &str| {
+        dirs.get(d)
+            .map_or(Ok(0), |x| count(at, "elevate_degree", x))
     };
-    Ok(Edit { object, op })
+    Ok(SurfaceEdit::ElevateDegree {
+        by: [by("u")?, by("v")?],
+    }
+    .into_object())
 }
 
-/// `i` (dims = 1) or `[i, j]` (dims = 2).
-fn index(at: &At, field: &str, v: &Value, dims: usize) -> Result<Index2, SceneError> {
-    if dims == 1 {
-        return Ok(Index2::One(as_usize(at, field, "index", v)?));
+/// A non-negative integer.
+fn count(at: &At, field: &str, v: &Value) -> Result<usize, SceneError> {
+    match v.as_i64() {
+        Some(n) if n < 0 => Err(at.err(field, format!("{n} is negative"))),
+        _ => as_usize(at, field, field, v),
     }
+}
+
+/// A positive integer.
+fn positive(at: &At, field: &str, v: &Value) -> Result<usize, SceneError> {
+    match count(at, field, v)? {
+        0 => Err(at.err(field, "must be at least 1")),
+        n => Ok(n),
+    }
+}
+
+fn index(at: &At, field: &str, v: &Value) -> Result<usize, SceneError> {
+    if v.is_array() {
+        return Err(at.err(field, format!("expected an index for a curve, found {v}")));
+    }
+    as_usize(at, field, "index", v)
+}
+
+/// `[i, j]`.
+fn pair(at: &At, field: &str, v: &Value) -> Result<[usize; 2], SceneError> {
     match v.as_array() {
-        Some(a) if a.len() == 2 => Ok(Index2::Two(
+        Some(a) if a.len() == 2 => Ok([
             as_usize(at, field, "index", &a[0])?,
             as_usize(at, field, "index", &a[1])?,
-        )),
+        ]),
         _ => Err(at.err(field, format!("expected [i, j] for a surface, found {v}"))),
-    }
-}
-
-fn out_of_range(at: &At, field: &str, idx: Index2, bounds: Index2) -> SceneError {
-    let msg = match (idx, bounds) {
-        (Index2::One(i), Index2::One(n)) => format!(
-            "index {i} out of range (valid: 0..={})",
-            n.saturating_sub(1)
-        ),
-        (Index2::Two(i, j), Index2::Two(n, m)) => {
-            format!(
-                "index [{i}, {j}] out of range (valid: [0..={}, 0..={}])",
-                n.saturating_sub(1),
-                m.saturating_sub(1)
-            )
-        }
-        _ => "index has the wrong number of components".to_string(),
-    };
-    at.err(field, msg)
-}
-
-fn within(idx: Index2, bounds: Index2) -> bool {
-    match (idx, bounds) {
-        (Index2::One(i), Index2::One(n)) => i < n,
-        (Index2::Two(i, j), Index2::Two(n, m)) => i < n && j < m,
-        _ => false,
-    }
-}
-
-fn check_point(at: &At, shape: &Shape, p: Index2) -> Result<(), SceneError> {
-    let bounds = match shape {
-        Shape::BezierCurve(c) | Shape::BSplineCurve(c) => Index2::One(c.points().len()),
-        Shape::BezierSurface(s) | Shape::BSplineSurface(s) => {
-            Index2::Two(s.count()[0], s.count()[1])
-        }
-        _ => unreachable!("ERBS objects are rejected before"),
-    };
-    if within(p, bounds) {
-        Ok(())
-    } else {
-        Err(out_of_range(at, "point", p, bounds))
-    }
-}
-
-fn check_local(at: &At, shape: &Shape, l: Index2) -> Result<(), SceneError> {
-    let bounds = match shape {
-        Shape::ErbsCurve(c) => Index2::One(c.local_curves().len()),
-        Shape::ErbsSurface(s) => Index2::Two(s.count()[0], s.count()[1]),
-        _ => unreachable!("only ERBS objects get here"),
-    };
-    if within(l, bounds) {
-        Ok(())
-    } else {
-        Err(out_of_range(at, "local", l, bounds))
-    }
-}
-
-fn check_local_point(at: &At, shape: &Shape, l: Index2, p: Index2) -> Result<(), SceneError> {
-    let bounds = match (shape, l) {
-        (Shape::ErbsCurve(c), Index2::One(l)) => Index2::One(c.local_curves()[l].points().len()),
-        (Shape::ErbsSurface(s), Index2::Two(k, l)) => {
-            let c = s.local_patch(k, l).count();
-            Index2::Two(c[0], c[1])
-        }
-        _ => unreachable!("validated by check_local"),
-    };
-    if within(p, bounds) {
-        Ok(())
-    } else {
-        Err(out_of_range(at, "point", p, bounds))
     }
 }
 
@@ -333,98 +265,11 @@ fn affine(at: &At, v: &Value) -> Result<DMat4, SceneError> {
         }
         m[r].copy_from_slice(&vals);
     }
-    if m[3] != [0.0, 0.0, 0.0, 1.0] {
-        return Err(at.err(
-            "transform",
-            format!(
-                "not affine: the last row must be [0, 0, 0, 1], found {:?}",
-                m[3]
-            ),
-        ));
-    }
     Ok(DMat4::from_cols_array_2d(&m).transpose())
 }
 
-/// Applies validated edits to the scene model in order.
-pub fn apply_all(scene: &mut Scene, edits: &[Edit]) {
-    for e in edits {
-        e.op.apply_to(&mut scene.objects[e.object].shape);
+impl From<EditError> for SceneError {
+    fn from(e: EditError) -> Self {
+        SceneError(e.to_string())
     }
-}
-
-/// What an edit acts on, for merging: ops on different targets commute.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Target {
-    Point(usize, Index2),
-    Weight(usize, Index2),
-    Local(usize, Index2),
-}
-
-fn target(e: &Edit) -> Target {
-    match &e.op {
-        EditOp::TranslatePoint { point, .. } | EditOp::SetPoint { point, .. } => {
-            Target::Point(e.object, *point)
-        }
-        EditOp::SetWeight { point, .. } => Target::Weight(e.object, *point),
-        EditOp::TransformLocal { local, .. }
-        | EditOp::TranslateLocalPoint { local, .. }
-        | EditOp::SetLocalPoints { local, .. } => Target::Local(e.object, *local),
-    }
-}
-
-/// Merges the edits of one frame so each touched control point or local patch is updated once:
-/// consecutive translations of a point add up, consecutive transforms of a local curve compose
-/// (A2·A1), consecutive moves of one local control point add up, and the last weight of a point
-/// wins. Edits on different targets commute (a point's position and its weight are independent,
-/// as are distinct local curves), so targets are applied in first-touch order; edits on one
-/// target keep their order.
-pub fn merge_edits(edits: &[Edit]) -> Vec<Edit> {
-    let mut groups: Vec<(Target, Vec<Edit>)> = Vec::new();
-    for e in edits {
-        let key = target(e);
-        let group = match groups.iter_mut().find(|(k, _)| *k == key) {
-            Some((_, g)) => g,
-            None => {
-                groups.push((key, Vec::new()));
-                &mut groups.last_mut().expect("just pushed").1
-            }
-        };
-        let merged = match (group.last().map(|x| &x.op), &e.op) {
-            (
-                Some(EditOp::TranslatePoint { point, delta: a }),
-                EditOp::TranslatePoint { delta: b, .. },
-            ) => Some(EditOp::TranslatePoint {
-                point: *point,
-                delta: *a + *b,
-            }),
-            (Some(EditOp::SetWeight { .. }), EditOp::SetWeight { .. }) => Some(e.op.clone()),
-            (
-                Some(EditOp::TransformLocal { local, matrix: a }),
-                EditOp::TransformLocal { matrix: b, .. },
-            ) => Some(EditOp::TransformLocal {
-                local: *local,
-                matrix: *b * *a,
-            }),
-            (
-                Some(EditOp::TranslateLocalPoint {
-                    local,
-                    point: p,
-                    delta: a,
-                }),
-                EditOp::TranslateLocalPoint {
-                    point: q, delta: b, ..
-                },
-            ) if p == q => Some(EditOp::TranslateLocalPoint {
-                local: *local,
-                point: *p,
-                delta: *a + *b,
-            }),
-            _ => None,
-        };
-        match merged {
-            Some(op) => group.last_mut().expect("merged with the last edit").op = op,
-            None => group.push(e.clone()),
-        }
-    }
-    groups.into_iter().flat_map(|(_, g)| g).collect()
 }

@@ -1,13 +1,13 @@
 //! Scene file → [`Scene`], validating everything with one-line errors.
 
 use super::json::*;
-use super::{
-    MAX_CURVE_SAMPLES, MAX_DEGREE, MAX_SURFACE_SAMPLES, Samples, Scene, SceneError, SceneObject,
-    Shape,
-};
+use super::{MAX_CURVE_SAMPLES, MAX_DEGREE, MAX_SURFACE_SAMPLES, Scene, SceneError, SceneObject};
 use crate::geom::{
     BFunctionKind, BSplineCurve, BezierCurve, ErbsCurve, ErbsSurface, GeomError, KnotVector,
     TensorSurface,
+};
+use crate::model::{
+    CurveModel, EditError, ErbsCurveModel, ErbsSurfaceModel, Model, SplineForm, SurfaceModel,
 };
 use glam::DVec3;
 use serde_json::{Map, Value};
@@ -55,7 +55,7 @@ fn parse_object(i: usize, v: &Value) -> Result<SceneObject, SceneError> {
     }
     let at = At(format!("object '{name}' (objects[{i}])"));
     let ty = as_str(&at, "type", require(&at, obj, "type")?)?;
-    let (shape, samples) = match ty {
+    let model = match ty {
         "bezier_curve" => {
             check_fields(&at, obj, &fields(&["points", "weights"]))?;
             let points = as_points(&at, "points", require(&at, obj, "points")?)?;
@@ -66,7 +66,7 @@ fn parse_object(i: usize, v: &Value) -> Result<SceneObject, SceneError> {
             let knots = KnotVector::bezier(points.len() - 1, 0.0, 1.0).into_vec();
             let c = BSplineCurve::new(points.len() - 1, knots, points, weights)
                 .map_err(|e| geom(&at, e))?;
-            (Shape::BezierCurve(c), curve_samples(&at, obj)?)
+            curve(&at, SplineForm::Bezier, c, curve_samples(&at, obj)?)?
         }
         "bspline_curve" => {
             check_fields(&at, obj, &fields(&["degree", "knots", "points", "weights"]))?;
@@ -78,7 +78,7 @@ fn parse_object(i: usize, v: &Value) -> Result<SceneObject, SceneError> {
                 .map(|w| as_f64_list(&at, "weights", "weight", w))
                 .transpose()?;
             let c = BSplineCurve::new(degree, knots, points, weights).map_err(|e| geom(&at, e))?;
-            (Shape::BSplineCurve(c), curve_samples(&at, obj)?)
+            curve(&at, SplineForm::BSpline, c, curve_samples(&at, obj)?)?
         }
         "erbs_curve" => {
             check_fields(&at, obj, &fields(&["knots", "local", "bfunction"]))?;
@@ -91,7 +91,8 @@ fn parse_object(i: usize, v: &Value) -> Result<SceneObject, SceneError> {
                 .collect::<Result<Vec<_>, _>>()?;
             let bf = bfunction(&at, obj)?;
             let c = ErbsCurve::new(knots, curves, bf).map_err(|e| geom(&at, e))?;
-            (Shape::ErbsCurve(c), curve_samples(&at, obj)?)
+            let m = ErbsCurveModel::new(c, curve_samples(&at, obj)?);
+            Model::ErbsCurve(m.map_err(|e| edit(&at, e))?)
         }
         "bezier_surface" => {
             check_fields(&at, obj, &fields(&["points", "weights"]))?;
@@ -99,7 +100,7 @@ fn parse_object(i: usize, v: &Value) -> Result<SceneObject, SceneError> {
             check_degree(&at, "points", count[0].max(count[1]) - 1)?;
             let weights = weight_grid(&at, obj, count)?;
             let s = TensorSurface::bezier(count, points, weights).map_err(|e| geom(&at, e))?;
-            (Shape::BezierSurface(s), surface_samples(&at, obj)?)
+            surface(&at, SplineForm::Bezier, s, surface_samples(&at, obj)?)?
         }
         "bspline_surface" => {
             check_fields(&at, obj, &fields(&["degree", "knots", "points", "weights"]))?;
@@ -120,7 +121,7 @@ fn parse_object(i: usize, v: &Value) -> Result<SceneObject, SceneError> {
             let weights = weight_grid(&at, obj, count)?;
             let s = TensorSurface::bspline(degree, knots, count, points, weights)
                 .map_err(|e| geom(&at, e))?;
-            (Shape::BSplineSurface(s), surface_samples(&at, obj)?)
+            surface(&at, SplineForm::BSpline, s, surface_samples(&at, obj)?)?
         }
         "erbs_surface" => {
             check_fields(&at, obj, &fields(&["knots", "local", "bfunction"]))?;
@@ -130,7 +131,8 @@ fn parse_object(i: usize, v: &Value) -> Result<SceneObject, SceneError> {
             })?;
             let bf = bfunction(&at, obj)?;
             let s = ErbsSurface::new(knots, count, patches, bf).map_err(|e| geom(&at, e))?;
-            (Shape::ErbsSurface(s), surface_samples(&at, obj)?)
+            let m = ErbsSurfaceModel::new(s, surface_samples(&at, obj)?);
+            Model::ErbsSurface(m.map_err(|e| edit(&at, e))?)
         }
         other => {
             return Err(at.err(
@@ -144,10 +146,30 @@ fn parse_object(i: usize, v: &Value) -> Result<SceneObject, SceneError> {
     let color = opt(obj, "color").map(|c| parse_color(&at, c)).transpose()?;
     Ok(SceneObject {
         name: name.to_string(),
-        shape,
-        samples,
+        model,
         color,
     })
+}
+
+fn curve(at: &At, form: SplineForm, c: BSplineCurve, m: usize) -> Result<Model, SceneError> {
+    Ok(Model::Curve(
+        CurveModel::new(form, c, m).map_err(|e| edit(at, e))?,
+    ))
+}
+
+fn surface(
+    at: &At,
+    form: SplineForm,
+    s: TensorSurface,
+    m: [usize; 2],
+) -> Result<Model, SceneError> {
+    Ok(Model::Surface(
+        SurfaceModel::new(form, s, m).map_err(|e| edit(at, e))?,
+    ))
+}
+
+fn edit(at: &At, e: EditError) -> SceneError {
+    at.err(e.field, e.message)
 }
 
 /// The common fields plus the type's own.
@@ -191,13 +213,13 @@ fn check_degree(at: &At, field: &str, degree: usize) -> Result<(), SceneError> {
     Ok(())
 }
 
-fn curve_samples(at: &At, obj: &Map<String, Value>) -> Result<Samples, SceneError> {
+fn curve_samples(at: &At, obj: &Map<String, Value>) -> Result<usize, SceneError> {
     let m = as_usize(at, "samples", "samples", require(at, obj, "samples")?)?;
     check_count(at, m, MAX_CURVE_SAMPLES)?;
-    Ok(Samples::Curve(m))
+    Ok(m)
 }
 
-fn surface_samples(at: &At, obj: &Map<String, Value>) -> Result<Samples, SceneError> {
+fn surface_samples(at: &At, obj: &Map<String, Value>) -> Result<[usize; 2], SceneError> {
     let v = require(at, obj, "samples")?;
     let a = v
         .as_array()
@@ -213,7 +235,7 @@ fn surface_samples(at: &At, obj: &Map<String, Value>) -> Result<Samples, SceneEr
             format!("{mu} × {mv} samples exceed the limit of {MAX_SURFACE_SAMPLES}"),
         ));
     }
-    Ok(Samples::Surface([mu, mv]))
+    Ok([mu, mv])
 }
 
 fn check_count(at: &At, m: usize, max: usize) -> Result<(), SceneError> {

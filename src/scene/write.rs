@@ -1,8 +1,9 @@
 //! [`Scene`] → scene file text. Numbers are written in Rust's shortest round-trip form, so
 //! loading a saved scene reproduces every control value bit for bit.
 
-use super::{Samples, Scene, SceneObject, Shape};
+use super::{Scene, SceneObject};
 use crate::geom::{BFunctionKind, TensorSurface};
+use crate::model::{Model, SplineForm};
 use glam::DVec3;
 use std::fmt::Write;
 
@@ -27,16 +28,18 @@ fn write_object(s: &mut String, o: &SceneObject) {
         s,
         "{{\"name\": {}, \"type\": \"{}\"",
         json_string(&o.name),
-        o.shape.type_name()
+        o.model.type_name()
     );
-    match &o.shape {
-        Shape::BezierCurve(c) => {
+    match &o.model {
+        Model::Curve(m) if m.form() == SplineForm::Bezier => {
+            let c = m.curve();
             field(s, "points", &points(c.points()));
             if let Some(w) = c.weights() {
                 field(s, "weights", &numbers(w));
             }
         }
-        Shape::BSplineCurve(c) => {
+        Model::Curve(m) => {
+            let c = m.curve();
             field(s, "degree", &c.degree().to_string());
             field(s, "knots", &numbers(c.knots()));
             field(s, "points", &points(c.points()));
@@ -44,7 +47,8 @@ fn write_object(s: &mut String, o: &SceneObject) {
                 field(s, "weights", &numbers(w));
             }
         }
-        Shape::ErbsCurve(c) => {
+        Model::ErbsCurve(m) => {
+            let c = m.curve();
             field(s, "knots", &numbers(c.knots()));
             let local: Vec<String> = c
                 .local_curves()
@@ -54,11 +58,13 @@ fn write_object(s: &mut String, o: &SceneObject) {
             field(s, "local", &format!("[{}]", local.join(", ")));
             bfunction(s, c.bfunction());
         }
-        Shape::BezierSurface(p) => {
+        Model::Surface(m) if m.form() == SplineForm::Bezier => {
+            let p = m.surface();
             field(s, "points", &point_grid(p));
             weights(s, p);
         }
-        Shape::BSplineSurface(p) => {
+        Model::Surface(m) => {
+            let p = m.surface();
             let [du, dv] = p.degree();
             field(s, "degree", &format!("[{du}, {dv}]"));
             let [ku, kv] = p.knots();
@@ -66,7 +72,8 @@ fn write_object(s: &mut String, o: &SceneObject) {
             field(s, "points", &point_grid(p));
             weights(s, p);
         }
-        Shape::ErbsSurface(e) => {
+        Model::ErbsSurface(m) => {
+            let e = m.surface();
             let [ku, kv] = e.knots();
             field(s, "knots", &format!("[{}, {}]", numbers(ku), numbers(kv)));
             let [nu, nv] = e.count();
@@ -82,9 +89,9 @@ fn write_object(s: &mut String, o: &SceneObject) {
             bfunction(s, e.bfunction());
         }
     }
-    match o.samples {
-        Samples::Curve(m) => field(s, "samples", &m.to_string()),
-        Samples::Surface([mu, mv]) => field(s, "samples", &format!("[{mu}, {mv}]")),
+    match o.model.sample_dims() {
+        [m, _] if !o.model.is_surface() => field(s, "samples", &m.to_string()),
+        [mu, mv] => field(s, "samples", &format!("[{mu}, {mv}]")),
     }
     if let Some(c) = o.color {
         field(s, "color", &numbers(&c));

@@ -36,6 +36,14 @@ pub const KEY_HELP: &[(&str, &str)] = &[
         "axis constraint, typed value (distance, degrees, factor), confirm",
     ),
     ("  Esc / right click", "cancel the transform"),
+    (
+        "I",
+        "insert a knot at the cursor on the selected curve or surface (U/V direction)",
+    ),
+    (
+        "E / Shift+E",
+        "elevate the degree of the selected curve or surface (in u / in v)",
+    ),
     ("Ctrl+Z / Ctrl+Shift+Z (Ctrl+Y)", "undo / redo"),
     ("Ctrl+S", "save the scene file"),
     ("F / A / Home", "frame selection / frame all / reset camera"),

@@ -7,6 +7,7 @@ pub mod autosave;
 pub mod hud;
 pub mod input;
 pub mod picking;
+pub mod refine;
 pub mod scenario;
 pub mod script;
 pub mod session;

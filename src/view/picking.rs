@@ -71,7 +71,7 @@ pub fn pick(candidates: &[Projected], cursor: (f64, f64), radius: f64) -> Option
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::Index2;
+    use crate::model::Index2;
 
     fn handle(k: usize) -> Handle {
         Handle::Point {

@@ -4,9 +4,8 @@
 use super::input::{InputEvent, Key, MouseButton};
 use super::script::Action;
 use super::session::Session;
+use crate::model::{Index2, ModelRef};
 use crate::render::Handle;
-use crate::sampling::ModelRef;
-use crate::scene::Index2;
 use std::f64::consts::TAU;
 
 /// What the scripted user does.
@@ -202,7 +201,7 @@ fn drag_target(session: &Session) -> Option<Handle> {
     let handles = doc.handles(best);
     match doc.objects[best].sampled.model() {
         ModelRef::Surface(s) => {
-            let [nu, nv] = s.count();
+            let [nu, nv] = s.surface().count();
             Some(Handle::Point {
                 object: best,
                 point: Index2::Two(nu / 2, nv / 2),
@@ -218,6 +217,7 @@ fn erbs_target(session: &Session) -> Option<Handle> {
     for (object, o) in doc.objects.iter().enumerate() {
         match o.sampled.model() {
             ModelRef::ErbsSurface(s) => {
+                let s = s.surface();
                 let [nu, nv] = s.count();
                 let (k, l) = (nu / 2, nv / 2);
                 let [a, b] = s.local_patch(k, l).count();
@@ -228,6 +228,7 @@ fn erbs_target(session: &Session) -> Option<Handle> {
                 });
             }
             ModelRef::ErbsCurve(c) => {
+                let c = c.curve();
                 let l = c.local_curves().len() / 2;
                 let q = c.local_curves()[l].points().len() / 2;
                 return Some(Handle::LocalPoint {

@@ -17,8 +17,8 @@
 //! keep working when the window size or framing changes.
 
 use super::input::{InputEvent, Key, Modifiers, MouseButton};
+use crate::model::Index2;
 use crate::render::{Document, Handle};
-use crate::scene::Index2;
 use serde_json::Value;
 use std::path::PathBuf;
 

@@ -7,17 +7,21 @@ use super::autosave::Autosave;
 use super::hud::Hud;
 use super::input::{InputEvent, Key, Modifiers, MouseButton};
 use super::picking::{PICK_RADIUS, Projected, pick, project_all};
+use super::refine::Refine;
 use super::script::Action;
 use super::tools::{Axis, Drag, Transform, TransformKind, View};
-use super::undo::{UndoStack, local_points};
+use super::undo::UndoStack;
 use crate::gpu::{Frame, GpuResult, Renderer};
+use crate::model::{
+    CurveEdit, Edit, ErbsCurveEdit, ErbsSurfaceEdit, Index2, KindEdit, LocalEdit, ModelRef,
+    SurfaceEdit, merge_edits,
+};
 use crate::render::overlays::overlay_lines;
 use crate::render::{
     Bounds, Document, GpuScene, Handle, Highlight, NetMode, OrbitCamera, Palette, UploadStats,
     ViewOptions, Wire,
 };
-use crate::scene::edit::merge_edits;
-use crate::scene::{Edit, EditOp, Index2, Scene};
+use crate::scene::Scene;
 use glam::{DMat4, DVec3};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -32,10 +36,20 @@ enum Target {
 #[derive(Debug, Clone)]
 enum Mode {
     Idle,
-    Orbit { moved: bool },
+    Orbit {
+        moved: bool,
+    },
     Pan,
-    Drag { handle: Handle, drag: Drag },
-    Transform { target: Target, t: Box<Transform> },
+    Drag {
+        handle: Handle,
+        drag: Drag,
+    },
+    Transform {
+        target: Target,
+        t: Box<Transform>,
+    },
+    /// Aiming a knot insertion (I).
+    Refine(Refine),
 }
 
 /// Cost of applying one frame's edits.
@@ -241,10 +255,19 @@ impl Session {
         self.view().project(world)
     }
 
-    /// Queues an edit for this frame, recording it for undo.
+    /// Queues an edit for this frame, recording it for undo. A structural edit is applied at
+    /// once, after what was queued before it: undo must capture the model each edit sees, and
+    /// the edits after a refinement address the refined net.
     pub fn queue(&mut self, edit: Edit) {
+        let structural = edit.edit.is_structural();
+        if structural {
+            self.apply_pending();
+        }
         self.undo.record(&self.doc, &edit);
         self.pending.push(edit);
+        if structural {
+            self.apply_pending();
+        }
     }
 
     /// Applies this frame's queued edits (merged per control point) through the delta path and
@@ -265,7 +288,14 @@ impl Session {
         let mut samples = 0;
         let mut edited = Vec::new();
         for e in &edits {
-            let region = self.doc.apply(e);
+            let region = match self.doc.apply(e) {
+                Ok(r) => r,
+                Err(err) => {
+                    let name = &self.doc.objects[e.object].name;
+                    self.set_status(format!("{name}: edit refused: {err}"));
+                    continue;
+                }
+            };
             if self.naive {
                 if !edited.contains(&e.object) {
                     edited.push(e.object);
@@ -366,6 +396,13 @@ impl Session {
         }
         let status = match &self.mode {
             Mode::Transform { t, .. } => t.describe(),
+            Mode::Refine(r) => {
+                let preview = r.preview(&self.doc, self.bounds.radius());
+                if !preview.is_empty() {
+                    frame.draw_lines3d(&preview)?;
+                }
+                r.describe(&self.doc)
+            }
             _ => self.status.clone(),
         };
         if hud {
@@ -428,8 +465,10 @@ impl Session {
                 self.mode = Mode::Pan;
             }
             Mode::Drag { handle, mut drag } => {
-                if let Some(inc) = drag.update(&self.view(), self.cursor) {
-                    self.queue(Document::move_handle(handle, inc));
+                if let Some(inc) = drag.update(&self.view(), self.cursor)
+                    && let Some(edit) = self.doc.move_handle(handle, inc)
+                {
+                    self.queue(edit);
                 }
                 self.mode = Mode::Drag { handle, drag };
             }
@@ -437,6 +476,10 @@ impl Session {
                 t.set_cursor(self.cursor);
                 self.mode = Mode::Transform { target, t };
                 self.update_transform();
+            }
+            Mode::Refine(mut r) => {
+                r.aim(&self.doc, &self.view(), self.cursor);
+                self.mode = Mode::Refine(r);
             }
         }
     }
@@ -455,6 +498,15 @@ impl Session {
                 return;
             }
             (m @ Mode::Transform { .. }, _, _) => m,
+            (Mode::Refine(r), MouseButton::Left, true) => {
+                self.insert_knot(&r);
+                Mode::Idle
+            }
+            (Mode::Refine(_), MouseButton::Right, true) => {
+                self.set_status("knot insertion cancelled");
+                Mode::Idle
+            }
+            (m @ Mode::Refine(_), _, _) => m,
             (Mode::Idle, MouseButton::Left, true) if !self.mods.shift => {
                 let cursor = self.cursor;
                 match pick(self.projected(), cursor, PICK_RADIUS) {
@@ -566,6 +618,9 @@ impl Session {
         if let Mode::Transform { .. } = self.mode {
             return self.transform_key(key);
         }
+        if let Mode::Refine(_) = self.mode {
+            return self.refine_key(key);
+        }
         match (key, ctrl) {
             (Key::Char('z'), true) if self.mods.shift => self.redo(),
             (Key::Char('z'), true) => self.undo(),
@@ -592,6 +647,8 @@ impl Session {
                     *drag = fresh;
                 }
             }
+            (Key::Char('i'), false) => self.start_refine(),
+            (Key::Char('e'), false) => self.elevate(),
             (Key::Char('g'), false) => self.start_transform(TransformKind::Grab),
             (Key::Char('r'), false) => self.start_transform(TransformKind::Rotate),
             (Key::Char('s'), false) => self.start_transform(TransformKind::Scale),
@@ -632,6 +689,108 @@ impl Session {
             }
             _ => {}
         }
+    }
+
+    /// The object the refinement tools act on: the selected one, else the one under the cursor.
+    fn focused_object(&self) -> Option<usize> {
+        self.selected
+            .map(|h| h.object())
+            .or(self.selected_local.map(|(o, _)| o))
+            .or(self.hovered_object)
+    }
+
+    fn start_refine(&mut self) {
+        let Some(object) = self.focused_object() else {
+            return self.set_status("select a curve or surface first (click one of its points)");
+        };
+        let mut r = Refine::new(object);
+        r.aim(&self.doc, &self.view(), self.cursor);
+        self.mode = Mode::Refine(r);
+    }
+
+    fn refine_key(&mut self, key: Key) {
+        let Mode::Refine(r) = &mut self.mode else {
+            return;
+        };
+        match key {
+            Key::Char(c @ ('u' | 'v')) => {
+                r.dir = usize::from(c == 'v')
+                    * usize::from(self.doc.objects[r.object].sampled.model().is_surface());
+                let mut r = r.clone();
+                r.aim(&self.doc, &self.view(), self.cursor);
+                self.mode = Mode::Refine(r);
+            }
+            Key::Enter => {
+                let r = r.clone();
+                self.mode = Mode::Idle;
+                self.insert_knot(&r);
+            }
+            Key::Escape => {
+                self.mode = Mode::Idle;
+                self.set_status("knot insertion cancelled");
+            }
+            _ => {}
+        }
+    }
+
+    fn insert_knot(&mut self, r: &Refine) {
+        match r.edit(&self.doc) {
+            Ok(edit) => {
+                let what = r.describe(&self.doc);
+                self.structural("insert knot", edit);
+                let at = what
+                    .split(" (")
+                    .next()
+                    .unwrap_or(&what)
+                    .replace("insert knot in", "inserted a knot in");
+                self.set_status(format!("{at} (Ctrl+Z undoes)"));
+            }
+            Err(e) => self.set_status(format!("cannot insert a knot: {e}")),
+        }
+    }
+
+    /// Degree elevation of the focused curve or surface by one (surfaces: in u, with Shift in v).
+    fn elevate(&mut self) {
+        let Some(object) = self.focused_object() else {
+            return self.set_status("select a curve or surface first (click one of its points)");
+        };
+        let model = self.doc.objects[object].sampled.model();
+        let dir = usize::from(self.mods.shift);
+        let edit = match model {
+            ModelRef::Curve(_) => CurveEdit::ElevateDegree { by: 1 }.into_object(),
+            ModelRef::Surface(_) => {
+                let mut by = [0, 0];
+                by[dir] = 1;
+                SurfaceEdit::ElevateDegree { by }.into_object()
+            }
+            _ => return self.set_status("ERBS objects are not refined by degree elevation"),
+        };
+        if let Err(e) = edit.validate(model) {
+            return self.set_status(format!("cannot elevate the degree: {e}"));
+        }
+        let name = self.doc.objects[object].name.clone();
+        self.structural("elevate degree", Edit { object, edit });
+        let degree = match self.doc.objects[object].sampled.model() {
+            ModelRef::Curve(m) => m.curve().degree().to_string(),
+            ModelRef::Surface(m) => format!("{:?}", m.surface().degree()),
+            _ => String::new(),
+        };
+        self.set_status(format!("{name}: degree {degree} (Ctrl+Z undoes)"));
+    }
+
+    /// Applies a structural edit as one undo step. Control point indices of that object change,
+    /// so its selection and the projected handles are dropped.
+    fn structural(&mut self, label: &str, edit: Edit) {
+        let object = edit.object;
+        self.undo.begin(label);
+        self.queue(edit);
+        self.undo.end();
+        if self.selected.is_some_and(|h| h.object() == object) {
+            self.selected = None;
+        }
+        self.hovered = None;
+        self.projected = None;
+        self.refresh_bounds();
     }
 
     fn transform_key(&mut self, key: Key) {
@@ -676,12 +835,14 @@ impl Session {
                 .into_iter()
                 .find(|(x, _)| *x == h)
                 .map(|(_, p)| p),
-            Target::Local(o, l) => local_points(self.doc.objects[o].sampled.model(), l)
+            Target::Local(o, l) => self
+                .doc
+                .local_points(o, l)
                 .map(|p| p.iter().sum::<DVec3>() / p.len() as f64),
         };
         let Some(pivot) = pivot else { return };
         self.transform_origin = match target {
-            Target::Local(o, l) => local_points(self.doc.objects[o].sampled.model(), l),
+            Target::Local(o, l) => self.doc.local_points(o, l),
             Target::Point(_) => None,
         }
         .unwrap_or_default();
@@ -713,27 +874,22 @@ impl Session {
         let inc = total * t.applied.inverse();
         t.applied = total;
         let edit = match *target {
-            Target::Local(object, local) if exact => Edit {
+            Target::Local(object, local) if exact => set_local_points(
+                &self.doc,
                 object,
-                op: EditOp::SetLocalPoints {
-                    local,
-                    points: self
-                        .transform_origin
-                        .iter()
-                        .map(|&p| total.transform_point3(p))
-                        .collect(),
-                },
-            },
-            Target::Local(object, local) => Edit {
-                object,
-                op: EditOp::TransformLocal { local, matrix: inc },
-            },
-            Target::Point(h) => {
-                // A point only translates: the increment's translation part.
-                Document::move_handle(h, inc.w_axis.truncate())
-            }
+                local,
+                self.transform_origin
+                    .iter()
+                    .map(|&p| total.transform_point3(p))
+                    .collect(),
+            ),
+            Target::Local(object, local) => self.doc.transform_local(object, local, inc),
+            // A point only translates: the increment's translation part.
+            Target::Point(h) => self.doc.move_handle(h, inc.w_axis.truncate()),
         };
-        self.queue(edit);
+        if let Some(edit) = edit {
+            self.queue(edit);
+        }
     }
 
     fn confirm_transform(&mut self) {
@@ -775,11 +931,11 @@ impl Session {
         }
     }
 
-    /// Writes the scene (exact control data) to the save path.
+    /// Writes the scene (exact control data) to the save path, as OBJ when it ends in `.obj`.
     pub fn save(&mut self) {
         self.apply_pending();
         let scene = self.doc.to_scene();
-        match scene.save(&self.save_path) {
+        match crate::scene::obj::save_scene_file(&scene, &self.save_path) {
             Ok(()) => {
                 if let Some(a) = self.autosave.as_mut() {
                     a.saved();
@@ -793,6 +949,19 @@ impl Session {
     fn refresh_bounds(&mut self) {
         self.bounds = self.doc.bounds();
         self.projected = None;
+        // An undone or redone refinement changes control point indices.
+        let exists =
+            |doc: &Document, h: Handle| doc.handles(h.object()).iter().any(|(x, _)| *x == h);
+        if self.selected.is_some_and(|h| !exists(&self.doc, h)) {
+            self.selected = None;
+        }
+        if self
+            .selected_local
+            .is_some_and(|(o, l)| self.doc.local_points(o, l).is_none())
+        {
+            self.selected_local = None;
+        }
+        self.hovered = None;
     }
 
     fn refresh_bounds_later(&mut self) {
@@ -809,9 +978,7 @@ impl Session {
 
     fn frame_selection(&mut self) {
         let points: Vec<DVec3> = match (self.selected_local, self.selected) {
-            (Some((o, l)), _) => {
-                local_points(self.doc.objects[o].sampled.model(), l).unwrap_or_default()
-            }
+            (Some((o, l)), _) => self.doc.local_points(o, l).unwrap_or_default(),
             (None, Some(h)) => self
                 .doc
                 .handles(h.object())
@@ -842,4 +1009,27 @@ fn index_text(i: Index2) -> String {
         Index2::One(k) => k.to_string(),
         Index2::Two(a, b) => format!("[{a}, {b}]"),
     }
+}
+
+/// The edit that sets every control point of an ERBS local curve or patch exactly.
+fn set_local_points(
+    doc: &Document,
+    object: usize,
+    local: Index2,
+    points: Vec<DVec3>,
+) -> Option<Edit> {
+    let edit = match (doc.objects.get(object)?.sampled.model(), local) {
+        (ModelRef::ErbsCurve(_), Index2::One(l)) => {
+            ErbsCurveEdit::Local(LocalEdit::SetPoints { local: l, points }).into_object()
+        }
+        (ModelRef::ErbsSurface(_), Index2::Two(k, l)) => {
+            ErbsSurfaceEdit::Local(LocalEdit::SetPoints {
+                local: [k, l],
+                points,
+            })
+            .into_object()
+        }
+        _ => return None,
+    };
+    Some(Edit { object, edit })
 }

@@ -5,9 +5,8 @@
 //! target it touched, the exact value before the step (undo sets them back, so undo is
 //! bit-exact too — inverse matrices would leave rounding behind).
 
+use crate::model::{Edit, Target};
 use crate::render::Document;
-use crate::sampling::ModelRef;
-use crate::scene::{Edit, EditOp, Index2};
 
 #[derive(Debug, Clone, Default)]
 pub struct UndoStep {
@@ -37,20 +36,25 @@ impl UndoStack {
         self.open.is_some()
     }
 
-    /// Records `edit` before it is applied: captures the exact prior value of its target the
-    /// first time the step touches it. Edits outside an open step form a step of their own.
+    /// Records `edit` just before it is applied to `doc`: keeps the exact prior state of its
+    /// target the first time the step touches it (every structural edit keeps the whole prior
+    /// model). Edits outside an open step form a step of their own.
     pub fn record(&mut self, doc: &Document, edit: &Edit) {
         let single = self.open.is_none();
         if single {
             self.begin("edit");
         }
-        let step = self.open.as_mut().expect("a step is open");
-        if let Some(restore) = capture(doc, edit) {
-            let same_target =
-                |e: &Edit| e.object == restore.object && target(&e.op) == target(&restore.op);
-            if !step.restore.iter().any(same_target) {
-                step.restore.push(restore);
-            }
+        let step = self.open.get_or_insert_with(UndoStep::default);
+        let target = edit.edit.target();
+        let known = target != Target::Structure && restored(&step.restore, edit.object, target);
+        if !known
+            && let Some(o) = doc.objects.get(edit.object)
+            && let Ok(inverse) = edit.edit.inverse(o.sampled.model())
+        {
+            step.restore.push(Edit {
+                object: edit.object,
+                edit: inverse,
+            });
         }
         step.forward.push(edit.clone());
         if single {
@@ -96,84 +100,18 @@ impl UndoStack {
     }
 }
 
-#[derive(Debug, PartialEq, Eq)]
-enum Target {
-    Point(Index2),
-    Weight(Index2),
-    Local(Index2),
-}
-
-fn target(op: &EditOp) -> Target {
-    match op {
-        EditOp::TranslatePoint { point, .. } | EditOp::SetPoint { point, .. } => {
-            Target::Point(*point)
+/// Whether `restores` (a step's restore edits in the order recorded) already puts `key`'s target
+/// back: a restore of the same target after the object's last structural restore. Indices
+/// before a structural edit address another net, so the search stops there.
+fn restored(restores: &[Edit], object: usize, target: Target) -> bool {
+    for r in restores.iter().rev().filter(|r| r.object == object) {
+        let t = r.edit.target();
+        if t == Target::Structure {
+            return false;
         }
-        EditOp::SetWeight { point, .. } => Target::Weight(*point),
-        EditOp::TransformLocal { local, .. }
-        | EditOp::TranslateLocalPoint { local, .. }
-        | EditOp::SetLocalPoints { local, .. } => Target::Local(*local),
+        if t == target {
+            return true;
+        }
     }
-}
-
-/// The edit that sets `edit`'s target back to its current value.
-fn capture(doc: &Document, edit: &Edit) -> Option<Edit> {
-    let model = doc.objects.get(edit.object)?.sampled.model();
-    let object = edit.object;
-    let op = match (&edit.op, model) {
-        (EditOp::TranslatePoint { point, .. } | EditOp::SetPoint { point, .. }, m) => {
-            EditOp::SetPoint {
-                point: *point,
-                position: point_of(m, *point)?,
-            }
-        }
-        (EditOp::SetWeight { point, .. }, ModelRef::Curve(c)) => {
-            let Index2::One(k) = point else { return None };
-            EditOp::SetWeight {
-                point: *point,
-                weight: c.weights().map_or(1.0, |w| w[*k]),
-            }
-        }
-        (EditOp::SetWeight { point, .. }, ModelRef::Surface(s)) => {
-            let Index2::Two(i, j) = point else {
-                return None;
-            };
-            let nv = s.count()[1];
-            EditOp::SetWeight {
-                point: *point,
-                weight: s.weights().map_or(1.0, |w| w[i * nv + j]),
-            }
-        }
-        (
-            EditOp::TransformLocal { local, .. }
-            | EditOp::TranslateLocalPoint { local, .. }
-            | EditOp::SetLocalPoints { local, .. },
-            m,
-        ) => EditOp::SetLocalPoints {
-            local: *local,
-            points: local_points(m, *local)?,
-        },
-        _ => return None,
-    };
-    Some(Edit { object, op })
-}
-
-fn point_of(m: ModelRef<'_>, p: Index2) -> Option<glam::DVec3> {
-    match (m, p) {
-        (ModelRef::Curve(c), Index2::One(k)) => c.points().get(k).copied(),
-        (ModelRef::Surface(s), Index2::Two(i, j)) => Some(s.point(i, j)),
-        _ => None,
-    }
-}
-
-/// Every control point of an ERBS local curve/patch.
-pub fn local_points(m: ModelRef<'_>, local: Index2) -> Option<Vec<glam::DVec3>> {
-    match (m, local) {
-        (ModelRef::ErbsCurve(c), Index2::One(l)) => {
-            Some(c.local_curves().get(l)?.points().to_vec())
-        }
-        (ModelRef::ErbsSurface(s), Index2::Two(k, l)) => {
-            Some(s.local_patch(k, l).points().to_vec())
-        }
-        _ => None,
-    }
+    false
 }

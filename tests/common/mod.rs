@@ -263,7 +263,7 @@ impl Scratch {
     }
 
     /// `path/name`.
-    pub fn join(&self, name: &str) -> PathBuf {
+    pub fn join(&self, name: impl AsRef<std::path::Path>) -> PathBuf {
         self.path.join(name)
     }
 

@@ -1,0 +1,212 @@
+//! Bézier, B-spline and NURBS curves: the model and its edits.
+
+use super::edit::{EditError, KindEdit, ObjectEdit, Target};
+use super::points::PointEdit;
+use super::{MAX_CURVE_SAMPLES, MAX_DEGREE, SplineForm, check_samples};
+use crate::geom::{BSplineCurve, GeomError, KnotVector};
+
+/// A Bézier or B-spline (NURBS with weights) curve with its sample count.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CurveModel {
+    form: SplineForm,
+    curve: BSplineCurve,
+    samples: usize,
+}
+
+impl CurveModel {
+    /// A Bézier form needs one clamped span on [0, 1] (the file format's Bézier curve).
+    pub fn new(form: SplineForm, curve: BSplineCurve, samples: usize) -> Result<Self, EditError> {
+        check_samples(samples, MAX_CURVE_SAMPLES)?;
+        if form == SplineForm::Bezier
+            && *curve.knots() != KnotVector::bezier(curve.degree(), 0.0, 1.0)
+        {
+            return Err(EditError::new(
+                "knots",
+                "a Bézier curve has the knot vector {0^(d+1), 1^(d+1)}",
+            ));
+        }
+        Ok(Self {
+            form,
+            curve,
+            samples,
+        })
+    }
+
+    pub fn form(&self) -> SplineForm {
+        self.form
+    }
+
+    pub fn curve(&self) -> &BSplineCurve {
+        &self.curve
+    }
+
+    pub fn samples(&self) -> usize {
+        self.samples
+    }
+}
+
+/// Edits of a [`CurveModel`].
+#[derive(Debug, Clone, PartialEq)]
+pub enum CurveEdit {
+    Point(PointEdit<usize>),
+    /// CurveKnotIns: insert `t` `times` times; the shape is unchanged, a Bézier curve becomes a
+    /// B-spline curve.
+    InsertKnot {
+        t: f64,
+        times: usize,
+    },
+    /// DegreeElevateCurve by `by`; the shape is unchanged, a Bézier curve stays Bézier.
+    ElevateDegree {
+        by: usize,
+    },
+    /// Put back a whole earlier model (undo of structural edits, and of a weight that made a
+    /// polynomial curve rational). `shape_kept`: the restored model describes the current
+    /// shape (undo of a refinement), so samples need not be recomputed.
+    Restore {
+        model: Box<CurveModel>,
+        shape_kept: bool,
+    },
+}
+
+impl KindEdit for CurveEdit {
+    type Model = CurveModel;
+
+    fn validate(&self, m: &CurveModel) -> Result<(), EditError> {
+        let c = &m.curve;
+        match *self {
+            CurveEdit::Point(p) => p.validate(c),
+            CurveEdit::InsertKnot { t, times } => {
+                check_insertion(c.domain(), c.degree(), c.knots().multiplicity(t), t, times)
+            }
+            CurveEdit::ElevateDegree { by } => check_elevation("elevate_degree", c.degree(), by),
+            CurveEdit::Restore { ref model, .. } => check_restore(model.samples == m.samples),
+        }
+    }
+
+    fn apply(&self, m: &mut CurveModel) {
+        match self {
+            CurveEdit::Point(p) => p.apply(&mut m.curve),
+            CurveEdit::InsertKnot { t, times } => {
+                let r = m.curve.insert_knot(*t, *times);
+                if replace(&mut m.curve, r) {
+                    m.form = SplineForm::BSpline;
+                }
+            }
+            CurveEdit::ElevateDegree { by } => {
+                let r = m.curve.elevate_degree(*by);
+                replace(&mut m.curve, r);
+            }
+            CurveEdit::Restore { model, .. } => *m = (**model).clone(),
+        }
+    }
+
+    fn inverse(&self, m: &CurveModel) -> Self {
+        let restore = |shape_kept| CurveEdit::Restore {
+            model: Box::new(m.clone()),
+            shape_kept,
+        };
+        match self {
+            CurveEdit::Point(p) => p.inverse(&m.curve).map_or(restore(false), CurveEdit::Point),
+            CurveEdit::InsertKnot { .. } | CurveEdit::ElevateDegree { .. } => restore(true),
+            CurveEdit::Restore { shape_kept, .. } => restore(*shape_kept),
+        }
+    }
+
+    fn target(&self) -> Target {
+        match self {
+            CurveEdit::Point(p) => p.target(),
+            _ => Target::Structure,
+        }
+    }
+
+    fn merge(&self, next: &Self) -> Option<Self> {
+        match (self, next) {
+            (CurveEdit::Point(a), CurveEdit::Point(b)) => a.merge(b).map(CurveEdit::Point),
+            _ => None,
+        }
+    }
+
+    fn into_object(self) -> ObjectEdit {
+        ObjectEdit::Curve(self)
+    }
+
+    fn from_object(e: &ObjectEdit) -> Option<&Self> {
+        match e {
+            ObjectEdit::Curve(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+/// Takes a refinement's result. Refining a valid model with validated arguments cannot fail;
+/// should it ever, the model stays as it was rather than half-changed.
+pub(super) fn replace<T>(slot: &mut T, refined: Result<T, GeomError>) -> bool {
+    match refined {
+        Ok(v) => {
+            *slot = v;
+            true
+        }
+        Err(e) => {
+            debug_assert!(false, "validated refinement failed: {e}");
+            false
+        }
+    }
+}
+
+pub(super) fn check_restore(same_samples: bool) -> Result<(), EditError> {
+    if same_samples {
+        Ok(())
+    } else {
+        Err(EditError::new(
+            "samples",
+            "a restored model keeps the sample counts",
+        ))
+    }
+}
+
+/// t strictly inside the domain (a, b), times ≥ 1, and the resulting multiplicity ≤ degree.
+pub(super) fn check_insertion(
+    (a, b): (f64, f64),
+    degree: usize,
+    multiplicity: usize,
+    t: f64,
+    times: usize,
+) -> Result<(), EditError> {
+    if !(t > a && t < b) {
+        return Err(EditError::new(
+            "insert_knot",
+            format!("parameter {t} is not inside the open domain ({a}, {b})"),
+        ));
+    }
+    if times == 0 {
+        return Err(EditError::new("times", "must be at least 1"));
+    }
+    if multiplicity + times > degree {
+        return Err(EditError::new(
+            "times",
+            format!(
+                "inserting {t} {times} time(s) gives multiplicity {} there, above the degree {degree}",
+                multiplicity + times
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// by ≥ 1 and degree + by ≤ MAX_DEGREE.
+pub(super) fn check_elevation(
+    field: &'static str,
+    degree: usize,
+    by: usize,
+) -> Result<(), EditError> {
+    if by == 0 {
+        return Err(EditError::new(field, "the elevation must be at least 1"));
+    }
+    if degree + by > MAX_DEGREE {
+        return Err(EditError::new(
+            field,
+            format!("degree {degree} + {by} exceeds the supported maximum {MAX_DEGREE}"),
+        ));
+    }
+    Ok(())
+}

@@ -1,0 +1,200 @@
+//! The edit vocabulary shared by every layer: one trait per-kind edits implement, the sum over
+//! kinds, and the frame-merging of edits.
+
+use super::{CurveEdit, ErbsCurveEdit, ErbsSurfaceEdit, Index2, Model, ModelRef, SurfaceEdit};
+use std::fmt::Debug;
+
+/// A rejected edit: which field of the edit is wrong and why (callers add the object and the
+/// edit's position, so the whole message is one line).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("field '{field}': {message}")]
+pub struct EditError {
+    pub field: &'static str,
+    pub message: String,
+}
+
+impl EditError {
+    pub fn new(field: &'static str, message: impl Into<String>) -> Self {
+        Self {
+            field,
+            message: message.into(),
+        }
+    }
+}
+
+/// What an edit acts on. Edits on different targets commute; consecutive edits on one target
+/// may merge. A structural edit acts on the whole object and orders everything around it. It
+/// also says what the edit changes in the drawn control structures: one point, one local curve
+/// or patch, nothing drawn (a weight), or their size and layout (structure).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Target {
+    Point(Index2),
+    Weight(Index2),
+    /// An ERBS local curve or patch (its transform and its control points).
+    Local(Index2),
+    Structure,
+}
+
+/// An edit of one object kind. Implemented once per kind: this is the table of what each edit
+/// means, written in one place per kind instead of one `match` per layer.
+pub trait KindEdit: Clone + Debug + PartialEq + Sized {
+    /// The model this kind of edit acts on.
+    type Model;
+
+    /// Checks the edit against the model it is about to be applied to.
+    fn validate(&self, model: &Self::Model) -> Result<(), EditError>;
+
+    /// Applies a validated edit to the model.
+    fn apply(&self, model: &mut Self::Model);
+
+    /// The edit that brings `model` (before this edit is applied) back bit for bit.
+    #[must_use]
+    fn inverse(&self, model: &Self::Model) -> Self;
+
+    fn target(&self) -> Target;
+
+    /// This edit followed by `next` as one edit, when both act on one target and combine.
+    #[must_use]
+    fn merge(&self, next: &Self) -> Option<Self>;
+
+    #[must_use]
+    fn into_object(self) -> ObjectEdit;
+
+    /// The edit if `e` is of this kind.
+    fn from_object(e: &ObjectEdit) -> Option<&Self>;
+}
+
+/// An edit of any kind.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ObjectEdit {
+    Curve(CurveEdit),
+    Surface(SurfaceEdit),
+    ErbsCurve(ErbsCurveEdit),
+    ErbsSurface(ErbsSurfaceEdit),
+}
+
+/// One edit of one object (`object` indexes the scene's objects).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Edit {
+    pub object: usize,
+    pub edit: ObjectEdit,
+}
+
+/// Calls `$f` on the kind's edit inside an [`ObjectEdit`].
+macro_rules! each_kind {
+    ($e:expr, $x:ident => $body:expr) => {
+        match $e {
+            ObjectEdit::Curve($x) => $body,
+            ObjectEdit::Surface($x) => $body,
+            ObjectEdit::ErbsCurve($x) => $body,
+            ObjectEdit::ErbsSurface($x) => $body,
+        }
+    };
+}
+
+impl ObjectEdit {
+    pub fn target(&self) -> Target {
+        each_kind!(self, e => e.target())
+    }
+
+    /// Whether the edit changes the object's structure (knots, degree, control counts).
+    pub fn is_structural(&self) -> bool {
+        self.target() == Target::Structure
+    }
+
+    /// The two as one edit, when they act on one target and combine.
+    #[must_use]
+    pub fn merge(&self, next: &ObjectEdit) -> Option<ObjectEdit> {
+        each_kind!(self, e => {
+            let next = KindEdit::from_object(next)?;
+            e.merge(next).map(KindEdit::into_object)
+        })
+    }
+
+    /// Checks the edit against a model (of its own kind).
+    pub fn validate(&self, model: ModelRef<'_>) -> Result<(), EditError> {
+        match (self, model) {
+            (ObjectEdit::Curve(e), ModelRef::Curve(m)) => e.validate(m),
+            (ObjectEdit::Surface(e), ModelRef::Surface(m)) => e.validate(m),
+            (ObjectEdit::ErbsCurve(e), ModelRef::ErbsCurve(m)) => e.validate(m),
+            (ObjectEdit::ErbsSurface(e), ModelRef::ErbsSurface(m)) => e.validate(m),
+            (e, m) => Err(edit_kind_mismatch(e, m.type_name())),
+        }
+    }
+
+    /// The edit restoring `model` as it is before this edit, or an error on a kind mismatch.
+    pub fn inverse(&self, model: ModelRef<'_>) -> Result<ObjectEdit, EditError> {
+        Ok(match (self, model) {
+            (ObjectEdit::Curve(e), ModelRef::Curve(m)) => e.inverse(m).into_object(),
+            (ObjectEdit::Surface(e), ModelRef::Surface(m)) => e.inverse(m).into_object(),
+            (ObjectEdit::ErbsCurve(e), ModelRef::ErbsCurve(m)) => e.inverse(m).into_object(),
+            (ObjectEdit::ErbsSurface(e), ModelRef::ErbsSurface(m)) => e.inverse(m).into_object(),
+            (e, m) => return Err(edit_kind_mismatch(e, m.type_name())),
+        })
+    }
+
+    /// The kind's name, for messages.
+    pub fn kind_name(&self) -> &'static str {
+        match self {
+            ObjectEdit::Curve(_) => "curve",
+            ObjectEdit::Surface(_) => "surface",
+            ObjectEdit::ErbsCurve(_) => "ERBS curve",
+            ObjectEdit::ErbsSurface(_) => "ERBS surface",
+        }
+    }
+}
+
+/// The error for an edit paired with a model of another kind.
+pub fn edit_kind_mismatch(e: &ObjectEdit, model_type: &str) -> EditError {
+    EditError::new(
+        "object",
+        format!("a {} edit does not apply to a {model_type}", e.kind_name()),
+    )
+}
+
+pub(super) fn apply_to_model(model: &mut Model, edit: &ObjectEdit) -> Result<(), EditError> {
+    match (model, edit) {
+        (Model::Curve(m), ObjectEdit::Curve(e)) => e.apply(m),
+        (Model::Surface(m), ObjectEdit::Surface(e)) => e.apply(m),
+        (Model::ErbsCurve(m), ObjectEdit::ErbsCurve(e)) => e.apply(m),
+        (Model::ErbsSurface(m), ObjectEdit::ErbsSurface(e)) => e.apply(m),
+        (m, e) => return Err(edit_kind_mismatch(e, m.type_name())),
+    }
+    Ok(())
+}
+
+/// Merges the edits of one frame so each touched target is updated once: consecutive edits of
+/// one target combine where their kind says so ([`KindEdit::merge`]); edits on different
+/// targets commute, so targets are applied in first-touch order while edits on one target keep
+/// their order. A structural edit is a barrier: nothing moves across it (indices change there).
+#[must_use]
+pub fn merge_edits(edits: &[Edit]) -> Vec<Edit> {
+    let mut out = Vec::with_capacity(edits.len());
+    let mut groups: Vec<((usize, Target), Vec<Edit>)> = Vec::new();
+    let flush = |groups: &mut Vec<((usize, Target), Vec<Edit>)>, out: &mut Vec<Edit>| {
+        out.extend(groups.drain(..).flat_map(|(_, g)| g));
+    };
+    for e in edits {
+        let target = e.edit.target();
+        if target == Target::Structure {
+            flush(&mut groups, &mut out);
+            out.push(e.clone());
+            continue;
+        }
+        let key = (e.object, target);
+        let group = match groups.iter().position(|(k, _)| *k == key) {
+            Some(i) => &mut groups[i].1,
+            None => {
+                groups.push((key, Vec::new()));
+                &mut groups.last_mut().expect("just pushed").1
+            }
+        };
+        let merged = group.last().and_then(|last| last.edit.merge(&e.edit));
+        match (merged, group.last_mut()) {
+            (Some(m), Some(last)) => last.edit = m,
+            _ => group.push(e.clone()),
+        }
+    }
+    flush(&mut groups, &mut out);
+    out
+}

@@ -1,0 +1,185 @@
+//! Tensor-product Bézier, B-spline and NURBS surfaces: the model and its edits.
+
+use super::curve::{check_elevation, check_insertion, check_restore, replace};
+use super::edit::{EditError, KindEdit, ObjectEdit, Target};
+use super::points::PointEdit;
+use super::{SplineForm, check_surface_samples};
+use crate::geom::{KnotVector, TensorSurface};
+use glam::DVec3;
+
+/// A Bézier or B-spline (NURBS with weights) surface with its sample counts [mu, mv].
+#[derive(Debug, Clone, PartialEq)]
+pub struct SurfaceModel {
+    form: SplineForm,
+    surface: TensorSurface,
+    samples: [usize; 2],
+}
+
+impl SurfaceModel {
+    /// A Bézier form needs one clamped span on [0, 1] per direction.
+    pub fn new(
+        form: SplineForm,
+        surface: TensorSurface,
+        samples: [usize; 2],
+    ) -> Result<Self, EditError> {
+        check_surface_samples(samples)?;
+        if form == SplineForm::Bezier && !is_bezier(&surface) {
+            return Err(EditError::new(
+                "knots",
+                "a Bézier surface has the knot vectors {0^(d+1), 1^(d+1)}",
+            ));
+        }
+        Ok(Self {
+            form,
+            surface,
+            samples,
+        })
+    }
+
+    pub fn form(&self) -> SplineForm {
+        self.form
+    }
+
+    pub fn surface(&self) -> &TensorSurface {
+        &self.surface
+    }
+
+    pub fn samples(&self) -> [usize; 2] {
+        self.samples
+    }
+
+    /// Mutable geometry for building examples (the demo's teapot placement); edits go through
+    /// [`SurfaceEdit`].
+    pub fn map_points(&mut self, f: impl Fn(DVec3) -> DVec3) {
+        self.surface.map_points(f);
+    }
+}
+
+fn is_bezier(s: &TensorSurface) -> bool {
+    (0..2).all(|dir| s.knots()[dir] == KnotVector::bezier(s.degree()[dir], 0.0, 1.0))
+}
+
+/// Edits of a [`SurfaceModel`]. Directions are 0 (u) and 1 (v).
+#[derive(Debug, Clone, PartialEq)]
+pub enum SurfaceEdit {
+    Point(PointEdit<[usize; 2]>),
+    /// SurfaceKnotIns in one direction; the shape is unchanged, Bézier becomes B-spline.
+    InsertKnot {
+        dir: usize,
+        t: f64,
+        times: usize,
+    },
+    /// Degree elevation by [bu, bv]; the shape is unchanged, Bézier stays Bézier.
+    ElevateDegree {
+        by: [usize; 2],
+    },
+    /// Put back a whole earlier model (see [`super::CurveEdit::Restore`]).
+    Restore {
+        model: Box<SurfaceModel>,
+        shape_kept: bool,
+    },
+}
+
+impl KindEdit for SurfaceEdit {
+    type Model = SurfaceModel;
+
+    fn validate(&self, m: &SurfaceModel) -> Result<(), EditError> {
+        let s = &m.surface;
+        match *self {
+            SurfaceEdit::Point(p) => p.validate(s),
+            SurfaceEdit::InsertKnot { dir, t, times } => {
+                if dir > 1 {
+                    return Err(EditError::new("insert_knot", "the direction is u or v"));
+                }
+                check_insertion(
+                    s.domain()[dir],
+                    s.degree()[dir],
+                    s.knots()[dir].multiplicity(t),
+                    t,
+                    times,
+                )
+                .map_err(|e| in_direction(e, dir))
+            }
+            SurfaceEdit::ElevateDegree { by } => {
+                if by == [0, 0] {
+                    return Err(EditError::new(
+                        "elevate_degree",
+                        "the elevation must be at least 1 in u or v",
+                    ));
+                }
+                for dir in 0..2 {
+                    if by[dir] > 0 {
+                        check_elevation("elevate_degree", s.degree()[dir], by[dir])
+                            .map_err(|e| in_direction(e, dir))?;
+                    }
+                }
+                Ok(())
+            }
+            SurfaceEdit::Restore { ref model, .. } => check_restore(model.samples == m.samples),
+        }
+    }
+
+    fn apply(&self, m: &mut SurfaceModel) {
+        match self {
+            SurfaceEdit::Point(p) => p.apply(&mut m.surface),
+            SurfaceEdit::InsertKnot { dir, t, times } => {
+                let r = m.surface.insert_knot(*dir, *t, *times);
+                if replace(&mut m.surface, r) {
+                    m.form = SplineForm::BSpline;
+                }
+            }
+            SurfaceEdit::ElevateDegree { by } => {
+                for (dir, &b) in by.iter().enumerate() {
+                    if b > 0 {
+                        m.surface = m.surface.elevate_degree(dir, b);
+                    }
+                }
+            }
+            SurfaceEdit::Restore { model, .. } => *m = (**model).clone(),
+        }
+    }
+
+    fn inverse(&self, m: &SurfaceModel) -> Self {
+        let restore = |shape_kept| SurfaceEdit::Restore {
+            model: Box::new(m.clone()),
+            shape_kept,
+        };
+        match self {
+            SurfaceEdit::Point(p) => p
+                .inverse(&m.surface)
+                .map_or(restore(false), SurfaceEdit::Point),
+            SurfaceEdit::InsertKnot { .. } | SurfaceEdit::ElevateDegree { .. } => restore(true),
+            SurfaceEdit::Restore { shape_kept, .. } => restore(*shape_kept),
+        }
+    }
+
+    fn target(&self) -> Target {
+        match self {
+            SurfaceEdit::Point(p) => p.target(),
+            _ => Target::Structure,
+        }
+    }
+
+    fn merge(&self, next: &Self) -> Option<Self> {
+        match (self, next) {
+            (SurfaceEdit::Point(a), SurfaceEdit::Point(b)) => a.merge(b).map(SurfaceEdit::Point),
+            _ => None,
+        }
+    }
+
+    fn into_object(self) -> ObjectEdit {
+        ObjectEdit::Surface(self)
+    }
+
+    fn from_object(e: &ObjectEdit) -> Option<&Self> {
+        match e {
+            ObjectEdit::Surface(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+fn in_direction(mut e: EditError, dir: usize) -> EditError {
+    e.message = format!("{} direction: {}", ["u", "v"][dir], e.message);
+    e
+}

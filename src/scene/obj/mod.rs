@@ -1,0 +1,223 @@
+//! Wavefront OBJ free-form geometry in and out (`cstype`, `deg`, `curv`, `surf`, `parm`, `end`
+//! with `v` control vertices), the exchange format Rhino, Maya and Ayam write for NURBS and
+//! Bézier geometry. Reading goes text → statements (`lex`) → free-form elements as written
+//! (`read`, [`model::FreeForm`]) → scene objects (`map`); writing goes the other way.
+//! Everything a user can rely on — which constructs map, how exactly, what is refused — is in
+//! docs/obj.md.
+
+mod check;
+mod erbs;
+mod lex;
+mod map;
+pub mod model;
+mod read;
+mod write;
+
+pub use map::{default_curve_samples, default_surface_samples};
+
+use super::{Scene, SceneError};
+use model::FreeForm;
+use std::collections::{HashMap, HashSet};
+use std::path::Path;
+
+/// A problem with an OBJ file, at a (1-based) line.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("line {line}: {message}")]
+pub struct ObjError {
+    pub line: usize,
+    pub message: String,
+}
+
+impl ObjError {
+    pub(crate) fn new(line: usize, message: impl Into<String>) -> Self {
+        Self {
+            line,
+            message: message.into(),
+        }
+    }
+
+    /// `FILE:LINE: message`, the form compilers use, so editors can jump to it.
+    pub fn in_file(&self, path: &Path) -> String {
+        format!("{}:{}: {}", path.display(), self.line, self.message)
+    }
+}
+
+/// Something in an OBJ file that was read past (polygons, trims, unsupported types, …).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ObjWarning {
+    pub line: usize,
+    pub message: String,
+}
+
+impl ObjWarning {
+    /// `FILE:LINE: warning: message`.
+    pub fn in_file(&self, path: &Path) -> String {
+        format!(
+            "{}:{}: warning: {}",
+            path.display(),
+            self.line,
+            self.message
+        )
+    }
+}
+
+/// A scene read from OBJ and what was ignored on the way.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ObjImport {
+    pub scene: Scene,
+    pub warnings: Vec<ObjWarning>,
+}
+
+/// The free-form elements of OBJ text exactly as written (before mapping to scene objects).
+pub fn read_elements(text: &str) -> Result<(Vec<FreeForm>, Vec<ObjWarning>), ObjError> {
+    let parsed = read::read(&lex::statements(text))?;
+    Ok((parsed.elements, parsed.warnings))
+}
+
+/// Parses OBJ text into a scene.
+pub fn parse_obj(text: &str) -> Result<ObjImport, ObjError> {
+    let (elements, warnings) = read_elements(text)?;
+    if elements.is_empty() {
+        // Say why, at the first thing that was read past (a skipped element, polygons, …).
+        let (line, why) = warnings
+            .first()
+            .map_or((1, String::new()), |w| (w.line, format!("; {}", w.message)));
+        return Err(ObjError::new(
+            line,
+            format!(
+                "no free-form curve or surface (curv/surf with cstype bezier or bspline) to read{why}"
+            ),
+        ));
+    }
+    let mut used = HashSet::new();
+    let objects = elements
+        .iter()
+        .map(|e| map::element_to_object(e, unique_name(e, &mut used)))
+        .collect::<Result<_, _>>()?;
+    Ok(ObjImport {
+        scene: Scene { objects },
+        warnings,
+    })
+}
+
+/// Parses file bytes (UTF-8, with the line of the first bad byte named otherwise).
+pub fn parse_obj_bytes(bytes: &[u8]) -> Result<ObjImport, ObjError> {
+    parse_obj(lex::decode(bytes)?)
+}
+
+/// The scene as OBJ text, or the first object that has no exact OBJ form.
+pub fn scene_to_obj(scene: &Scene) -> Result<String, SceneError> {
+    let elements = scene
+        .objects
+        .iter()
+        .map(map::object_to_element)
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(write::write(&elements))
+}
+
+/// Reads an OBJ file; errors read `FILE:LINE: message`.
+pub fn load_obj(path: &Path) -> Result<ObjImport, SceneError> {
+    let bytes = std::fs::read(path)
+        .map_err(|e| SceneError(format!("cannot read {}: {e}", path.display())))?;
+    parse_obj_bytes(&bytes).map_err(|e| SceneError(e.in_file(path)))
+}
+
+/// Scene file formats, told apart by extension.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    Json,
+    Obj,
+}
+
+impl Format {
+    /// `.obj` and `.json` (any case); `None` for anything else.
+    pub fn of(path: &Path) -> Option<Format> {
+        let ext = path.extension()?.to_str()?;
+        if ext.eq_ignore_ascii_case("obj") {
+            Some(Format::Obj)
+        } else if ext.eq_ignore_ascii_case("json") {
+            Some(Format::Json)
+        } else {
+            None
+        }
+    }
+}
+
+/// Writes the scene in the format the path names — OBJ for `.obj`, the JSON scene format
+/// otherwise — atomically (temporary file + rename), so a failed save never destroys the
+/// previous file. Nothing is written when an object has no OBJ form.
+pub fn save_scene_file(scene: &Scene, path: &Path) -> Result<(), SceneError> {
+    if Format::of(path) != Some(Format::Obj) {
+        return scene.save(path);
+    }
+    let text = scene_to_obj(scene)?;
+    super::write_durably(path, text.as_bytes())
+        .map_err(|e| SceneError(format!("cannot write {}: {e}", path.display())))
+}
+
+/// The element's `o`/`g` name (or "curve"/"surface"), made unique with ".2", ".3", ….
+fn unique_name(e: &FreeForm, used: &mut HashSet<String>) -> String {
+    let base = e
+        .name
+        .clone()
+        .unwrap_or_else(|| if e.is_surface() { "surface" } else { "curve" }.to_string());
+    let mut name = base.clone();
+    let mut k = 2;
+    while used.contains(&name) {
+        name = format!("{base}.{k}");
+        k += 1;
+    }
+    used.insert(name.clone());
+    name
+}
+
+/// Warnings grouped by kind: one line per kind, at its first occurrence, with a count.
+#[derive(Debug, Default)]
+struct Warnings {
+    kinds: Vec<Warned>,
+    /// Kind key → index into `kinds`.
+    index: HashMap<String, usize>,
+}
+
+/// One kind of warning.
+#[derive(Debug)]
+struct Warned {
+    /// Line of the first occurrence.
+    line: usize,
+    count: usize,
+    message: String,
+}
+
+impl Warnings {
+    /// Counts an occurrence of `key`; the message is made once, for the first.
+    fn add(&mut self, key: &str, line: usize, message: impl FnOnce() -> String) {
+        match self.index.get(key) {
+            Some(&i) => self.kinds[i].count += 1,
+            None => {
+                self.index.insert(key.to_string(), self.kinds.len());
+                self.kinds.push(Warned {
+                    line,
+                    count: 1,
+                    message: message(),
+                });
+            }
+        }
+    }
+
+    fn into_list(self) -> Vec<ObjWarning> {
+        let mut out: Vec<ObjWarning> = self
+            .kinds
+            .into_iter()
+            .map(|w| ObjWarning {
+                line: w.line,
+                message: if w.count > 1 {
+                    format!("{} ({} times, first here)", w.message, w.count)
+                } else {
+                    w.message
+                },
+            })
+            .collect();
+        out.sort_by_key(|w| w.line);
+        out
+    }
+}
