@@ -41,8 +41,9 @@ pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
                     autosave_file.display()
                 )));
             }
-            let scene =
+            let mut scene =
                 Scene::load(&autosave_file).map_err(|e| CliError::in_file(&autosave_file, e))?;
+            opts.samples.apply(&mut scene)?;
             let (title, save) = match opts.scene {
                 Some(p) => (p.display().to_string(), p.to_path_buf()),
                 None => ("demo".to_string(), Path::new(DEMO_SAVE).to_path_buf()),
