@@ -74,6 +74,8 @@ struct App {
     /// as this frame's input phase.
     rec: Recorder,
     device: String,
+    /// The wake-up this app asked for on the autosave's behalf (so it clears only its own).
+    autosave_wakeup: Option<Instant>,
 }
 
 /// Whether an X11 display is reachable (this build's winit backend is X11; Wayland sessions
@@ -104,6 +106,7 @@ pub fn run(args: ViewArgs) -> Result<ViewRun, String> {
         error: None,
         rec,
         device: String::new(),
+        autosave_wakeup: None,
     };
     // A panic anywhere in the loop must not lose unsaved edits: write the autosave, then let
     // the panic go on.
@@ -170,14 +173,13 @@ impl App {
                 },
             )
             .map_err(|e| e.to_string())?;
-        let session = Session::new(
+        let mut session = Session::new(
             &mut renderer,
             &self.args.scene,
             self.args.save_path.clone(),
             [size.width, size.height],
         )
         .map_err(|e| e.to_string())?;
-        let mut session = session;
         session.set_autosave(self.args.autosave.clone());
         window.request_redraw();
         self.running = Some(Running {
@@ -313,13 +315,20 @@ impl App {
         let Some(r) = self.running.as_mut() else {
             return;
         };
-        let next = r.session.tick(Instant::now());
-        match (event_loop.control_flow(), next) {
-            (ControlFlow::Poll, _) => {}
-            (_, Some(deadline)) => event_loop.set_control_flow(ControlFlow::WaitUntil(deadline)),
-            (ControlFlow::WaitUntil(_), None) => event_loop.set_control_flow(ControlFlow::Wait),
-            (ControlFlow::Wait, None) => {}
-        }
+        let now = Instant::now();
+        let next = r.session.tick(now);
+        let mine = std::mem::replace(&mut self.autosave_wakeup, next);
+        let flow = match (event_loop.control_flow(), next) {
+            (ControlFlow::Poll, _) => return,
+            // Another timer of the loop's that is still ahead and comes first stays.
+            (ControlFlow::WaitUntil(t), Some(d)) if t > now && Some(t) != mine => t.min(d),
+            (_, Some(d)) => d,
+            (ControlFlow::WaitUntil(t), None) if Some(t) == mine => {
+                return event_loop.set_control_flow(ControlFlow::Wait);
+            }
+            (_, None) => return,
+        };
+        event_loop.set_control_flow(ControlFlow::WaitUntil(flow));
     }
 }
 
