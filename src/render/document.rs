@@ -7,7 +7,7 @@ use crate::geom::knots::uniform_params;
 use crate::geom::{LocalCurve as GeomLocalCurve, LocalPatch as GeomLocalPatch};
 use crate::model::{
     CurveEdit, Edit, EditError, ErbsCurveEdit, ErbsSurfaceEdit, Index2, KindEdit, LocalEdit,
-    LocalPath, ModelRef, ObjectEdit, PointEdit, SurfaceEdit,
+    LocalPath, Model, ModelRef, ObjectEdit, PointEdit, SurfaceEdit,
 };
 use crate::sampling::{DirtyRegion, SampleMode, SampledObject};
 use crate::scene::{Scene, SceneObject};
@@ -311,6 +311,41 @@ impl Document {
             _ => return None,
         };
         (!points.is_empty()).then_some(points)
+    }
+
+    /// The edit that sets the ERBS local at `local` exactly to its state in `origin` mapped
+    /// by `matrix` (a transform taken from a gesture's start rather than by increments).
+    pub fn set_local_transformed(
+        object: usize,
+        local: LocalPath<Index2>,
+        origin: &Model,
+        matrix: &glam::DMat4,
+    ) -> Option<Edit> {
+        let f = |p: DVec3| matrix.transform_point3(p);
+        let edit = match origin {
+            Model::ErbsCurve(m) => {
+                let path = local.to_curve()?;
+                let mut l = m.curve().local_at(path.steps())?.clone();
+                l.map_points(&f);
+                ErbsCurveEdit::SetLocal {
+                    local: path,
+                    to: Box::new(l),
+                }
+                .into_object()
+            }
+            Model::ErbsSurface(m) => {
+                let path = local.to_surface()?;
+                let mut p = m.surface().local_at(path.steps())?.clone();
+                p.map_points(&f);
+                ErbsSurfaceEdit::SetLocal {
+                    local: path,
+                    to: Box::new(p),
+                }
+                .into_object()
+            }
+            _ => return None,
+        };
+        Some(Edit { object, edit })
     }
 
     /// The edit that maps an ERBS local curve or patch by the affine `matrix`.

@@ -317,7 +317,7 @@ pub(super) fn weight_grid(
 
 fn parse_color(at: &At, v: &Value) -> Result<[f64; 3], SceneError> {
     let p = as_point(at, "color", "color", v)?;
-    if p.min_element() < 0.0 || p.max_element() > 1.0 {
+    if !p.cmpge(glam::DVec3::ZERO).all() || !p.cmple(glam::DVec3::ONE).all() {
         return Err(at.err(
             "color",
             format!("components must lie in [0, 1], found {:?}", p.to_array()),

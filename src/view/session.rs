@@ -3,6 +3,7 @@
 //! delta path, copy dirty rows, record draws and the overlay). The winit viewer, `--script`
 //! replays and `prespline bench` all drive this same type.
 
+use super::autosave::Autosave;
 use super::hud::Hud;
 use super::input::{InputEvent, Key, Modifiers, MouseButton};
 use super::picking::{PICK_RADIUS, Projected, pick, project_all};
@@ -12,7 +13,7 @@ use super::tools::{Axis, Drag, Transform, TransformKind, View};
 use super::undo::UndoStack;
 use crate::gpu::{Frame, GpuResult, Renderer};
 use crate::model::{
-    CurveEdit, Edit, Index2, KindEdit, LocalPath, ModelRef, SurfaceEdit, merge_edits,
+    CurveEdit, Edit, Index2, KindEdit, LocalPath, Model, ModelRef, SurfaceEdit, merge_edits,
 };
 use crate::render::overlays::overlay_lines;
 use crate::render::{
@@ -88,6 +89,10 @@ pub struct Session {
     /// What tools without pre-evaluation do on an edit: re-sample every edited object from
     /// scratch and upload all of it (`prespline bench --naive`).
     pub naive: bool,
+    /// Unsaved edits kept beside the scene file (`None`: not kept, as in benchmarks).
+    autosave: Option<Autosave>,
+    /// The transformed object's model when the gesture began.
+    transform_origin: Option<Model>,
 }
 
 impl Session {
@@ -135,7 +140,59 @@ impl Session {
             projected: None,
             merge: true,
             naive: false,
+            autosave: None,
+            transform_origin: None,
         })
+    }
+
+    /// Keeps unsaved edits in an autosave file (see [`super::autosave`]).
+    pub fn set_autosave(&mut self, autosave: Option<Autosave>) {
+        self.autosave = autosave;
+    }
+
+    pub fn autosave(&self) -> Option<&Autosave> {
+        self.autosave.as_ref()
+    }
+
+    /// Writes the autosave when it is due at `now`; returns when it is due next, for an event
+    /// loop that otherwise sleeps until input arrives.
+    pub fn tick(&mut self, now: Instant) -> Option<Instant> {
+        let due = self.autosave.as_ref()?.deadline()?;
+        if due > now {
+            return Some(due);
+        }
+        self.write_autosave();
+        self.autosave.as_ref()?.deadline()
+    }
+
+    /// Every way out (window close, Ctrl+Q, a script's quit, an error): writes the autosave if
+    /// edits are unsaved, and returns its path while it holds edits the scene file lacks.
+    pub fn on_exit(&mut self) -> Option<PathBuf> {
+        self.write_autosave();
+        let a = self.autosave.as_ref()?;
+        a.exists().then(|| a.path().to_path_buf())
+    }
+
+    /// The device was lost or the viewer is about to fail: write the autosave now, before
+    /// anything else can go wrong (CPU only; touches no GPU object). Returns its path as
+    /// [`Session::on_exit`] does.
+    pub fn on_fatal_exit(&mut self) -> Option<PathBuf> {
+        self.on_exit()
+    }
+
+    /// Brings the autosave up to date with every queued edit (no-op when nothing is unsaved).
+    fn write_autosave(&mut self) {
+        if self.autosave.is_none() {
+            return;
+        }
+        self.apply_pending();
+        let scene = self.doc.to_scene();
+        if let Some(a) = self.autosave.as_mut()
+            && let Err(e) = a.write(&scene)
+        {
+            eprintln!("autosave failed: {e}");
+            self.set_status(format!("autosave failed: {e}"));
+        }
     }
 
     /// Gives the GPU resources back.
@@ -252,6 +309,9 @@ impl Session {
             samples += region.samples();
             self.gpu.note_samples(i, &region);
             self.gpu.note_controls(&self.doc, i);
+        }
+        if let Some(a) = self.autosave.as_mut() {
+            a.edited(start);
         }
         let micros = start.elapsed().as_secs_f64() * 1e6;
         self.projected = None;
@@ -757,6 +817,8 @@ impl Session {
     }
 
     fn start_transform(&mut self, kind: TransformKind) {
+        // The pivot and the starting points come from the model with every queued edit in.
+        self.apply_pending();
         let target = match (self.selected_local, self.selected) {
             (Some((o, l)), _) => Target::Local(o, l),
             (None, Some(h)) if kind == TransformKind::Grab => Target::Point(h),
@@ -778,6 +840,10 @@ impl Session {
                 .map(|p| p.iter().sum::<DVec3>() / p.len() as f64),
         };
         let Some(pivot) = pivot else { return };
+        self.transform_origin = match target {
+            Target::Local(o, _) => Some(self.doc.objects[o].sampled.model().to_model()),
+            Target::Point(_) => None,
+        };
         let t = Box::new(Transform::new(kind, pivot, &self.view(), self.cursor));
         self.undo.begin(kind.name());
         self.mode = Mode::Transform { target, t };
@@ -795,12 +861,21 @@ impl Session {
             return;
         };
         let total = t.total(&view);
-        let inc = total * t.applied.inverse();
-        if inc == DMat4::IDENTITY {
+        if total == t.applied {
             return;
         }
+        // A singular transform (a typed scale passes through 0 on the way to "0.5") has no
+        // inverse to take the next increment from: the local's points are then set exactly
+        // from where they were when the gesture began.
+        let singular = |m: &DMat4| !(m.determinant().abs() > 0.0 && m.inverse().is_finite());
+        let exact = singular(&total) || singular(&t.applied);
+        let inc = total * t.applied.inverse();
         t.applied = total;
         let edit = match *target {
+            Target::Local(object, local) if exact => self
+                .transform_origin
+                .as_ref()
+                .and_then(|origin| Document::set_local_transformed(object, local, origin, &total)),
             Target::Local(object, local) => self.doc.transform_local(object, local, inc),
             // A point only translates: the increment's translation part.
             Target::Point(h) => self.doc.move_handle(h, inc.w_axis.truncate()),
@@ -854,7 +929,12 @@ impl Session {
         self.apply_pending();
         let scene = self.doc.to_scene();
         match crate::scene::obj::save_scene_file(&scene, &self.save_path) {
-            Ok(()) => self.set_status(format!("saved {}", self.save_path.display())),
+            Ok(()) => {
+                if let Some(a) = self.autosave.as_mut() {
+                    a.saved();
+                }
+                self.set_status(format!("saved {}", self.save_path.display()))
+            }
             Err(e) => self.set_status(format!("save failed: {e}")),
         }
     }
