@@ -106,7 +106,7 @@ fn erbs_edit(at: &At, obj: &Map<String, Value>, surface: bool) -> Result<ObjectE
             let at_knot = direction_parameter(at, v)?;
             let degree = obj
                 .get("degree")
-                .map(|d| super::parse::usize_pair(at, "degree", d))
+                .map(|d| super::parse::usize_pair(at, "degree", "[du, dv]", d))
                 .transpose()?;
             return Ok(ErbsSurfaceEdit::InsertKnot {
                 local,
@@ -121,10 +121,18 @@ fn erbs_edit(at: &At, obj: &Map<String, Value>, surface: bool) -> Result<ObjectE
             let spec = as_object(at, "to_erbs", v)?;
             let inner = At(format!("{}: field 'to_erbs'", at.0));
             check_fields(&inner, spec, &["local_patches", "local_degree"])?;
-            let count =
-                super::parse::usize_pair(at, "to_erbs", require(&inner, spec, "local_patches")?)?;
-            let degree =
-                super::parse::usize_pair(at, "to_erbs", require(&inner, spec, "local_degree")?)?;
+            let count = super::parse::usize_pair(
+                at,
+                "to_erbs",
+                "[nu, nv]",
+                require(&inner, spec, "local_patches")?,
+            )?;
+            let degree = super::parse::usize_pair(
+                at,
+                "to_erbs",
+                "[du, dv]",
+                require(&inner, spec, "local_degree")?,
+            )?;
             return Ok(ErbsSurfaceEdit::ToErbs {
                 local,
                 count,

@@ -144,7 +144,7 @@ pub(super) fn spline_surface(
         obj,
         &with(outer, &["degree", "knots", "points", "weights"]),
     )?;
-    let degree = usize_pair(at, "degree", require(at, obj, "degree")?)?;
+    let degree = usize_pair(at, "degree", "[du, dv]", require(at, obj, "degree")?)?;
     check_degree(at, "degree", degree[0].max(degree[1]))?;
     let knots = knot_pair(at, obj)?;
     let (count, points) = point_grid(at, "points", require(at, obj, "points")?)?;
@@ -154,14 +154,21 @@ pub(super) fn spline_surface(
     Ok((SplineForm::BSpline, s))
 }
 
-/// `[a, b]` of non-negative integers.
-pub(super) fn usize_pair(at: &At, field: &str, v: &Value) -> Result<[usize; 2], SceneError> {
+/// `[a, b]` of non-negative integers, one per direction (`form` shows it in messages, e.g.
+/// "[du, dv]").
+pub(super) fn usize_pair(
+    at: &At,
+    field: &str,
+    form: &str,
+    v: &Value,
+) -> Result<[usize; 2], SceneError> {
     match v.as_array() {
         Some(a) if a.len() == 2 => Ok([
             as_usize(at, field, &format!("{field}[0]"), &a[0])?,
             as_usize(at, field, &format!("{field}[1]"), &a[1])?,
         ]),
-        _ => Err(at.err(field, format!("expected [u, v], found {v}"))),
+        Some(a) => Err(at.err(field, format!("expected {form}, found {} entries", a.len()))),
+        None => Err(at.err(field, format!("expected {form}, found {v}"))),
     }
 }
 

@@ -160,8 +160,18 @@ pub(super) fn erbs_surface(
         only_from(at, obj)?;
         let source = source_body(at, src, &["bezier_surface", "bspline_surface"])?;
         let (_, s) = spline_surface(&source.0, source.1, source.2, &LOCAL_FIELDS)?;
-        let count = usize_pair(at, "local_patches", require(at, obj, "local_patches")?)?;
-        let degree = usize_pair(at, "local_degree", require(at, obj, "local_degree")?)?;
+        let count = usize_pair(
+            at,
+            "local_patches",
+            "[nu, nv]",
+            require(at, obj, "local_patches")?,
+        )?;
+        let degree = usize_pair(
+            at,
+            "local_degree",
+            "[du, dv]",
+            require(at, obj, "local_degree")?,
+        )?;
         check_degree(at, "local_degree", degree[0].max(degree[1]))?;
         return ErbsSurface::from_surface(&s, count, degree, bf, closed).map_err(|e| geom(at, e));
     }
