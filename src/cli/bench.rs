@@ -158,6 +158,10 @@ fn run_headless(
             rec.add_bytes(stats.bytes as u64);
             rec.phase_start(Phase::Record);
             session.record(&mut frame, true).map_err(gpu)?;
+            if k + 1 == total {
+                // Only the last image is written (final.png); no other frame is read back.
+                frame.capture();
+            }
             rec.phase_start(Phase::Submit);
             frame.finish().map_err(gpu)?;
             rec.end_frame();

@@ -5,7 +5,7 @@
 use ash::vk;
 
 use super::device::Device;
-use super::draw::Camera;
+use super::draw::{Camera, DrawStats};
 use super::error::{GpuError, GpuResult, VkResultExt};
 use super::memory::Buffer;
 use super::mirror::{Mirror, MirrorWriter};
@@ -146,6 +146,16 @@ pub(crate) struct TargetView {
     pub samples: vk::SampleCountFlags,
 }
 
+/// State bound in the frame's command buffer, so draws skip binding it again.
+#[derive(Clone, Copy, Default)]
+pub(crate) struct Bound {
+    pub pipeline: vk::Pipeline,
+    pub vertices: Option<(vk::Buffer, u64)>,
+    pub indices: vk::Buffer,
+    /// `None` until set after the last pipeline bind.
+    pub depth_test: Option<bool>,
+}
+
 pub(crate) enum FrameTarget<'a> {
     Offscreen(&'a mut OffscreenTarget),
     Swapchain {
@@ -175,6 +185,10 @@ pub struct Frame<'a> {
     pub(crate) viewport: vk::Rect2D,
     pub(crate) flushes: Vec<vk::MappedMemoryRange<'static>>,
     pub(crate) finished: bool,
+    pub(crate) bound: Bound,
+    pub(crate) stats: DrawStats,
+    /// Offscreen only: copy the image into the readback buffer at the end of the frame.
+    pub(crate) capture: bool,
 }
 
 impl<'a> Frame<'a> {
@@ -187,6 +201,11 @@ impl<'a> Frame<'a> {
     /// Sequential frame number (0 for the renderer's first frame).
     pub fn number(&self) -> u64 {
         self.number
+    }
+
+    /// MSAA samples per pixel of the target.
+    pub fn samples(&self) -> u32 {
+        self.view.samples.as_raw()
     }
 
     /// Target size in pixels.
@@ -206,6 +225,13 @@ impl<'a> Frame<'a> {
         let atom = self.renderer.device.caps.non_coherent_atom_size;
         let track = self.renderer.always_flush || mirror.slot(self.slot).buffer.needs_flush();
         mirror.writer(self.slot, atom, track, &mut self.flushes)
+    }
+
+    /// Offscreen frames: also copy the finished image into the target's readback buffer, for
+    /// [`Renderer::read_pixels`]. Frames that are not captured copy nothing (an image read
+    /// back every frame costs a full-image copy nobody looks at). No effect on swapchains.
+    pub fn capture(&mut self) {
+        self.capture = true;
     }
 
     /// Sets the camera used by subsequent 3D draws.

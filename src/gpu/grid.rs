@@ -1,8 +1,13 @@
-//! Static index buffers for row-major sample grids, cached by shape.
+//! Static index buffers for row-major sample grids, cached by shape and stride.
 //!
 //! A grid of `rows × cols` vertices stores vertex `(i, j)` at index `i * cols + j`. Triangles
 //! cover every cell; isolines run along every `every`-th row and column, always including the
 //! last ones so the boundary is closed (`every == 1` is the full wireframe).
+//!
+//! A [`GridStride`] draws a coarser mesh over the same vertices (display level of detail):
+//! every `rows`-th row and `cols`-th column, plus the last ones, so the boundary and the
+//! corners are those of the full grid. Changing the stride binds another cached index buffer;
+//! the vertex data is never touched.
 
 use std::collections::HashMap;
 use std::collections::hash_map::Entry;
@@ -41,46 +46,102 @@ impl GridShape {
     }
 }
 
+/// Which rows and columns of a grid a draw uses: every `rows`-th row and every `cols`-th
+/// column, plus the last row and column (display level of detail; `1 × 1` is the full grid).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct GridStride {
+    /// Step between drawn rows (≥ 1).
+    pub rows: u32,
+    /// Step between drawn columns (≥ 1).
+    pub cols: u32,
+}
+
+impl GridStride {
+    /// Every row and column.
+    pub const FULL: Self = Self { rows: 1, cols: 1 };
+
+    /// Zero steps count as 1.
+    #[must_use]
+    pub fn normalized(self) -> Self {
+        Self {
+            rows: self.rows.max(1),
+            cols: self.cols.max(1),
+        }
+    }
+
+    /// Cells (quads) of the strided mesh over `shape`.
+    pub fn cells(self, shape: GridShape) -> u64 {
+        let s = self.normalized();
+        let n = |count: u32, step: u32| u64::from(count.saturating_sub(1).div_ceil(step));
+        n(shape.rows, s.rows) * n(shape.cols, s.cols)
+    }
+}
+
+impl Default for GridStride {
+    fn default() -> Self {
+        Self::FULL
+    }
+}
+
 /// Triangle-list indices for all cells, two triangles per cell.
 pub fn grid_triangles(shape: GridShape) -> Vec<u32> {
-    let (rows, cols) = (shape.rows, shape.cols);
-    let mut out =
-        Vec::with_capacity((rows.saturating_sub(1) * cols.saturating_sub(1) * 6) as usize);
-    for i in 0..rows.saturating_sub(1) {
-        for j in 0..cols.saturating_sub(1) {
-            let a = i * cols + j;
-            let b = a + 1;
-            let c = a + cols;
-            let d = c + 1;
-            out.extend_from_slice(&[a, c, b, b, c, d]);
+    grid_triangles_strided(shape, GridStride::FULL)
+}
+
+/// Triangle-list indices for the cells of the strided mesh (see [`GridStride`]).
+pub fn grid_triangles_strided(shape: GridShape, stride: GridStride) -> Vec<u32> {
+    let stride = stride.normalized();
+    let cols = shape.cols;
+    let rows: Vec<u32> = iso_lines(shape.rows, stride.rows).collect();
+    let cs: Vec<u32> = iso_lines(shape.cols, stride.cols).collect();
+    let mut out = Vec::with_capacity(rows.len().saturating_sub(1) * cs.len().saturating_sub(1) * 6);
+    for r in rows.windows(2) {
+        for c in cs.windows(2) {
+            let a = r[0] * cols + c[0];
+            let b = r[0] * cols + c[1];
+            let c0 = r[1] * cols + c[0];
+            let d = r[1] * cols + c[1];
+            out.extend_from_slice(&[a, c0, b, b, c0, d]);
         }
     }
     out
 }
 
-/// The rows (or columns) `0, every, 2*every, ...` plus `n - 1`.
+/// The rows (or columns) `0, every, 2*every, ...` plus `n - 1` (nothing for `n == 0`).
 fn iso_lines(n: u32, every: u32) -> impl Iterator<Item = u32> {
     let every = every.max(1);
+    let last = n.checked_sub(1);
     (0..n)
         .step_by(every as usize)
-        .chain((!(n - 1).is_multiple_of(every)).then_some(n - 1))
+        .chain(last.filter(|l| !l.is_multiple_of(every)))
 }
 
 /// Line-list indices for isolines every `every` samples in both directions.
 pub fn grid_lines(shape: GridShape, every: u32) -> Vec<u32> {
+    grid_lines_strided(shape, every, GridStride::FULL)
+}
+
+/// Isolines over the strided mesh: lines lie on rows and columns the mesh draws (the spacing
+/// `every` is rounded up to a multiple of the stride) and follow the mesh's edges, so they sit
+/// exactly on its triangles.
+pub fn grid_lines_strided(shape: GridShape, every: u32, stride: GridStride) -> Vec<u32> {
+    let stride = stride.normalized();
     let (rows, cols) = (shape.rows, shape.cols);
     let mut out = Vec::new();
     if rows == 0 || cols == 0 {
         return out;
     }
-    for i in iso_lines(rows, every) {
-        for j in 0..cols - 1 {
-            out.extend_from_slice(&[i * cols + j, i * cols + j + 1]);
+    let along = |n: u32, step: u32| iso_lines(n, step).collect::<Vec<u32>>();
+    let round_up = |every: u32, step: u32| every.max(1).div_ceil(step) * step;
+    let (row_pts, col_pts) = (along(rows, stride.rows), along(cols, stride.cols));
+    for i in iso_lines(rows, round_up(every, stride.rows)) {
+        for w in col_pts.windows(2) {
+            out.extend_from_slice(&[i * cols + w[0], i * cols + w[1]]);
         }
     }
-    for j in iso_lines(cols, every) {
-        for i in 0..rows - 1 {
-            out.extend_from_slice(&[i * cols + j, (i + 1) * cols + j]);
+    for j in iso_lines(cols, round_up(every, stride.cols)) {
+        for w in row_pts.windows(2) {
+            out.extend_from_slice(&[w[0] * cols + j, w[1] * cols + j]);
         }
     }
     out
@@ -92,11 +153,11 @@ pub(crate) struct IndexBuffer {
     pub count: u32,
 }
 
-/// Index buffers by shape (triangles) and by shape + spacing (lines).
+/// Index buffers by shape + stride (triangles) and by shape + spacing + stride (lines).
 #[derive(Default)]
 pub(crate) struct GridCache {
-    triangles: HashMap<GridShape, IndexBuffer>,
-    lines: HashMap<(GridShape, u32), IndexBuffer>,
+    triangles: HashMap<(GridShape, GridStride), IndexBuffer>,
+    lines: HashMap<(GridShape, u32, GridStride), IndexBuffer>,
 }
 
 fn upload_indices(
@@ -125,15 +186,17 @@ impl GridCache {
         device: &Device,
         uploader: &mut Uploader,
         shape: GridShape,
+        stride: GridStride,
     ) -> GpuResult<&IndexBuffer> {
         shape.validate()?;
-        Ok(match self.triangles.entry(shape) {
+        let stride = stride.normalized();
+        Ok(match self.triangles.entry((shape, stride)) {
             Entry::Occupied(e) => e.into_mut(),
             Entry::Vacant(e) => e.insert(upload_indices(
                 device,
                 uploader,
                 "grid triangles",
-                &grid_triangles(shape),
+                &grid_triangles_strided(shape, stride),
             )?),
         })
     }
@@ -144,16 +207,17 @@ impl GridCache {
         uploader: &mut Uploader,
         shape: GridShape,
         every: u32,
+        stride: GridStride,
     ) -> GpuResult<&IndexBuffer> {
         shape.validate()?;
-        let key = (shape, every.max(1));
+        let key = (shape, every.max(1), stride.normalized());
         Ok(match self.lines.entry(key) {
             Entry::Occupied(e) => e.into_mut(),
             Entry::Vacant(e) => e.insert(upload_indices(
                 device,
                 uploader,
                 "grid lines",
-                &grid_lines(shape, key.1),
+                &grid_lines_strided(shape, key.1, key.2),
             )?),
         })
     }
@@ -187,5 +251,50 @@ mod tests {
         assert_eq!(grid_lines(shape, 1).len(), 2 * (3 * 3 + 4 * 2));
         // every=2: rows 0,2 and columns 0,2,3.
         assert_eq!(grid_lines(shape, 2).len(), 2 * (2 * 3 + 3 * 2));
+    }
+
+    #[test]
+    fn strided_triangles_keep_the_boundary_and_cover_the_grid() {
+        let shape = GridShape { rows: 10, cols: 7 };
+        let stride = GridStride { rows: 4, cols: 2 };
+        let t = grid_triangles_strided(shape, stride);
+        // Rows 0, 4, 8, 9 and columns 0, 2, 4, 6: 3 × 3 cells.
+        assert_eq!(t.len(), 3 * 3 * 6);
+        assert_eq!(stride.cells(shape), 9);
+        let used: std::collections::BTreeSet<u32> = t.iter().copied().collect();
+        let expect: std::collections::BTreeSet<u32> = [0, 4, 8, 9]
+            .iter()
+            .flat_map(|r| [0, 2, 4, 6].map(|c| r * 7 + c))
+            .collect();
+        assert_eq!(used, expect);
+        assert_eq!(
+            grid_triangles_strided(shape, GridStride::FULL),
+            grid_triangles(shape)
+        );
+        // A stride larger than the grid still draws the outer quad.
+        let big = GridStride { rows: 64, cols: 64 };
+        assert_eq!(
+            grid_triangles_strided(shape, big),
+            vec![0, 63, 6, 6, 63, 69]
+        );
+    }
+
+    #[test]
+    fn strided_isolines_follow_the_strided_mesh() {
+        let shape = GridShape { rows: 9, cols: 9 };
+        let stride = GridStride { rows: 2, cols: 2 };
+        // every = 3 rounds up to 4: lines on rows/columns 0, 4, 8, each of 4 segments.
+        let l = grid_lines_strided(shape, 3, stride);
+        assert_eq!(l.len(), 2 * (3 * 4 + 3 * 4));
+        let tri: std::collections::BTreeSet<u32> =
+            grid_triangles_strided(shape, stride).into_iter().collect();
+        assert!(
+            l.iter().all(|i| tri.contains(i)),
+            "isolines use mesh vertices only"
+        );
+        assert_eq!(
+            grid_lines_strided(shape, 1, GridStride::FULL),
+            grid_lines(shape, 1)
+        );
     }
 }

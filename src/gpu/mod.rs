@@ -86,12 +86,14 @@ pub const FRAMES_IN_FLIGHT: usize = 2;
 pub use ash::vk;
 pub use device::{Device, DeviceCaps, GPU_ENV};
 pub use draw::{
-    Camera, LineVertex, OverlayVertex, PointRun, PointStyle, PolylineStyle, SurfaceGrid,
-    SurfaceStyle,
+    Camera, DrawStats, LineVertex, OverlayVertex, PointRun, PointStyle, PolylineStyle,
+    SurfaceBatch, SurfaceGrid, SurfaceStyle,
 };
 pub use error::{GpuError, GpuResult};
 pub use frame::Frame;
-pub use grid::{GridShape, grid_lines, grid_triangles};
+pub use grid::{
+    GridShape, GridStride, grid_lines, grid_lines_strided, grid_triangles, grid_triangles_strided,
+};
 pub use instance::{ValidationMode, force_driver_files};
 pub use memory::{Buffer, BufferDesc};
 pub use mirror::{Mirror, MirrorBuffer, MirrorWriter};

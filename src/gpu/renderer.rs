@@ -2,6 +2,7 @@
 
 use std::mem::ManuallyDrop;
 
+use ash::vk;
 use raw_window_handle::RawDisplayHandle;
 
 use super::FRAMES_IN_FLIGHT;
@@ -10,8 +11,10 @@ use super::error::{GpuError, GpuResult};
 use super::frame::FrameSlot;
 use super::grid::GridCache;
 use super::instance::{Instance, InstanceDesc, ValidationMode};
+use super::memory::Buffer;
 use super::mirror::Mirror;
 use super::pipeline::Pipelines;
+use super::pod::slice_bytes;
 use super::shader::Shaders;
 use super::upload::Uploader;
 use super::validation::ValidationSink;
@@ -44,6 +47,8 @@ pub struct Renderer {
     pub(crate) shaders: Shaders,
     pub(crate) grids: GridCache,
     pub(crate) uploader: Uploader,
+    /// The HUD font's glyph rows in device memory (read by `overlay.frag` through its address).
+    pub(crate) font: Option<Buffer>,
     pub(crate) always_flush: bool,
     // Dropped by hand, in order, after everything above (see `Drop`).
     pub(crate) device: ManuallyDrop<Device>,
@@ -78,6 +83,7 @@ impl Renderer {
             shaders: Shaders::default(),
             grids: GridCache::default(),
             uploader: Uploader::default(),
+            font: None,
             always_flush: desc.always_flush,
             device: ManuallyDrop::new(device),
             instance: ManuallyDrop::new(instance),
@@ -85,6 +91,14 @@ impl Renderer {
         renderer.shaders = Shaders::new(&renderer.device)?;
         renderer.pipelines = Pipelines::new(&renderer.device)?;
         renderer.uploader = Uploader::new(&renderer.device)?;
+        renderer.font = Some(renderer.uploader.upload(
+            &renderer.device,
+            "font",
+            slice_bytes(&super::font::glyph_rows()),
+            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS,
+            vk::PipelineStageFlags2::FRAGMENT_SHADER,
+            vk::AccessFlags2::SHADER_STORAGE_READ,
+        )?);
         for _ in 0..FRAMES_IN_FLIGHT {
             let slot = FrameSlot::new(&renderer.device, desc.always_flush)?;
             renderer.frames.push(slot);
@@ -196,6 +210,9 @@ impl Drop for Renderer {
         }
         std::mem::take(&mut self.grids).destroy(device);
         std::mem::take(&mut self.uploader).destroy(device);
+        if let Some(font) = self.font.take() {
+            device.destroy_buffer(font);
+        }
         std::mem::take(&mut self.pipelines).destroy(device);
         std::mem::take(&mut self.shaders).destroy(device);
         // SAFETY: `device` and `instance` are taken exactly once, here, and never used again;

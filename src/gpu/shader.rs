@@ -26,9 +26,10 @@ pub(crate) enum ShaderId {
     Lines3dVert,
     OverlayVert,
     ColorFrag,
+    OverlayFrag,
 }
 
-const SOURCES: [(ShaderId, &str, &[u8]); 10] = [
+const SOURCES: [(ShaderId, &str, &[u8]); 11] = [
     (
         ShaderId::SurfaceVert,
         "surface.vert",
@@ -59,6 +60,11 @@ const SOURCES: [(ShaderId, &str, &[u8]); 10] = [
         spirv!("overlay.vert"),
     ),
     (ShaderId::ColorFrag, "color.frag", spirv!("color.frag")),
+    (
+        ShaderId::OverlayFrag,
+        "overlay.frag",
+        spirv!("overlay.frag"),
+    ),
 ];
 
 /// The shader modules, created once; pipelines for new target formats are built from them.

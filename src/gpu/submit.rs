@@ -211,6 +211,9 @@ impl Renderer {
             },
             flushes: Vec::new(),
             finished: false,
+            bound: Default::default(),
+            stats: Default::default(),
+            capture: false,
         })
     }
 }
@@ -230,7 +233,13 @@ impl Frame<'_> {
         use vk::PipelineStageFlags2 as S;
         // SAFETY: `cmd` is recording inside the rendering scope begun above.
         unsafe { raw.cmd_end_rendering(cmd) };
+        let capture = self.capture;
         match &mut self.target {
+            FrameTarget::Offscreen(target) if !capture => {
+                // Nothing to copy; the next frame's begin barrier orders its writes after ours.
+                // Older captured pixels no longer show what the target holds.
+                target.last_slot = None;
+            }
             FrameTarget::Offscreen(target) => {
                 let to_src = [image_barrier(
                     view.image,

@@ -295,6 +295,7 @@ fn screenshot(r: &mut Running, path: &Path, hud: bool) -> Result<(), String> {
         let mut frame = r.renderer.begin_offscreen(&mut target)?;
         r.session.upload(&mut frame)?;
         r.session.record(&mut frame, hud)?;
+        frame.capture();
         frame.finish()?;
         r.renderer.read_pixels(&target)
     })();

@@ -58,6 +58,8 @@ pub struct Hud {
     pub samples_touched: usize,
     pub bytes: usize,
     pub gpu_ms: Option<f64>,
+    /// Surface triangles drawn last frame and at full resolution (level of detail).
+    pub triangles: (u64, u64),
     pub visible: bool,
 }
 
@@ -109,6 +111,7 @@ impl Hud {
                     self.samples_touched,
                     self.bytes as f64 / 1024.0
                 ),
+                lod_line(self.triangles),
             ];
             let (gw, gh) = (HISTORY as f32 * 2.0, 60.0);
             push_rect(
@@ -116,7 +119,7 @@ impl Hud {
                 8.0,
                 8.0,
                 gw.max(560.0) + 16.0,
-                2.0 * line + gh + 24.0,
+                lines.len() as f32 * line + gh + 24.0,
                 PANEL,
             );
             for (k, l) in lines.iter().enumerate() {
@@ -125,7 +128,7 @@ impl Hud {
             // Frame-time graph: one bar per frame. Full scale is 33 ms, or the next of 50, 100,
             // 200, 500, 1000 ms above the slowest recent frame (software rendering is slow), so
             // bars are never pegged; reference lines at 16.7 and 33.3 ms and at full scale.
-            let (gx, gy) = (16.0, 16.0 + 2.0 * line);
+            let (gx, gy) = (16.0, 16.0 + lines.len() as f32 * line);
             let slowest = self.frames.iter().copied().fold(0.0f32, f32::max);
             let full = [33.3f32, 50.0, 100.0, 200.0, 500.0, 1000.0]
                 .into_iter()
@@ -188,5 +191,23 @@ impl Hud {
             }
         }
         v
+    }
+}
+
+/// The level-of-detail line: surface triangles drawn and what the full grids would take.
+fn lod_line((drawn, full): (u64, u64)) -> String {
+    let k = |n: u64| {
+        if n >= 1_000_000 {
+            format!("{:.2} M", n as f64 / 1e6)
+        } else if n >= 1000 {
+            format!("{:.1} k", n as f64 / 1e3)
+        } else {
+            n.to_string()
+        }
+    };
+    if drawn == full {
+        format!("LOD full: {} triangles", k(full))
+    } else {
+        format!("LOD: {} of {} triangles", k(drawn), k(full))
     }
 }
