@@ -214,9 +214,10 @@ fn multi_draw_limit(instance: &Instance, physical: vk::PhysicalDevice) -> Option
 }
 
 impl Device {
-    /// Chooses a physical device (see [`GPU_ENV`]) and creates the logical device. When the
-    /// instance was created for a display, `VK_KHR_swapchain` is required and enabled.
-    pub fn new(instance: &Instance) -> GpuResult<Self> {
+    /// Chooses a physical device (`preference`: a name substring, else [`GPU_ENV`]) and creates
+    /// the logical device. When the instance was created for a display, `VK_KHR_swapchain` is
+    /// required and enabled.
+    pub fn new(instance: &Instance, preference: Option<&str>) -> GpuResult<Self> {
         let want_swapchain = instance.surface_fn.is_some();
         // SAFETY: valid instance.
         let physicals = unsafe { instance.raw.enumerate_physical_devices() }
@@ -230,7 +231,9 @@ impl Device {
                 candidates.push(c);
             }
         }
-        let preference = std::env::var(GPU_ENV).ok();
+        let preference = preference
+            .map(str::to_owned)
+            .or_else(|| std::env::var(GPU_ENV).ok());
         let listing: Vec<_> = candidates
             .iter()
             .map(|c| (c.name.clone(), c.props.device_type))

@@ -30,6 +30,10 @@ pub(crate) struct FrameSlot {
     pub transient: TransientBuffer,
     /// GPU time of the previous use of this slot.
     pub gpu_ms: Option<f64>,
+    /// Whether a submission signalling `fence` is pending. Only such a fence is waited for:
+    /// the fence is reset just before submitting, so after a failed submission it would
+    /// never signal, and waiting for it would hang the slot forever.
+    pub in_flight: bool,
 }
 
 impl FrameSlot {
@@ -44,6 +48,7 @@ impl FrameSlot {
             release: Vec::new(),
             transient: TransientBuffer::new(always_flush),
             gpu_ms: None,
+            in_flight: false,
         };
         let result = (|| {
             let info = vk::CommandPoolCreateInfo::default()
@@ -80,13 +85,15 @@ impl FrameSlot {
         }
     }
 
-    /// Waits for the slot's previous submission, then recycles what it used.
+    /// Waits for the slot's previous submission (if it was submitted), then recycles what it
+    /// used. A failed wait leaves everything in place, so a later call may try again.
     pub(crate) fn wait_and_recycle(&mut self, device: &Device) -> GpuResult<()> {
-        // SAFETY: the fence belongs to this device.
-        unsafe { device.raw.wait_for_fences(&[self.fence], true, u64::MAX) }
-            .vk("vkWaitForFences")?;
-        if let Some(t) = self.timer.as_mut() {
-            self.gpu_ms = t.read(device).or(self.gpu_ms);
+        if self.in_flight {
+            device.wait_fence(self.fence)?;
+            self.in_flight = false;
+            if let Some(t) = self.timer.as_mut() {
+                self.gpu_ms = t.read(device).or(self.gpu_ms);
+            }
         }
         for b in self.release.drain(..) {
             device.destroy_buffer(b);

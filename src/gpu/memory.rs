@@ -212,6 +212,13 @@ impl Device {
         }
     }
 
+    /// Waits for `fence` at most [`super::WAIT_LIMIT`] (then [`GpuError::Timeout`]).
+    pub(crate) fn wait_fence(&self, fence: vk::Fence) -> GpuResult<()> {
+        let limit = u64::try_from(super::WAIT_LIMIT.as_nanos()).unwrap_or(u64::MAX);
+        // SAFETY: the fence belongs to this device.
+        unsafe { self.raw.wait_for_fences(&[fence], true, limit) }.vk("vkWaitForFences")
+    }
+
     /// Flushes host writes so the device sees them (no-op call list when empty).
     pub(crate) fn flush_ranges(&self, ranges: &[vk::MappedMemoryRange<'_>]) -> GpuResult<()> {
         if ranges.is_empty() {

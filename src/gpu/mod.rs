@@ -83,6 +83,10 @@ mod validation;
 /// Frames the CPU may record ahead of the GPU; also the number of slots of every mirror.
 pub const FRAMES_IN_FLIGHT: usize = 2;
 
+/// The longest the renderer waits for the GPU (a fence) before reporting
+/// [`GpuError::Timeout`] instead of hanging: far beyond any frame, even in software.
+pub const WAIT_LIMIT: std::time::Duration = std::time::Duration::from_secs(30);
+
 pub use ash::vk;
 pub use device::{Device, DeviceCaps, GPU_ENV};
 pub use draw::{
@@ -99,7 +103,7 @@ pub use memory::{Buffer, BufferDesc};
 pub use mirror::{Mirror, MirrorBuffer, MirrorWriter};
 pub use offscreen::{OFFSCREEN_FORMAT, OffscreenDesc, OffscreenTarget, Pixels};
 pub use pipeline::DEPTH_FORMAT;
-pub use renderer::{Renderer, RendererDesc};
+pub use renderer::{Fault, Renderer, RendererDesc};
 pub use swapchain::{Swapchain, SwapchainDesc};
 pub use validation::{Severity, ValidationMessage, ValidationSink};
 

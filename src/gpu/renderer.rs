@@ -33,6 +33,22 @@ pub struct RendererDesc {
     /// Flush host writes even when memory is coherent. Only useful to exercise the
     /// non-coherent path (under validation) on drivers whose memory is all coherent.
     pub always_flush: bool,
+    /// The device to use: the first whose name contains this (case-insensitive), e.g.
+    /// `"llvmpipe"` for Mesa's software rasteriser among several installed drivers. `None`
+    /// follows `PRESPLINE_GPU`, else prefers discrete > integrated > virtual > CPU.
+    pub device: Option<String>,
+}
+
+/// A failure a test makes the renderer report instead of calling Vulkan, to exercise error
+/// paths that real drivers rarely take ([`Renderer::inject_fault`]).
+#[doc(hidden)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Fault {
+    /// The next `vkQueueSubmit2` of a frame returns this result (after its fence was reset).
+    Submit(vk::Result),
+    /// The next static upload's `vkWaitForFences` returns this result after a successful
+    /// submission (the copy may still be running).
+    UploadWait(vk::Result),
 }
 
 /// The GPU renderer. See the [module docs](super) for the frame protocol.
@@ -50,6 +66,8 @@ pub struct Renderer {
     /// The HUD font's glyph rows in device memory (read by `overlay.frag` through its address).
     pub(crate) font: Option<Buffer>,
     pub(crate) always_flush: bool,
+    /// A failure to report at the next matching call (error-path tests).
+    pub(crate) fault: Option<Fault>,
     // Dropped by hand, in order, after everything above (see `Drop`).
     pub(crate) device: ManuallyDrop<Device>,
     pub(crate) instance: ManuallyDrop<Instance>,
@@ -68,7 +86,7 @@ impl Renderer {
             sync_validation: desc.sync_validation,
             display: desc.display,
         })?;
-        let device = match Device::new(&instance) {
+        let device = match Device::new(&instance, desc.device.as_deref()) {
             Ok(d) => d,
             Err(e) => {
                 instance.destroy();
@@ -85,6 +103,7 @@ impl Renderer {
             uploader: Uploader::default(),
             font: None,
             always_flush: desc.always_flush,
+            fault: None,
             device: ManuallyDrop::new(device),
             instance: ManuallyDrop::new(instance),
         };
@@ -134,6 +153,17 @@ impl Renderer {
             .get(prev)
             .and_then(|f| f.gpu_ms)
             .or_else(|| self.frames.iter().find_map(|f| f.gpu_ms))
+    }
+
+    /// Makes the next matching call fail with `fault` instead of reaching the driver. For
+    /// tests of error paths (a submission that fails, a wait that fails): the renderer must
+    /// report the error, never hang, and stay usable where the error allows.
+    #[doc(hidden)]
+    pub fn inject_fault(&mut self, fault: Fault) {
+        match fault {
+            Fault::Submit(_) => self.fault = Some(fault),
+            Fault::UploadWait(result) => self.uploader.fail_next_wait(result),
+        }
     }
 
     /// Blocks until the GPU has finished all submitted work.

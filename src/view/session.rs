@@ -126,6 +126,14 @@ impl Session {
         })
     }
 
+    /// The viewer is about to end on an error it cannot recover from (a lost GPU device):
+    /// save unsaved work now. The document lives in main memory, so nothing is lost with the
+    /// device. Autosave (`NAME.autosave.json`, see DESIGN.md "Nothing lost") plugs in here;
+    /// until then this only notes the reason in the status line.
+    pub fn on_fatal_exit(&mut self) {
+        self.set_status("fatal GPU error: the viewer is closing");
+    }
+
     /// Gives the GPU resources back.
     pub fn destroy(self, renderer: &mut Renderer) {
         self.gpu.destroy(renderer);
