@@ -71,7 +71,10 @@ fn an_idle_viewer_draws_no_frames() {
     let long = frames_until_quit(&dir, 6.5);
     eprintln!("frames: {short} when quitting at 1.5 s, {long} at 6.5 s");
     // Start-up (first frame, window events, the overlay's settle tick) and the quit frame.
-    assert!((2..=8).contains(&short), "{short} frames in a short idle session");
+    assert!(
+        (2..=8).contains(&short),
+        "{short} frames in a short idle session"
+    );
     assert_eq!(
         long, short,
         "frames were drawn during 5 s without input ({long} against {short})"
@@ -105,7 +108,10 @@ fn a_lost_device_ends_the_viewer_with_one_line() {
     let dir = scratch("device-lost");
     let out = run_with_lost_device(&dir);
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success(), "the viewer went on after losing its device: {err}");
+    assert!(
+        !out.status.success(),
+        "the viewer went on after losing its device: {err}"
+    );
     let errors: Vec<&str> = err.lines().filter(|l| l.starts_with("error:")).collect();
     assert_eq!(errors.len(), 1, "not one error line:\n{err}");
     assert!(

@@ -385,9 +385,12 @@ impl Device {
         unsafe { self.raw.device_wait_idle() }.vk("vkDeviceWaitIdle")
     }
 
-    /// Frees the allocator's memory blocks and destroys the device. Every resource created
-    /// from it must already be destroyed.
-    pub fn destroy(self) {
+    /// Frees the allocator's memory blocks and destroys the device.
+    ///
+    /// # Safety
+    /// Every object created from the device must already be destroyed and the GPU idle (or
+    /// the device lost).
+    pub(crate) unsafe fn destroy(self) {
         drop(
             self.allocator
                 .lock()

@@ -79,7 +79,8 @@ impl FrameSlot {
         match result {
             Ok(()) => Ok(slot),
             Err(e) => {
-                slot.destroy(device);
+                // SAFETY: created just above and never used by the GPU.
+                unsafe { slot.destroy(device) };
                 Err(e)
             }
         }
@@ -96,7 +97,9 @@ impl FrameSlot {
             }
         }
         for b in self.release.drain(..) {
-            device.destroy_buffer(b);
+            // SAFETY: released buffers were last used by this slot's previous submission,
+            // whose fence was just waited for (or which never happened).
+            unsafe { device.destroy_buffer(b) };
         }
         self.transient.reset();
         Ok(())
@@ -123,15 +126,22 @@ impl FrameSlot {
         Ok(())
     }
 
-    /// Destroys everything; the caller waited for the device to be idle.
-    pub(crate) fn destroy(mut self, device: &Device) {
-        for b in self.release.drain(..) {
-            device.destroy_buffer(b);
+    /// Destroys everything.
+    ///
+    /// # Safety
+    /// No submitted GPU work that uses these objects may still be pending (the device is idle
+    /// or lost, or they were never used).
+    pub(crate) unsafe fn destroy(mut self, device: &Device) {
+        // SAFETY: the caller guarantees nothing pending uses them (this function's contract).
+        unsafe {
+            for b in self.release.drain(..) {
+                device.destroy_buffer(b);
+            }
+            if let Some(t) = self.timer.take() {
+                t.destroy(device);
+            }
+            self.transient.destroy(device);
         }
-        if let Some(t) = self.timer.take() {
-            t.destroy(device);
-        }
-        self.transient.destroy(device);
         // SAFETY: idle device; null handles (from a failed `new`) are ignored by Vulkan.
         unsafe {
             device.raw.destroy_semaphore(self.acquire, None);

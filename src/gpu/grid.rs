@@ -222,9 +222,15 @@ impl GridCache {
         })
     }
 
-    pub(crate) fn destroy(self, device: &Device) {
+    /// Destroys every cached index buffer.
+    ///
+    /// # Safety
+    /// No submitted GPU work that uses these objects may still be pending (the device is idle
+    /// or lost, or they were never used).
+    pub(crate) unsafe fn destroy(self, device: &Device) {
         for ib in self.triangles.into_values().chain(self.lines.into_values()) {
-            device.destroy_buffer(ib.buffer);
+            // SAFETY: the caller guarantees nothing pending uses them (this function's contract).
+            unsafe { device.destroy_buffer(ib.buffer) };
         }
     }
 }

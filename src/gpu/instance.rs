@@ -218,8 +218,11 @@ impl Instance {
         self.debug.is_some()
     }
 
-    /// Destroys the messenger and the instance. Every object created from it must be gone.
-    pub fn destroy(self) {
+    /// Destroys the messenger and the instance.
+    ///
+    /// # Safety
+    /// Every object created from the instance (device, surfaces) must already be destroyed.
+    pub(crate) unsafe fn destroy(self) {
         if let Some((loader, messenger)) = self.debug {
             // SAFETY: the messenger belongs to this instance and is destroyed once.
             unsafe { loader.destroy_debug_utils_messenger(messenger, None) };

@@ -12,7 +12,7 @@ use super::error::{GpuError, GpuResult};
 use super::frame::TargetView;
 use super::image::{Attachments, Image, ImageDesc};
 use super::memory::{Buffer, BufferDesc};
-use super::renderer::Renderer;
+use super::renderer::{Orphan, Renderer};
 
 /// Colour format of offscreen targets. sRGB, so shaders output linear colour and the PNG
 /// bytes read back are display-ready.
@@ -64,11 +64,19 @@ impl OffscreenTarget {
         }
     }
 
-    fn destroy(self, device: &Device) {
-        self.color.destroy(device);
-        self.attachments.destroy(device);
-        for b in self.readback {
-            device.destroy_buffer(b);
+    /// Destroys images and readback buffers.
+    ///
+    /// # Safety
+    /// No submitted GPU work that uses these objects may still be pending (the device is idle
+    /// or lost, or they were never used).
+    pub(crate) unsafe fn destroy(self, device: &Device) {
+        // SAFETY: the caller guarantees nothing pending uses them (this function's contract).
+        unsafe {
+            self.color.destroy(device);
+            self.attachments.destroy(device);
+            for b in self.readback {
+                device.destroy_buffer(b);
+            }
         }
     }
 }
@@ -205,7 +213,8 @@ impl Renderer {
         let attachments = match Attachments::new(device, extent, OFFSCREEN_FORMAT, samples) {
             Ok(a) => a,
             Err(e) => {
-                color.destroy(device);
+                // SAFETY: created just above and never used by the GPU.
+                unsafe { color.destroy(device) };
                 return Err(e);
             }
         };
@@ -227,7 +236,8 @@ impl Renderer {
             match buffer {
                 Ok(b) => target.readback.push(b),
                 Err(e) => {
-                    target.destroy(device);
+                    // SAFETY: created just above and never used by the GPU.
+                    unsafe { target.destroy(device) };
                     return Err(e);
                 }
             }
@@ -270,10 +280,25 @@ impl Renderer {
         })
     }
 
-    /// Destroys an offscreen target (waits for the GPU to finish with it first).
+    /// Destroys an offscreen target, after waiting for the GPU to finish with it. If that
+    /// wait fails for another reason than a lost device (work may still run), the target is
+    /// kept until the renderer is dropped and the error returned.
     pub fn destroy_offscreen(&mut self, target: OffscreenTarget) -> GpuResult<()> {
-        let waited = self.wait_idle();
-        target.destroy(&self.device);
-        waited
+        match self.wait_idle() {
+            Ok(()) => {
+                // SAFETY: the device is idle.
+                unsafe { target.destroy(&self.device) };
+                Ok(())
+            }
+            Err(e) if e.is_device_lost() => {
+                // SAFETY: nothing executes on a lost device; its objects may be destroyed.
+                unsafe { target.destroy(&self.device) };
+                Err(e)
+            }
+            Err(e) => {
+                self.orphans.push(Orphan::Target(target));
+                Err(e)
+            }
+        }
     }
 }

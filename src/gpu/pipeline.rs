@@ -233,7 +233,12 @@ impl Pipelines {
         })
     }
 
-    pub(crate) fn destroy(self, device: &Device) {
+    /// Destroys every pipeline and the layout.
+    ///
+    /// # Safety
+    /// No submitted GPU work that uses these objects may still be pending (the device is idle
+    /// or lost, or they were never used).
+    pub(crate) unsafe fn destroy(self, device: &Device) {
         for set in self.sets.into_values() {
             for p in [
                 set.surface,

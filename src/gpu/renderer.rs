@@ -13,9 +13,11 @@ use super::grid::GridCache;
 use super::instance::{Instance, InstanceDesc, ValidationMode};
 use super::memory::Buffer;
 use super::mirror::Mirror;
+use super::offscreen::OffscreenTarget;
 use super::pipeline::Pipelines;
 use super::pod::slice_bytes;
 use super::shader::Shaders;
+use super::swapchain::Swapchain;
 use super::upload::Uploader;
 use super::validation::ValidationSink;
 
@@ -51,6 +53,12 @@ pub enum Fault {
     UploadWait(vk::Result),
 }
 
+/// A resource given back while the GPU might still use it (a wait for it failed).
+pub(crate) enum Orphan {
+    Target(OffscreenTarget),
+    Swapchain(Swapchain),
+}
+
 /// The GPU renderer. See the [module docs](super) for the frame protocol.
 ///
 /// Resources it hands out (mirrors, targets, swapchains) must be given back through the
@@ -68,6 +76,9 @@ pub struct Renderer {
     pub(crate) always_flush: bool,
     /// A failure to report at the next matching call (error-path tests).
     pub(crate) fault: Option<Fault>,
+    /// Objects whose GPU use could not be shown to have ended when they were given back;
+    /// destroyed after the final wait in `Drop`.
+    pub(crate) orphans: Vec<Orphan>,
     // Dropped by hand, in order, after everything above (see `Drop`).
     pub(crate) device: ManuallyDrop<Device>,
     pub(crate) instance: ManuallyDrop<Instance>,
@@ -89,7 +100,8 @@ impl Renderer {
         let device = match Device::new(&instance, desc.device.as_deref()) {
             Ok(d) => d,
             Err(e) => {
-                instance.destroy();
+                // SAFETY: nothing was created from the instance (the device failed).
+                unsafe { instance.destroy() };
                 return Err(e);
             }
         };
@@ -104,6 +116,7 @@ impl Renderer {
             font: None,
             always_flush: desc.always_flush,
             fault: None,
+            orphans: Vec::new(),
             device: ManuallyDrop::new(device),
             instance: ManuallyDrop::new(instance),
         };
@@ -205,7 +218,9 @@ impl Renderer {
         for (i, b) in mirror.slots.into_iter().enumerate() {
             match self.frames.get_mut(i) {
                 Some(f) => f.release.push(b.buffer),
-                None => self.device.destroy_buffer(b.buffer),
+                // No slot, so no frame ever used this buffer.
+                // SAFETY: a buffer without a frame slot was never bound by a submission.
+                None => unsafe { self.device.destroy_buffer(b.buffer) },
             }
         }
     }
@@ -232,28 +247,45 @@ impl Renderer {
 
 impl Drop for Renderer {
     fn drop(&mut self) {
-        // Even if the device is lost there is nothing better to do than destroy everything.
-        let _ = self.device.wait_idle();
+        match self.device.wait_idle() {
+            // Idle, or lost (nothing executes on a lost device): everything may go.
+            Ok(()) => {}
+            Err(e) if e.is_device_lost() => {}
+            // The GPU may still be running our work: destroying it would be undefined
+            // behaviour, so everything is leaked instead (the process is usually ending).
+            Err(_) => return,
+        }
+        for orphan in std::mem::take(&mut self.orphans) {
+            // SAFETY: the device is idle or lost, so no GPU work uses them.
+            unsafe {
+                match orphan {
+                    Orphan::Target(t) => t.destroy(&self.device),
+                    Orphan::Swapchain(s) => self.destroy_swapchain_now(s),
+                }
+            }
+        }
         let device = &*self.device;
-        for f in std::mem::take(&mut self.frames) {
-            f.destroy(device);
+        // SAFETY: the device is idle or lost, so no GPU work uses any of these objects.
+        unsafe {
+            for f in std::mem::take(&mut self.frames) {
+                f.destroy(device);
+            }
+            std::mem::take(&mut self.grids).destroy(device);
+            std::mem::take(&mut self.uploader).destroy(device);
+            if let Some(font) = self.font.take() {
+                device.destroy_buffer(font);
+            }
+            std::mem::take(&mut self.pipelines).destroy(device);
+            std::mem::take(&mut self.shaders).destroy(device);
         }
-        std::mem::take(&mut self.grids).destroy(device);
-        std::mem::take(&mut self.uploader).destroy(device);
-        if let Some(font) = self.font.take() {
-            device.destroy_buffer(font);
-        }
-        std::mem::take(&mut self.pipelines).destroy(device);
-        std::mem::take(&mut self.shaders).destroy(device);
         // SAFETY: `device` and `instance` are taken exactly once, here, and never used again;
-        // every child object was destroyed above (or by the caller via destroy_*).
-        let (device, instance) = unsafe {
-            (
-                ManuallyDrop::take(&mut self.device),
-                ManuallyDrop::take(&mut self.instance),
-            )
-        };
-        device.destroy();
-        instance.destroy();
+        // every child object was destroyed above (or by the caller via destroy_*), and the
+        // device is idle or lost.
+        unsafe {
+            let device = ManuallyDrop::take(&mut self.device);
+            let instance = ManuallyDrop::take(&mut self.instance);
+            device.destroy();
+            instance.destroy();
+        }
     }
 }

@@ -11,7 +11,7 @@ use super::device::Device;
 use super::error::{GpuError, GpuResult, VkResultExt};
 use super::frame::TargetView;
 use super::image::{Attachments, create_view};
-use super::renderer::Renderer;
+use super::renderer::{Orphan, Renderer};
 
 /// Parameters for [`Renderer::create_swapchain`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -115,14 +115,18 @@ impl Swapchain {
     }
 
     /// Destroys views and attachments (not the swapchain, surface or semaphores).
-    fn destroy_images(&mut self, device: &Device) {
+    ///
+    /// # Safety
+    /// The device must be idle (or lost): no frame still renders into these attachments.
+    unsafe fn destroy_images(&mut self, device: &Device) {
         for v in self.views.drain(..) {
             // SAFETY: the caller made the device idle.
             unsafe { device.raw.destroy_image_view(v, None) };
         }
         self.images.clear();
         if let Some(a) = self.attachments.take() {
-            a.destroy(device);
+            // SAFETY: as above.
+            unsafe { a.destroy(device) };
         }
     }
 }
@@ -236,7 +240,8 @@ impl Renderer {
             retired: Vec::new(),
         };
         if let Err(e) = self.rebuild_swapchain(&mut swapchain) {
-            self.destroy_swapchain_now(swapchain);
+            // SAFETY: the swapchain was just created: no frame ever rendered into its images.
+            unsafe { self.destroy_swapchain_now(swapchain) };
             return Err(e);
         }
         Ok(swapchain)
@@ -253,7 +258,9 @@ impl Renderer {
         ) else {
             return Err(GpuError::Surface("no surface support".into()));
         };
-        sc.destroy_images(device);
+        let old_images = sc.images.len();
+        // SAFETY: the device is idle (waited above), so no frame renders into them.
+        unsafe { sc.destroy_images(device) };
         // SAFETY: valid physical device and surface for all three queries.
         let (caps, formats, modes) = unsafe {
             (
@@ -327,7 +334,7 @@ impl Renderer {
             sc.retired.push(Retired {
                 raw: old,
                 semaphores: std::mem::take(&mut sc.render_finished),
-                until: self.frame_number + (FRAMES_IN_FLIGHT + sc.images.len().max(1)) as u64,
+                until: self.frame_number + (FRAMES_IN_FLIGHT + old_images.max(1)) as u64,
             });
             sc.raw = vk::SwapchainKHR::null();
         }
@@ -358,9 +365,23 @@ impl Renderer {
 
     /// Destroys the swapchain and its surface (waits for the GPU first).
     pub fn destroy_swapchain(&mut self, swapchain: Swapchain) -> GpuResult<()> {
-        let waited = self.wait_idle();
-        self.destroy_swapchain_now(swapchain);
-        waited
+        match self.wait_idle() {
+            Ok(()) => {
+                // SAFETY: the device is idle.
+                unsafe { self.destroy_swapchain_now(swapchain) };
+                Ok(())
+            }
+            Err(e) if e.is_device_lost() => {
+                // SAFETY: nothing executes on a lost device.
+                unsafe { self.destroy_swapchain_now(swapchain) };
+                Err(e)
+            }
+            Err(e) => {
+                // Work may still render into its images: keep it until the renderer goes.
+                self.orphans.push(Orphan::Swapchain(swapchain));
+                Err(e)
+            }
+        }
     }
 
     /// Destroys retired swapchains whose presents are surely done (`all`: every one, at
@@ -388,19 +409,26 @@ impl Renderer {
         });
     }
 
-    fn destroy_swapchain_now(&mut self, mut sc: Swapchain) {
+    /// Destroys the swapchain, its retired predecessors, semaphores and surface.
+    ///
+    /// # Safety
+    /// The device must be idle or lost (no frame renders into its images).
+    pub(crate) unsafe fn destroy_swapchain_now(&mut self, mut sc: Swapchain) {
         self.collect_retired(&mut sc, true);
         let device = &*self.device;
-        sc.destroy_images(device);
-        for s in sc.render_finished.drain(..) {
-            // SAFETY: the device is idle; presents waiting on it have been processed.
-            unsafe { device.raw.destroy_semaphore(s, None) };
-        }
+        // SAFETY: the caller guarantees an idle (or lost) device.
+        unsafe { sc.destroy_images(device) };
         if let Some(f) = device.swapchain_fn.as_ref()
             && sc.raw != vk::SwapchainKHR::null()
         {
             // SAFETY: idle device, swapchain destroyed once.
             unsafe { f.destroy_swapchain(sc.raw, None) };
+        }
+        for s in sc.render_finished.drain(..) {
+            // SAFETY: the device is idle and the swapchain that presented with these
+            // semaphores is gone. Present completion itself cannot be observed without
+            // VK_EXT_swapchain_maintenance1; this is the teardown order the Vulkan samples use.
+            unsafe { device.raw.destroy_semaphore(s, None) };
         }
         if let Some(f) = self.instance.surface_fn.as_ref() {
             // SAFETY: the swapchain using the surface is gone.

@@ -94,11 +94,13 @@ impl Uploader {
         let result = self.copy_via(device, name, &staging, bytes, usage, dst_stage, dst_access);
         match result {
             Ok(dst) => {
-                device.destroy_buffer(staging);
+                // SAFETY: the copy that read it completed (its fence was waited for).
+                unsafe { device.destroy_buffer(staging) };
                 Ok(dst)
             }
             Err(Failure::Idle(e)) => {
-                device.destroy_buffer(staging);
+                // SAFETY: nothing using it is pending (`Failure::Idle`).
+                unsafe { device.destroy_buffer(staging) };
                 Err(e)
             }
             Err(Failure::Pending(e)) => {
@@ -143,7 +145,8 @@ impl Uploader {
         match self.submit_copy(device, staging, &dst, dst_stage, dst_access) {
             Ok(()) => Ok(dst),
             Err(Failure::Idle(e)) => {
-                device.destroy_buffer(dst);
+                // SAFETY: nothing using it is pending (`Failure::Idle`).
+                unsafe { device.destroy_buffer(dst) };
                 Err(Failure::Idle(e))
             }
             Err(Failure::Pending(e)) => {
@@ -244,9 +247,15 @@ impl Uploader {
         outcome
     }
 
-    pub(crate) fn destroy(self, device: &Device) {
+    /// Destroys the pool, the fence and orphaned buffers.
+    ///
+    /// # Safety
+    /// No submitted GPU work that uses these objects may still be pending (the device is idle
+    /// or lost, or they were never used).
+    pub(crate) unsafe fn destroy(self, device: &Device) {
         for b in self.orphans {
-            device.destroy_buffer(b);
+            // SAFETY: the caller guarantees nothing pending uses them (this function's contract).
+            unsafe { device.destroy_buffer(b) };
         }
         // SAFETY: every upload waited for its fence, or the renderer waited for the device
         // (or lost it) before destroying the uploader.
