@@ -27,6 +27,8 @@ pub struct BenchArgs {
     pub naive: bool,
     pub out: PathBuf,
     pub msaa: u32,
+    /// Display level of detail (off: every sample of every surface is drawn).
+    pub lod: bool,
 }
 
 /// Runs the benchmark, writes the reports and returns the closing line.
@@ -132,6 +134,7 @@ fn run_headless(
     let mut session =
         Session::new(&mut renderer, scene, dir.join("scene.json"), [w, h]).map_err(gpu)?;
     session.naive = naive;
+    session.options.lod = args.lod;
     let total = args.warmup + args.frames;
     let result = (|| -> Result<Recorder, CliError> {
         let mut driver = ScenarioDriver::new(args.scenario, &session, args.warmup, args.frames)
@@ -213,6 +216,8 @@ fn run_window(
         warmup: args.warmup,
         max_frames: Some(args.warmup + args.frames),
         naive,
+        msaa: args.msaa,
+        lod: args.lod,
     })
     .map_err(CliError)?;
     Ok((run.frames, run.device))

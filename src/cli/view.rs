@@ -57,6 +57,8 @@ pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
         warmup: 0,
         max_frames: None,
         naive: false,
+        msaa: 0,
+        lod: true,
     };
     let title = args.title.clone();
     let run = app::run(args).map_err(CliError)?;

@@ -48,6 +48,10 @@ pub struct ViewArgs {
     pub max_frames: Option<usize>,
     /// Re-sample and upload edited objects in full (`--naive`).
     pub naive: bool,
+    /// MSAA samples; 0 picks the device's default.
+    pub msaa: u32,
+    /// Display level of detail.
+    pub lod: bool,
 }
 
 /// What a viewer run measured.
@@ -192,7 +196,7 @@ impl App {
                     width: size.width,
                     height: size.height,
                     vsync: self.args.vsync,
-                    samples: 0,
+                    samples: self.args.msaa,
                 },
             )
             .map_err(|e| e.to_string())?;
@@ -203,6 +207,9 @@ impl App {
             [size.width, size.height],
         )
         .map_err(|e| e.to_string())?;
+        let mut session = session;
+        session.naive = self.args.naive;
+        session.options.lod = self.args.lod;
         if let Some(scenario) = self.args.scenario {
             let frames = self
                 .args

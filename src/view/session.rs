@@ -571,6 +571,14 @@ impl Session {
             (Key::Char('t'), false) => self.options.frenet = !self.options.frenet,
             (Key::Char('k'), false) => self.options.curvature_comb = !self.options.curvature_comb,
             (Key::Char('p'), false) => self.hud.visible = !self.hud.visible,
+            (Key::Char('d'), false) => {
+                self.options.lod = !self.options.lod;
+                self.set_status(if self.options.lod {
+                    "level of detail: on (dense surfaces drawn from a strided subset)"
+                } else {
+                    "level of detail: off (every sample drawn)"
+                });
+            }
             (Key::Char('h'), false) | (Key::F1, _) => self.show_help = !self.show_help,
             (Key::Char('f'), false) => self.frame_selection(),
             (Key::Char('a'), false) => self.frame_all(),
