@@ -26,9 +26,10 @@ fn main() -> ExitCode {
             return ExitCode::FAILURE;
         }
     };
-    let out = args
-        .next()
-        .map_or_else(|| PathBuf::from(format!("teapots{}.json", n * n)), PathBuf::from);
+    let out = args.next().map_or_else(
+        || PathBuf::from(format!("teapots{}.json", n * n)),
+        PathBuf::from,
+    );
     let teapot = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/teapot.json");
     let result = Scene::load(&teapot)
         .map_err(|e| e.to_string())

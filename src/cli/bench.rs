@@ -171,6 +171,7 @@ fn run_headless(
             session
                 .hud
                 .push_frame(rec.frames().last().map_or(0.0, |f| f.frame_ms));
+            session.hud.gpu_ms = renderer.last_gpu_time_ms();
             progress.update(k + 1);
         }
         progress.finish(total);

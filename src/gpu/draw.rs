@@ -87,8 +87,10 @@ impl SurfaceGrid {
 
 /// Surfaces of one grid shape, each at its own float offset in one mirror, drawn with one
 /// stride in one call: many small patches (a teapot's 32, a scene's thousands) cost one
-/// multi-draw (`VK_EXT_multi_draw`) instead of a draw each. Offsets must be congruent modulo
-/// [`SurfaceGrid::FLOATS_PER_VERTEX`] (vertices of one mirror bound once).
+/// multi-draw (`VK_EXT_multi_draw`) instead of a draw each, and surfaces stored back to back
+/// (each offset the previous one's end) are a single range of a repeated index buffer
+/// within it. Offsets must be congruent modulo [`SurfaceGrid::FLOATS_PER_VERTEX`] (vertices
+/// of one mirror bound once).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SurfaceBatch<'a> {
     /// Shape shared by every surface.
@@ -357,9 +359,9 @@ impl Frame<'_> {
         ]
     }
 
-    /// Checks the batch against `mirror`; returns the byte offset to bind the vertices at
-    /// and each surface's vertex offset from there.
-    fn batch_offsets(mirror: &Mirror, batch: &SurfaceBatch) -> GpuResult<(u64, Vec<i32>)> {
+    /// Checks the batch against `mirror`; returns the byte offset to bind the vertices at and
+    /// the batch's runs: (vertex offset from there, number of surfaces stored back to back).
+    fn batch_runs(mirror: &Mirror, batch: &SurfaceBatch) -> GpuResult<(u64, Vec<(i32, u32)>)> {
         batch.shape.validate()?;
         let per = SurfaceGrid::FLOATS_PER_VERTEX;
         let floats = SurfaceGrid {
@@ -368,14 +370,22 @@ impl Frame<'_> {
         }
         .floats();
         let residue = batch.offsets.first().map_or(0, |o| o % per);
-        let mut vertex_offsets = Vec::with_capacity(batch.offsets.len());
+        let mut runs: Vec<(i32, u32)> = Vec::with_capacity(batch.offsets.len());
+        let mut next = None;
         for &offset in batch.offsets {
             let fits = offset
                 .checked_add(floats)
                 .is_some_and(|end| end <= mirror.len());
             let vertex = i32::try_from((offset - offset % per) / per).ok();
             match vertex {
-                Some(v) if fits && offset % per == residue => vertex_offsets.push(v),
+                Some(v) if fits && offset % per == residue => {
+                    match runs.last_mut() {
+                        // Right after the previous surface: the same run.
+                        Some(run) if next == Some(offset) => run.1 += 1,
+                        _ => runs.push((v, 1)),
+                    }
+                    next = Some(offset + floats);
+                }
                 _ => {
                     return Err(GpuError::InvalidArgument(format!(
                         "surface grid {}x{} at float {offset} does not fit a mirror of {} \
@@ -387,7 +397,7 @@ impl Frame<'_> {
                 }
             }
         }
-        Ok((residue as u64 * 4, vertex_offsets))
+        Ok((residue as u64 * 4, runs))
     }
 
     /// Draws a shaded grid surface from this frame's slot of `mirror`.
@@ -413,14 +423,16 @@ impl Frame<'_> {
         batch: &SurfaceBatch,
         style: &SurfaceStyle,
     ) -> GpuResult<()> {
-        let (base, vertex_offsets) = Self::batch_offsets(mirror, batch)?;
-        if vertex_offsets.is_empty() {
+        let (base, runs) = Self::batch_runs(mirror, batch)?;
+        let Some(longest) = runs.iter().map(|r| r.1).max() else {
             return Ok(());
-        }
+        };
         let r = &mut *self.renderer;
+        let release = &mut r.frames[self.slot].release;
+        let key = (batch.shape, batch.stride, longest);
         let ib = r
             .grids
-            .triangles(&r.device, &mut r.uploader, batch.shape, batch.stride)?;
+            .triangles(&r.device, &mut r.uploader, key, release)?;
         let (index_buffer, count) = (ib.buffer.raw, ib.count);
         let eye = self.camera.eye;
         let push = SurfacePush {
@@ -435,9 +447,9 @@ impl Frame<'_> {
             front: style.front,
             back: style.back,
         };
-        self.stats.surface_triangles += u64::from(count / 3) * vertex_offsets.len() as u64;
+        self.stats.surface_triangles += u64::from(count / 3) * batch.offsets.len() as u64;
         self.bind_and_push(self.pipelines.surface, &push);
-        self.draw_indexed(mirror, base, index_buffer, count, &vertex_offsets);
+        self.draw_indexed(mirror, base, index_buffer, count, &runs);
         Ok(())
     }
 
@@ -468,45 +480,46 @@ impl Frame<'_> {
         every: u32,
         color: [f32; 4],
     ) -> GpuResult<()> {
-        let (base, vertex_offsets) = Self::batch_offsets(mirror, batch)?;
-        if vertex_offsets.is_empty() {
+        let (base, runs) = Self::batch_runs(mirror, batch)?;
+        let Some(longest) = runs.iter().map(|r| r.1).max() else {
             return Ok(());
-        }
+        };
         let r = &mut *self.renderer;
-        let ib = r
-            .grids
-            .lines(&r.device, &mut r.uploader, batch.shape, every, batch.stride)?;
+        let release = &mut r.frames[self.slot].release;
+        let key = (batch.shape, every, batch.stride, longest);
+        let ib = r.grids.lines(&r.device, &mut r.uploader, key, release)?;
         let (index_buffer, count) = (ib.buffer.raw, ib.count);
         let push = WirePush {
             view_proj: self.view_proj(),
             color,
         };
         self.bind_and_push(self.pipelines.wire, &push);
-        self.draw_indexed(mirror, base, index_buffer, count, &vertex_offsets);
+        self.draw_indexed(mirror, base, index_buffer, count, &runs);
         Ok(())
     }
 
-    /// `count` indices of `index_buffer` once per vertex offset: one `vkCmdDrawMultiIndexedEXT`
-    /// (per `maxMultiDrawCount` offsets) where supported, else one draw each.
+    /// For each run (vertex offset, surfaces), the first `surfaces · count` indices of
+    /// `index_buffer` (copies of one grid's `count`): one `vkCmdDrawMultiIndexedEXT` (per
+    /// `maxMultiDrawCount` runs) where supported, else one draw per run.
     fn draw_indexed(
         &mut self,
         mirror: &Mirror,
         base: u64,
         index_buffer: vk::Buffer,
         count: u32,
-        vertex_offsets: &[i32],
+        runs: &[(i32, u32)],
     ) {
         self.bind_vertices(mirror.slot(self.slot).raw(), base);
         self.bind_indices(index_buffer);
         let device = &*self.renderer.device;
         match &device.multi_draw {
             Some(multi) => {
-                for chunk in vertex_offsets.chunks(multi.max_count as usize) {
+                for chunk in runs.chunks(multi.max_count as usize) {
                     let infos: Vec<vk::MultiDrawIndexedInfoEXT> = chunk
                         .iter()
-                        .map(|&vertex_offset| vk::MultiDrawIndexedInfoEXT {
+                        .map(|&(vertex_offset, surfaces)| vk::MultiDrawIndexedInfoEXT {
                             first_index: 0,
-                            index_count: count,
+                            index_count: count * surfaces,
                             vertex_offset,
                         })
                         .collect();
@@ -529,12 +542,17 @@ impl Frame<'_> {
                 }
             }
             None => {
-                for &vertex_offset in vertex_offsets {
+                for &(vertex_offset, surfaces) in runs {
                     // SAFETY: recording inside a rendering scope; ranges checked by the caller.
                     unsafe {
-                        device
-                            .raw
-                            .cmd_draw_indexed(self.cmd, count, 1, 0, vertex_offset, 0)
+                        device.raw.cmd_draw_indexed(
+                            self.cmd,
+                            count * surfaces,
+                            1,
+                            0,
+                            vertex_offset,
+                            0,
+                        )
                     };
                     self.stats.draws += 1;
                 }

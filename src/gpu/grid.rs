@@ -147,10 +147,39 @@ pub fn grid_lines_strided(shape: GridShape, every: u32, stride: GridStride) -> V
     out
 }
 
-/// A cached index buffer and its index count.
+/// A cached index buffer: `copies` back-to-back copies of one grid's `count` indices, copy
+/// `k` offset by `k` grids' vertices, so a run of `n ≤ copies` surfaces stored back to back
+/// draws as one range of `n · count` indices.
 pub(crate) struct IndexBuffer {
     pub buffer: Buffer,
     pub count: u32,
+    pub copies: u32,
+}
+
+/// `pattern` repeated for `copies` grids of `vertices` vertices each, stored back to back.
+fn repeated(pattern: &[u32], vertices: u32, copies: u32) -> Vec<u32> {
+    let mut out = Vec::with_capacity(pattern.len() * copies as usize);
+    for k in 0..copies {
+        out.extend(pattern.iter().map(|&i| i + k * vertices));
+    }
+    out
+}
+
+/// The copies to build for a run of `needed` grids: the next power of two (so a cache entry
+/// is rebuilt at most log₂ times), as long as every index stays below 2³².
+fn copies_for(shape: GridShape, needed: u32) -> GpuResult<u32> {
+    let fits = |c: u32| shape.vertices() * u64::from(c) <= u64::from(u32::MAX);
+    let c = needed.max(1).checked_next_power_of_two().unwrap_or(needed);
+    if fits(c) {
+        Ok(c)
+    } else if fits(needed) {
+        Ok(needed)
+    } else {
+        Err(GpuError::InvalidArgument(format!(
+            "{needed} grids of {}x{} need more than 2^32 vertices",
+            shape.rows, shape.cols
+        )))
+    }
 }
 
 /// Index buffers by shape + stride (triangles) and by shape + spacing + stride (lines).
@@ -164,61 +193,104 @@ fn upload_indices(
     device: &Device,
     uploader: &mut Uploader,
     name: &str,
-    indices: &[u32],
+    pattern: &[u32],
+    vertices: u32,
+    copies: u32,
 ) -> GpuResult<IndexBuffer> {
+    let indices = repeated(pattern, vertices, copies);
     let buffer = uploader.upload(
         device,
         name,
-        slice_bytes(indices),
+        slice_bytes(&indices),
         vk::BufferUsageFlags::INDEX_BUFFER,
         vk::PipelineStageFlags2::INDEX_INPUT,
         vk::AccessFlags2::INDEX_READ,
     )?;
     Ok(IndexBuffer {
         buffer,
-        count: indices.len() as u32,
+        count: pattern.len() as u32,
+        copies,
+    })
+}
+
+/// The cached buffer of `entry` if it holds at least `copies` copies, else a new one built by
+/// `build` in its place (the old buffer goes to `release`).
+fn cached<'a, K>(
+    entry: Entry<'a, K, IndexBuffer>,
+    copies: u32,
+    release: &mut Vec<Buffer>,
+    build: impl FnOnce(u32) -> GpuResult<IndexBuffer>,
+) -> GpuResult<&'a IndexBuffer> {
+    Ok(match entry {
+        Entry::Occupied(e) if e.get().copies >= copies => e.into_mut(),
+        Entry::Occupied(mut e) => {
+            let old = std::mem::replace(e.get_mut(), build(copies)?);
+            release.push(old.buffer);
+            e.into_mut()
+        }
+        Entry::Vacant(e) => e.insert(build(copies)?),
     })
 }
 
 impl GridCache {
+    /// Triangles of the strided mesh, for runs of up to `copies` grids stored back to back.
+    /// A cached buffer too short for `copies` is replaced; the old one goes to `release`
+    /// (freed once the current frame's slot is next waited for, after every earlier frame).
     pub(crate) fn triangles(
         &mut self,
         device: &Device,
         uploader: &mut Uploader,
-        shape: GridShape,
-        stride: GridStride,
+        key: (GridShape, GridStride, u32),
+        release: &mut Vec<Buffer>,
     ) -> GpuResult<&IndexBuffer> {
+        let (shape, stride, copies) = key;
         shape.validate()?;
         let stride = stride.normalized();
-        Ok(match self.triangles.entry((shape, stride)) {
-            Entry::Occupied(e) => e.into_mut(),
-            Entry::Vacant(e) => e.insert(upload_indices(
+        let build = |copies: u32, uploader: &mut Uploader| {
+            let c = copies_for(shape, copies)?;
+            let pattern = grid_triangles_strided(shape, stride);
+            upload_indices(
                 device,
                 uploader,
                 "grid triangles",
-                &grid_triangles_strided(shape, stride),
-            )?),
-        })
+                &pattern,
+                shape.vertices() as u32,
+                c,
+            )
+        };
+        cached(
+            self.triangles.entry((shape, stride)),
+            copies,
+            release,
+            |c| build(c, uploader),
+        )
     }
 
+    /// Isolines over the strided mesh, for runs of up to `copies` grids (see `triangles`).
     pub(crate) fn lines(
         &mut self,
         device: &Device,
         uploader: &mut Uploader,
-        shape: GridShape,
-        every: u32,
-        stride: GridStride,
+        key: (GridShape, u32, GridStride, u32),
+        release: &mut Vec<Buffer>,
     ) -> GpuResult<&IndexBuffer> {
+        let (shape, every, stride, copies) = key;
         shape.validate()?;
         let key = (shape, every.max(1), stride.normalized());
-        Ok(match self.lines.entry(key) {
-            Entry::Occupied(e) => e.into_mut(),
-            Entry::Vacant(e) => e.insert(upload_indices(
+        let build = |copies: u32, uploader: &mut Uploader| {
+            let c = copies_for(shape, copies)?;
+            let pattern = grid_lines_strided(shape, key.1, key.2);
+            upload_indices(
                 device,
                 uploader,
                 "grid lines",
-                &grid_lines_strided(shape, key.1, key.2),
-            )?),
+                &pattern,
+                shape.vertices() as u32,
+                c,
+            )
+        };
+        cached(self.lines.entry(key), copies, release, |c| {
+            build(c, uploader)
         })
     }
 
@@ -283,6 +355,23 @@ mod tests {
             grid_triangles_strided(shape, big),
             vec![0, 63, 6, 6, 63, 69]
         );
+    }
+
+    #[test]
+    fn copies_index_consecutive_grids() {
+        let shape = GridShape { rows: 2, cols: 2 };
+        let one = grid_triangles(shape);
+        let three = repeated(&one, 4, 3);
+        assert_eq!(three.len(), 3 * one.len());
+        assert_eq!(&three[6..12], &[4, 6, 5, 5, 6, 7]);
+        assert_eq!(copies_for(shape, 3).unwrap(), 4);
+        assert_eq!(copies_for(shape, 0).unwrap(), 1);
+        let big = GridShape {
+            rows: 65536,
+            cols: 32768,
+        };
+        assert_eq!(copies_for(big, 1).unwrap(), 1);
+        assert!(copies_for(big, 2).is_err());
     }
 
     #[test]
