@@ -25,6 +25,7 @@
 //! frame.set_camera(Camera::default());
 //! frame.draw_surface(&mirror, grid, &SurfaceStyle::default())?;
 //! frame.draw_wire(&mirror, grid, 8, [0.0, 0.0, 0.0, 1.0])?;
+//! frame.capture(); // copy the image out for read_pixels (frames copy nothing by default)
 //! frame.finish()?;
 //! let pixels = renderer.read_pixels(&target)?;
 //! # renderer.destroy_mirror(mirror);
@@ -39,7 +40,8 @@
 //!   every change made since *it* was last written (keep per-slot dirty ranges).
 //! * Draw calls record into the frame; rendering begins lazily with the clear.
 //! * [`Frame::finish`] ends recording, flushes non-coherent host writes (aligned to
-//!   `nonCoherentAtomSize`), submits with `vkQueueSubmit2`, presents for swapchains.
+//!   `nonCoherentAtomSize`), submits with `vkQueueSubmit2`, presents for swapchains. If it
+//!   fails, the slot stays usable (see the README's "Errors and failure injection").
 //!
 //! Mapped memory is never read: mirrors expose only writes (it may be write-combined).
 //!
