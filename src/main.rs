@@ -97,11 +97,15 @@ enum Command {
         /// Output directory for the reports.
         #[arg(long, default_value = "bench-out", value_name = "DIR")]
         out: PathBuf,
-        /// MSAA samples (1, 2, 4, 8); 0 picks 4 where supported.
+        /// MSAA samples (1, 2, 4, 8); 0 picks the device's default: 1 on CPU rasterisers such
+        /// as lavapipe, 4 on GPUs (see README "Interactive frames").
         #[arg(long, default_value_t = 0)]
         msaa: u32,
         #[command(flatten)]
         memory: MemoryArgs,
+        /// Draw every sample of every surface (no display level of detail), for comparison.
+        #[arg(long)]
+        no_lod: bool,
     },
     /// Render a scene headless (no display needed) into a PNG image.
     Render {
@@ -120,8 +124,9 @@ enum Command {
         /// Edits (JSON list) applied before rendering.
         #[arg(long, value_name = "EDITS.json")]
         edits: Option<PathBuf>,
-        /// MSAA samples (1, 2, 4, 8); 0 picks 4 where supported.
-        #[arg(long, default_value_t = 0)]
+        /// MSAA samples (1, 2, 4, 8); a still image is worth 4; 0 picks the device's interactive
+        /// default (1 on CPU rasterisers, 4 on GPUs).
+        #[arg(long, default_value_t = 4)]
         msaa: u32,
         #[command(flatten)]
         display: DisplayArgs,
@@ -195,6 +200,9 @@ struct DisplayArgs {
     /// Draw curvature combs along curves.
     #[arg(long)]
     comb: bool,
+    /// Draw every sample of every surface (no display level of detail).
+    #[arg(long)]
+    no_lod: bool,
 }
 
 impl DisplayArgs {
@@ -210,6 +218,7 @@ impl DisplayArgs {
             normals: self.normals,
             frenet: self.frenet,
             curvature_comb: self.comb,
+            lod: !self.no_lod,
             ..ViewOptions::default()
         }
     }
@@ -266,6 +275,7 @@ fn main() -> ExitCode {
             out,
             msaa,
             memory,
+            no_lod,
         } => {
             let args = cli::bench::BenchArgs {
                 scene,
@@ -278,6 +288,7 @@ fn main() -> ExitCode {
                 out,
                 msaa,
                 memory: memory.budget(),
+                lod: !no_lod,
             };
             cli::bench::run(&args).map(|line| eprintln!("{line}"))
         }

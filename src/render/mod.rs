@@ -5,11 +5,13 @@
 pub mod camera;
 pub mod document;
 pub mod gpu_scene;
+pub mod lod;
 pub mod offscreen;
 pub mod overlays;
 pub mod style;
 
 pub use camera::{Bounds, OrbitCamera};
 pub use document::{Controls, DocObject, Document, Handle};
-pub use gpu_scene::{GpuScene, Highlight, UploadStats};
+pub use gpu_scene::{DrawReport, GpuScene, Highlight, UploadStats};
+pub use lod::Lod;
 pub use style::{NetMode, Palette, ViewOptions, Wire};
