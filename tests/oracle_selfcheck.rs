@@ -13,6 +13,7 @@ mod oracle;
 use oracle::bfunction::{self, BFunction, EXPO_SCALE};
 use oracle::blossom::Spline;
 use oracle::compare::compare_output;
+use oracle::condition::{compare_conditioned, compare_refined_outputs, condition_scales};
 use oracle::eval::{
     self, Basis, Homogeneous, Point3, bspline_derivatives, project_curve_derivatives,
 };
@@ -1972,20 +1973,18 @@ fn refined_quarter_circle_stays_on_the_circle() {
     }
 }
 
-/// Max over objects and derivative orders of |after − before| / max(1, |before|), at the
-/// oracle's parameters (the domain does not change; a Bézier object that became a B-spline
-/// one is compared as what it was).
+/// Max over objects and derivative orders of |after − before| relative to the condition
+/// scales of the two nets (`oracle::condition`), at the oracle's parameters (the domain does
+/// not change).
 fn shape_change(before: &Scene, after: &Scene, n: usize) -> f64 {
-    let mut out = after.sample_json(n);
-    for (entry, object) in out["objects"]
-        .as_array_mut()
-        .unwrap()
-        .iter_mut()
-        .zip(&before.objects)
-    {
-        entry["type"] = json!(object.type_name());
-    }
-    let report = compare_output(before, n, &out, f64::INFINITY);
+    let report = compare_refined_outputs(
+        before,
+        after,
+        n,
+        &before.sample_json(n),
+        &after.sample_json(n),
+        f64::INFINITY,
+    );
     assert!(report.problems.is_empty(), "{}", report.describe());
     report.max_relative_error
 }
@@ -2073,7 +2072,6 @@ fn structural_edits_keep_the_shape_and_refine_the_knots() {
         let n = (seed % 5) as usize;
         let mix = random::StructuralMix {
             max_points: 16,
-            min_polynomial_elevation: n,
             ..Default::default()
         };
         let original = random::random_scene(seed, &kinds, &opts);
@@ -2092,7 +2090,7 @@ fn structural_edits_keep_the_shape_and_refine_the_knots() {
         }
         let change = shape_change(&original, &scene, n);
         assert!(
-            change < 1e-13,
+            change < 1e-14,
             "seed {seed}: shape changed by {change:e}\nbefore: {}\nafter: {}",
             original.to_json(),
             scene.to_json()
@@ -2276,4 +2274,215 @@ fn random_structural_edits_cover_the_contract() {
             "generator rarely produces {key:?}: {seen:?}"
         );
     }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Condition scales (tests/oracle/condition.rs), the measure of the structural agreement tests
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn condition_scales_by_hand() {
+    // C(t) = (1−t) P0 + t P1 with P0 = (1,0,0), P1 = (3,0,0), at t = 0 and 1:
+    //   order 0: Σ|N_i||P_i| = (1−t)·1 + t·3, largest 3;  order 1: |−1|·1 + |1|·3 = 4.
+    let line = |weights: Option<Vec<f64>>| {
+        curve(&[[1.0, 0.0, 0.0], [3.0, 0.0, 0.0]], weights, Basis::Bezier)
+    };
+    let params = vec![vec![0.0, 1.0]];
+    assert_eq!(
+        condition_scales(&line(None), &params, 1).unwrap(),
+        vec![3.0, 4.0]
+    );
+    // With unit weights the quotient rule adds the weights' bounds (w = 1, w' = 0, C = 1 + 2t,
+    // C' = 2): order 0: (1+2t) + 1·|C| = 2 + 4t → 6; order 1: 4 + 1·|C'| + (|−1|+|1|)·|C| + 0
+    // = 8 + 4t → 12.
+    assert_eq!(
+        condition_scales(&line(Some(vec![1.0, 1.0])), &params, 1).unwrap(),
+        vec![6.0, 12.0]
+    );
+    // ERBS objects have none.
+    let scene = random::random_scene(1, &[Kind::ErbsCurve], &Options::default());
+    let erbs = &scene.objects[0];
+    assert!(condition_scales(erbs, &erbs.params(), 1).is_none());
+}
+
+#[test]
+fn condition_scales_bound_values_and_rounding_of_the_net() {
+    let kinds = [
+        Kind::BezierCurve,
+        Kind::BSplineCurve,
+        Kind::BezierSurface,
+        Kind::BSplineSurface,
+    ];
+    let opts = Options {
+        max_samples: 9,
+        ..Options::default()
+    };
+    let mut worst = 0.0f64;
+    for seed in 0..60 {
+        let scene = random::random_scene(seed, &kinds, &opts);
+        let n = (seed % 4) as usize + 1;
+        // A polynomial order's condition scale is at least its largest value.
+        for object in &scene.objects {
+            if matches!(
+                object.shape,
+                Shape::Curve { weights: None, .. } | Shape::Surface { weights: None, .. }
+            ) {
+                let scales = condition_scales(object, &object.params(), n).unwrap();
+                let values = object.sample_json(n)["samples"].clone();
+                let largest = flatten_numbers(&values)
+                    .into_iter()
+                    .fold(0.0f64, |m, x| m.max(x.abs()));
+                let top = scales.iter().fold(0.0f64, |m, &x| m.max(x));
+                assert!(
+                    top >= largest * (1.0 - 1e-15),
+                    "seed {seed}: {top} < {largest}"
+                );
+            }
+        }
+        // Rounding every control coordinate and weight by a relative δ moves each sample by
+        // at most δ times the condition scale (first order).
+        let delta = 1e-11;
+        let mut rng = Rng::new(seed);
+        let mut nudge = |x: &mut f64| *x *= 1.0 + delta * rng.range(-1.0, 1.0);
+        let mut perturbed = scene.clone();
+        for object in &mut perturbed.objects {
+            match &mut object.shape {
+                Shape::Curve {
+                    points, weights, ..
+                } => {
+                    points.iter_mut().flatten().for_each(&mut nudge);
+                    weights.iter_mut().flatten().for_each(&mut nudge);
+                }
+                Shape::Surface {
+                    points, weights, ..
+                } => {
+                    points.iter_mut().flatten().flatten().for_each(&mut nudge);
+                    weights.iter_mut().flatten().flatten().for_each(&mut nudge);
+                }
+                _ => unreachable!(),
+            }
+        }
+        let report = compare_conditioned(&scene, n, &perturbed.sample_json(n), f64::INFINITY);
+        assert!(report.problems.is_empty(), "{}", report.describe());
+        worst = worst.max(report.max_relative_error / delta);
+    }
+    println!("rounding by δ moved samples by at most {worst:.3} δ·(condition scale)");
+    assert!(worst <= 1.0 + 1e-3, "{worst}");
+    assert!(worst > 0.05, "the perturbation did not register: {worst}");
+}
+
+#[test]
+fn conditioned_comparisons_detect_mismatches() {
+    let kinds = [
+        Kind::BezierCurve,
+        Kind::BSplineSurface,
+        Kind::ErbsCurve,
+        Kind::BSplineCurve,
+    ];
+    let opts = Options {
+        max_samples: 5,
+        rational_chance: 0.5,
+        ..Options::default()
+    };
+    // A seed whose B-spline surface has room for a knot in u.
+    let scene = (0..)
+        .map(|seed| random::random_scene(seed, &kinds, &opts))
+        .find(|s| {
+            matches!(&s.objects[1].shape,
+                Shape::Surface { basis: [Basis::BSpline { degree, .. }, _], points, .. }
+                    if *degree >= 1 && points.len() > *degree)
+        })
+        .unwrap();
+    let n = 2;
+    let out = scene.sample_json(n);
+    let report = compare_conditioned(&scene, n, &out, 1e-13);
+    assert!(report.ok(), "{}", report.describe());
+    assert!(report.compared > 0);
+
+    // One number of the surface and of a curve off by 1e-11 of its condition scale: one
+    // mismatch each, located.
+    for (object, path, slot) in [
+        (1usize, vec![1usize, 0, 1, 0, 2], n + 1),
+        (3, vec![2, 1, 0], 1),
+    ] {
+        let o = &scene.objects[object];
+        let scale = condition_scales(o, &o.params(), n).unwrap()[slot];
+        let mut bad = out.clone();
+        let mut cell = &mut bad["objects"][object]["samples"];
+        for &i in &path {
+            cell = &mut cell[i];
+        }
+        let x = cell.as_f64().unwrap();
+        *cell = json!(x + 1e-11 * scale);
+        let report = compare_conditioned(&scene, n, &bad, 1e-13);
+        assert_eq!(report.mismatch_count, 1, "{}", report.describe());
+        assert_eq!(report.mismatches[0].object, format!("o{object}"));
+    }
+    // The ERBS curve is held to its values by compare_output.
+    let mut bad = out.clone();
+    let x = bad["objects"][2]["samples"][1][0][0].as_f64().unwrap();
+    bad["objects"][2]["samples"][1][0][0] = json!(x + 1e-9 * x.abs().max(1.0));
+    assert_eq!(
+        compare_conditioned(&scene, n, &bad, 1e-13).mismatch_count,
+        1
+    );
+    // A last-bit change passes.
+    let mut fine = out.clone();
+    let x = fine["objects"][0]["samples"][1][1][0].as_f64().unwrap();
+    fine["objects"][0]["samples"][1][1][0] = json!(x * (1.0 + f64::EPSILON));
+    assert!(compare_conditioned(&scene, n, &fine, 1e-13).ok());
+    // Structure: a missing object, a wrong type, a non-number.
+    let mut missing = out.clone();
+    missing["objects"].as_array_mut().unwrap().remove(0);
+    assert!(!compare_conditioned(&scene, n, &missing, 1e-13).ok());
+    let mut typed = out.clone();
+    typed["objects"][0]["type"] = json!("bspline_curve");
+    assert!(!compare_conditioned(&scene, n, &typed, 1e-13).ok());
+    let mut nan = out.clone();
+    nan["objects"][3]["samples"][0][0][1] = json!(null);
+    assert!(!compare_conditioned(&scene, n, &nan, 1e-13).ok());
+
+    // compare_refined_outputs: a correct refinement passes, a refined net off by 1e-10 does not.
+    let mut refined = scene.clone();
+    apply_edits(
+        &mut refined,
+        &[
+            parse_edit(json!({"object": "o0", "elevate_degree": 1})),
+            parse_edit(
+                json!({"object": "o1", "insert_knot": {"u": refined_middle(&scene.objects[1])}}),
+            ),
+        ],
+    )
+    .unwrap();
+    let after = refined.sample_json(n);
+    let report = compare_refined_outputs(&scene, &refined, n, &out, &after, 1e-13);
+    assert!(report.ok(), "{}", report.describe());
+    let mut wrong = refined.clone();
+    if let Shape::Surface { points, .. } = &mut wrong.objects[1].shape {
+        let p = &mut points[1][0];
+        p[0] += 1e-10 * p[0].abs().max(1.0);
+    }
+    let report = compare_refined_outputs(&scene, &refined, n, &out, &wrong.sample_json(n), 1e-13);
+    assert!(!report.ok() && report.mismatch_count > 0);
+    // Changed parameters are a problem, not a pass.
+    let mut moved = after.clone();
+    let t = moved["objects"][0]["params"][1].as_f64().unwrap();
+    moved["objects"][0]["params"][1] = json!(t + 1e-12);
+    assert!(!compare_refined_outputs(&scene, &refined, n, &out, &moved, 1e-13).ok());
+}
+
+/// A parameter inside the u domain of a B-spline surface that is not a knot there.
+fn refined_middle(object: &Object) -> f64 {
+    let (a, b) = object.domains()[0];
+    let Shape::Surface {
+        basis: [Basis::BSpline { knots, .. }, _],
+        ..
+    } = &object.shape
+    else {
+        unreachable!()
+    };
+    (1..)
+        .map(|k| a + (b - a) * (0.5 + 0.1 / f64::from(k)))
+        .find(|t| !knots.contains(t))
+        .unwrap()
 }

@@ -21,6 +21,7 @@
 //! Submodules: [`bfunction`] (the five B-functions), [`eval`] (point evaluation), [`blossom`]
 //! (refinement by polar forms), [`scene`]
 //! (scene/edit JSON, model, `sample` output), [`compare`] (product vs oracle, error measure),
+//! [`condition`] (condition scales for refined control nets),
 //! [`random`] + [`rng`] (seeded scenes and edit lists). `gen_expo_table.py` regenerates
 //! `tests/data/expo_bfunction_reference.json` with mpmath; the tests themselves need no Python.
 //!
@@ -35,6 +36,7 @@
 pub mod bfunction;
 pub mod blossom;
 pub mod compare;
+pub mod condition;
 pub mod eval;
 pub mod random;
 pub mod rng;

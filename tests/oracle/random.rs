@@ -497,11 +497,6 @@ pub struct StructuralMix {
     pub max_degree: usize,
     /// No structural edit on a direction that already has this many control points.
     pub max_points: usize,
-    /// A polynomial (non-rational) direction of lower degree is not elevated. Set it to the
-    /// derivative order sampled: derivatives above a polynomial's degree vanish identically,
-    /// and after elevation any f64 control net leaves rounding noise there (about
-    /// ε·|P|·q!/h^r) that no relative measure against zero can hold.
-    pub min_polynomial_elevation: usize,
 }
 
 impl Default for StructuralMix {
@@ -510,7 +505,6 @@ impl Default for StructuralMix {
             chance: 0.3,
             max_degree: 6,
             max_points: 24,
-            min_polynomial_elevation: 0,
         }
     }
 }
@@ -555,7 +549,8 @@ fn multiplicity(knots: &[f64], t: f64) -> usize {
 }
 
 /// A knot parameter strictly inside the domain with room for at least one more copy, and how
-/// many copies to insert: an existing interior knot, a sample parameter, or any value.
+/// many copies to insert: an existing interior knot, a sample parameter, or any value inside a
+/// span (short new spans included: `oracle::condition` measures what they cost).
 fn random_insertion(
     rng: &mut Rng,
     degree: usize,
@@ -566,12 +561,19 @@ fn random_insertion(
     let (a, b) = (knots[degree], knots[n]);
     let room = |t: f64| degree.saturating_sub(multiplicity(knots, t));
     let inside = |t: &f64| a < *t && *t < b && room(*t) > 0;
+    let spans: Vec<(f64, f64)> = (degree..n)
+        .map(|s| (knots[s], knots[s + 1]))
+        .filter(|(lo, hi)| lo < hi)
+        .collect();
     let existing: Vec<f64> = knots.iter().copied().filter(inside).collect();
     let on_samples: Vec<f64> = params.iter().copied().filter(inside).collect();
     let t = match rng.int(0, 9) {
         0..=2 if !existing.is_empty() => *rng.pick(&existing),
         3..=4 if !on_samples.is_empty() => *rng.pick(&on_samples),
-        _ => a + (b - a) * rng.range(0.02, 0.98),
+        _ => {
+            let (lo, hi) = *rng.pick(&spans);
+            lo + (hi - lo) * rng.range(0.02, 0.98)
+        }
     };
     if !inside(&t) {
         return None;
@@ -605,36 +607,12 @@ pub fn random_insertion_edit(rng: &mut Rng, object: &Object) -> Option<Edit> {
     })
 }
 
-/// Whether `object` has weights that are not all equal (equal weights are a polynomial).
-pub fn is_rational(object: &Object) -> bool {
-    let weights: Vec<f64> = match &object.shape {
-        Shape::Curve {
-            weights: Some(w), ..
-        } => w.clone(),
-        Shape::Surface {
-            weights: Some(w), ..
-        } => w.iter().flatten().copied().collect(),
-        _ => return false,
-    };
-    weights.iter().any(|&w| w != weights[0])
-}
-
-/// A random `elevate_degree` edit valid for `object` that keeps every degree ≤ `mix.max_degree`
-/// and elevates no polynomial direction of degree below `mix.min_polynomial_elevation`.
+/// A random `elevate_degree` edit valid for `object` that keeps every degree ≤ `mix.max_degree`.
 pub fn random_elevation_edit(rng: &mut Rng, object: &Object, mix: &StructuralMix) -> Option<Edit> {
     let directions = refinable_directions(object)?;
-    let min_degree = if is_rational(object) {
-        0
-    } else {
-        mix.min_polynomial_elevation
-    };
     let amount = |degree: usize, rng: &mut Rng| -> usize {
         let e = if rng.chance(0.75) { 1 } else { 2 };
-        if degree + e <= mix.max_degree && degree >= min_degree {
-            e
-        } else {
-            0
-        }
+        if degree + e <= mix.max_degree { e } else { 0 }
     };
     let by = if directions.len() == 1 {
         let e = amount(directions[0].0, rng);

@@ -1144,12 +1144,15 @@ fn refined_basis<const D: usize>(was: &Basis, r: Refinement, spline: &Spline<D>)
     }
 }
 
+/// A refined basis and its control polygons (or grid rows).
+type Refined<const D: usize> = (Basis, Vec<Vec<[f64; D]>>);
+
 /// Refines every control polygon in `lines` (all on `basis`); returns the new basis and lines.
 fn refine_lines<const D: usize>(
     basis: &Basis,
     lines: &[Vec<[f64; D]>],
     r: Refinement,
-) -> Result<(Basis, Vec<Vec<[f64; D]>>), String> {
+) -> Result<Refined<D>, String> {
     let mut out = Vec::with_capacity(lines.len());
     let mut new_basis = None;
     for line in lines {
@@ -1180,7 +1183,7 @@ fn refine_grid<const D: usize>(
     grid: &[Vec<[f64; D]>],
     dir: usize,
     r: Refinement,
-) -> Result<(Basis, Vec<Vec<[f64; D]>>), String> {
+) -> Result<Refined<D>, String> {
     if dir == 0 {
         let (b, columns) = refine_lines(basis, &transpose(grid), r)?;
         Ok((b, transpose(&columns)))
