@@ -751,7 +751,8 @@ fn insertion_then_new_point_edits(seed: u64, scene: &Scene) -> Vec<Edit> {
 /// derivatives, with and without --full"): after random insertions and elevations only, both
 /// paths give the unedited scene's samples to within `TOL_CONDITIONED` of the condition scales
 /// of the nets before and after (the oracle's models of them). Bézier objects that became
-/// B-splines included; the ERBS curve, untouched, must not move either.
+/// B-splines included; the ERBS curve, untouched, must not move either. The product's refined
+/// nets also have the oracle's control counts (`check_refined_counts`).
 #[test]
 fn structural_edits_alone_leave_samples_unchanged() {
     let seeds = seeds(16, 10);
@@ -775,6 +776,12 @@ fn structural_edits_alone_leave_samples_unchanged() {
         }
         structural += edits.len();
         let label = format!("unchanged-seed{seed}-n{n}");
+        if let Err(e) = check_refined_counts(&dir, &label, scene, &model, &edits) {
+            summary.runs += 1;
+            summary
+                .failures
+                .push(format!("[{label}] control counts: {e}"));
+        }
         let before = match sample_output(&dir, &label, scene, None, n, false) {
             Ok(out) => out,
             Err(e) => {
@@ -820,4 +827,62 @@ fn structural_edits_alone_leave_samples_unchanged() {
         "only {structural} structural edits"
     );
     summary.finish("unchanged");
+}
+
+/// The product's refined nets have the oracle's control counts: after `edits`, a point edit at
+/// the last index of every Bézier/B-spline object's net is accepted and one just past it (in
+/// each direction) is refused naming the field `point`.
+fn check_refined_counts(
+    dir: &Path,
+    label: &str,
+    scene: &Scene,
+    model: &Scene,
+    edits: &[Edit],
+) -> Result<(), String> {
+    use oracle::scene::{Index, Shape};
+    for object in &model.objects {
+        let (last, past): (Index, Vec<Index>) = match &object.shape {
+            Shape::Curve { points, .. } => {
+                (Index::One(points.len() - 1), vec![Index::One(points.len())])
+            }
+            Shape::Surface { points, .. } => {
+                let (nu, nv) = (points.len(), points[0].len());
+                (
+                    Index::Two(nu - 1, nv - 1),
+                    vec![Index::Two(nu, 0), Index::Two(0, nv)],
+                )
+            }
+            _ => continue,
+        };
+        let with = |point: Index| -> Vec<Edit> {
+            let mut list = edits.to_vec();
+            list.push(Edit::PointDelta {
+                object: object.name.clone(),
+                point,
+                delta: [0.0, 0.0, 0.0],
+            });
+            list
+        };
+        let probe = format!("{label}-counts-{}", object.name);
+        sample_output(dir, &probe, scene, Some(&with(last)), 0, false)
+            .map_err(|e| format!("{}: the last point {last:?} was refused: {e}", object.name))?;
+        for point in past {
+            match sample_output(dir, &probe, scene, Some(&with(point)), 0, false) {
+                Ok(_) => {
+                    return Err(format!(
+                        "{}: {point:?} past the net was accepted",
+                        object.name
+                    ));
+                }
+                Err(e) if e.contains("'point'") && e.contains(&format!("'{}'", object.name)) => {}
+                Err(e) => {
+                    return Err(format!(
+                        "{}: {point:?}: unexpected refusal {e}",
+                        object.name
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
 }
