@@ -220,26 +220,30 @@ fn parameter_not_a_number() {
 }
 
 #[test]
-fn erbs_objects_are_refused() {
-    refused(
-        r#"[{"object": "e", "insert_knot": 0.5}]"#,
-        "e",
-        "insert_knot",
-    );
+fn erbs_objects_refine_by_their_own_insertion_only() {
+    // ERBS refinement inserts a local between two knots; B-spline refinement does not apply.
+    accepted(r#"[{"object": "e", "insert_knot": 0.5}]"#);
+    accepted(r#"[{"object": "es", "insert_knot": {"u": 0.5}}]"#);
     refused(
         r#"[{"object": "e", "elevate_degree": 1}]"#,
         "e",
         "elevate_degree",
     );
     refused(
-        r#"[{"object": "es", "insert_knot": {"u": 0.5}}]"#,
-        "es",
-        "insert_knot",
-    );
-    refused(
         r#"[{"object": "es", "elevate_degree": {"u": 1}}]"#,
         "es",
         "elevate_degree",
+    );
+    refused(r#"[{"object": "e", "insert_knot": 1}]"#, "e", "insert_knot");
+    refused(
+        r#"[{"object": "e", "insert_knot": 0.5}, {"object": "e", "insert_knot": 0.5}]"#,
+        "e",
+        "insert_knot",
+    );
+    refused(
+        r#"[{"object": "es", "insert_knot": {"v": -0.5}}]"#,
+        "es",
+        "insert_knot",
     );
 }
 

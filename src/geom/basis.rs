@@ -128,6 +128,13 @@ pub fn hermite_rows_into(
         for j in 0..w {
             out[r * w + j] = scale * cur[j];
         }
+        // The basis functions sum to 1, so every derivative row sums to 0. Rounding leaves a
+        // residual that locally constant weights (w' = Σ N_k' w_k) turn into noise multiplied
+        // into higher derivatives by the quotient rule; make the sum, taken in the order dot
+        // products take it, exactly 0 by giving the residual to the last entry.
+        let row = &mut out[r * w..(r + 1) * w];
+        let partial = row[..w - 1].iter().fold(0.0, |acc, &x| acc + x);
+        row[w - 1] = -partial;
     }
 }
 

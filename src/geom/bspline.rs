@@ -248,6 +248,19 @@ impl BSplineCurve {
             ));
         }
         let p = self.degree;
+        if p == 0 {
+            // Piecewise constant: the span holding t is simply cut in two.
+            let k = self.find_span(t);
+            let u = &self.knots;
+            let mut lk = u[..=k].to_vec();
+            lk.push(t);
+            let mut rk = vec![t];
+            rk.extend_from_slice(&u[k + 1..]);
+            let q = self.homogeneous_points();
+            let left = self.with_homogeneous(KnotVector::new(lk)?, q[..=k].to_vec());
+            let right = self.with_homogeneous(KnotVector::new(rk)?, q[k..].to_vec());
+            return Ok((left, right));
+        }
         let s = self.knots.multiplicity(t);
         let c = if s < p {
             self.insert_knot(t, p - s)?
@@ -255,7 +268,9 @@ impl BSplineCurve {
             self.clone()
         };
         let u = &c.knots;
-        let first = u.iter().position(|&x| x == t).expect("t was inserted");
+        let Some(first) = u.iter().position(|&x| x == t) else {
+            return Err(GeomError::new("parameter", format!("cannot split at {t}")));
+        };
         let q = c.homogeneous_points();
         // With multiplicity p the curve interpolates q[first−1]; with p+1 (a jump) the left piece
         // ends with q[first−1] and the right one starts with q[first].

@@ -222,6 +222,19 @@ impl TensorSurface {
             ));
         }
         let p = self.degree[dir];
+        if p == 0 {
+            // Piecewise constant in `dir`: the span holding t is cut in two.
+            let n = self.count[dir];
+            let k = self.knots[dir].find_span(0, n, t);
+            let u = &self.knots[dir];
+            let mut lk = u[..=k].to_vec();
+            lk.push(t);
+            let mut rk = vec![t];
+            rk.extend_from_slice(&u[k + 1..]);
+            let left = self.sliced(dir, 0..k + 1, KnotVector::new(lk)?);
+            let right = self.sliced(dir, k..n, KnotVector::new(rk)?);
+            return Ok((left, right));
+        }
         let s = self.knots[dir].multiplicity(t);
         let c = if s < p {
             self.with_knot(dir, t, p - s)
@@ -229,7 +242,9 @@ impl TensorSurface {
             self.clone()
         };
         let u = &c.knots[dir];
-        let first = u.iter().position(|&x| x == t).expect("t was inserted");
+        let Some(first) = u.iter().position(|&x| x == t) else {
+            return Err(GeomError::new("parameter", format!("cannot split at {t}")));
+        };
         let mult = u.multiplicity(t);
         let right_start = if mult == p + 1 { first } else { first - 1 };
         let mut lk = u[..first].to_vec();
