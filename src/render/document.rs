@@ -5,8 +5,8 @@ use super::camera::Bounds;
 use crate::geom::knots::uniform_params;
 use crate::geom::{BezierCurve, TensorSurface};
 use crate::model::{
-    CurveEdit, Edit, EditError, ErbsCurveEdit, ErbsSurfaceEdit, Index2, KindEdit, LocalEdit,
-    ModelRef, ObjectEdit, PointEdit, SurfaceEdit,
+    BezierSplineEdit, CatmullRomEdit, CurveEdit, Edit, EditError, ErbsCurveEdit, ErbsSurfaceEdit,
+    Index2, KindEdit, LocalEdit, ModelRef, ObjectEdit, PointEdit, SurfaceEdit,
 };
 use crate::sampling::{DirtyRegion, SampleMode, SampledObject};
 use crate::scene::{Scene, SceneObject};
@@ -144,6 +144,11 @@ impl Document {
     pub fn controls(&self, i: usize) -> Controls {
         match self.objects[i].sampled.model() {
             ModelRef::Curve(c) => Controls::Polygon(c.curve().points().to_vec()),
+            // The interpolated points.
+            ModelRef::CatmullRom(c) => Controls::Polygon(c.spline().points().to_vec()),
+            // Bézier points, or the de Boor polygon of splines edited through it (their Bézier
+            // points are drawn as an overlay).
+            ModelRef::BezierSpline(c) => Controls::Polygon(c.spline().handles()),
             ModelRef::Surface(s) => {
                 let s = s.surface();
                 let [rows, cols] = s.count();
@@ -172,7 +177,19 @@ impl Document {
     /// Every pickable control point of object `i` with its position (no sampling: cheap).
     pub fn handles(&self, i: usize) -> Vec<(Handle, DVec3)> {
         let object = i;
+        let polygon = |points: Vec<DVec3>| {
+            points
+                .into_iter()
+                .enumerate()
+                .map(|(k, q)| {
+                    let point = Index2::One(k);
+                    (Handle::Point { object, point }, q)
+                })
+                .collect()
+        };
         match self.objects[i].sampled.model() {
+            ModelRef::CatmullRom(c) => polygon(c.spline().points().to_vec()),
+            ModelRef::BezierSpline(c) => polygon(c.spline().handles()),
             ModelRef::Curve(c) => c
                 .curve()
                 .points()
@@ -266,6 +283,20 @@ impl Document {
                 },
                 ModelRef::Curve(_),
             ) => CurveEdit::Point(PointEdit::Move { point, delta }).into_object(),
+            (
+                Handle::Point {
+                    point: Index2::One(point),
+                    ..
+                },
+                ModelRef::CatmullRom(_),
+            ) => CatmullRomEdit::Point(PointEdit::Move { point, delta }).into_object(),
+            (
+                Handle::Point {
+                    point: Index2::One(point),
+                    ..
+                },
+                ModelRef::BezierSpline(_),
+            ) => BezierSplineEdit::Move { point, delta }.into_object(),
             (
                 Handle::Point {
                     point: Index2::Two(i, j),

@@ -7,7 +7,7 @@ use super::style::ViewOptions;
 use crate::geom::differential::frenet_frame;
 use crate::geom::knots::uniform_params;
 use crate::gpu::LineVertex;
-use crate::model::ModelRef;
+use crate::model::{Model, ModelRef};
 use glam::DVec3;
 
 /// Frames drawn per curve.
@@ -49,6 +49,13 @@ pub fn overlay_lines(doc: &Document, opts: &ViewOptions, scale: f64) -> Vec<Line
                 Box::new(move |t| c.curve().derivatives(t, 3)),
                 c.curve().domain(),
             ),
+            m @ (ModelRef::CatmullRom(_) | ModelRef::BezierSpline(_)) => {
+                let Some(Model::Curve(chain)) = m.to_bspline_curve() else {
+                    continue;
+                };
+                let domain = chain.curve().domain();
+                (Box::new(move |t| chain.curve().derivatives(t, 3)), domain)
+            }
             _ => continue,
         };
         if opts.frenet {

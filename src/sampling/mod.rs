@@ -6,6 +6,7 @@
 //! `geom` knows the curves; this module knows where they are sampled. Nothing here knows Vulkan.
 
 pub mod axis;
+pub mod chain_curve;
 pub mod dirty;
 pub mod erbs_axis;
 pub mod erbs_curve;

@@ -2,7 +2,7 @@
 //! loading a saved scene reproduces every control value bit for bit.
 
 use super::{Scene, SceneObject};
-use crate::geom::{BFunctionKind, TensorSurface};
+use crate::geom::{BFunctionKind, Parametrization, TensorSurface};
 use crate::model::{Model, SplineForm};
 use glam::DVec3;
 use std::fmt::Write;
@@ -87,6 +87,27 @@ fn write_object(s: &mut String, o: &SceneObject) {
                 .collect();
             field(s, "local", &format!("[{}]", rows.join(", ")));
             bfunction(s, e.bfunction());
+        }
+        Model::CatmullRom(m) => {
+            let c = m.spline();
+            field(s, "points", &points(c.points()));
+            if c.parametrization() != Parametrization::Uniform {
+                field(
+                    s,
+                    "parametrization",
+                    &format!("\"{}\"", c.parametrization().name()),
+                );
+            }
+            if c.closed() {
+                field(s, "closed", "true");
+            }
+        }
+        Model::BezierSpline(m) => {
+            let c = m.spline();
+            field(s, "degree", &c.degree().to_string());
+            field(s, "knots", &numbers(c.knots()));
+            field(s, "points", &points(c.points()));
+            field(s, "continuity", &format!("\"{}\"", c.continuity().name()));
         }
     }
     match o.model.sample_dims() {

@@ -700,6 +700,12 @@ impl Session {
                 by[dir] = 1;
                 SurfaceEdit::ElevateDegree { by }.into_object()
             }
+            ModelRef::CatmullRom(_) | ModelRef::BezierSpline(_) => {
+                let ty = model.type_name();
+                return self.set_status(format!(
+                    "a {ty} keeps its segments: B converts it to a bspline_curve first"
+                ));
+            }
             _ => return self.set_status("ERBS objects are not refined by degree elevation"),
         };
         if let Err(e) = edit.validate(model) {
