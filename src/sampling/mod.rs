@@ -7,6 +7,7 @@
 
 pub mod axis;
 pub mod chain_curve;
+pub mod curvature;
 pub mod dirty;
 pub mod erbs_axis;
 pub mod erbs_curve;

@@ -20,6 +20,9 @@ pub enum SampleMode {
     Derivatives(usize),
     /// Curves c, c'; surfaces S, Su, Sv and unit normals (what the renderer draws).
     Render,
+    /// As `Render`, and surfaces also Suu, Suv, Svv with Gaussian and mean curvature per
+    /// sample (the analysis colour maps, updated by the delta path like the positions).
+    Analysis,
 }
 
 impl SampleMode {
@@ -29,6 +32,7 @@ impl SampleMode {
         match self {
             SampleMode::Derivatives(g) => (g, PartialSet::Square(g), false),
             SampleMode::Render => (1, PartialSet::Shading, true),
+            SampleMode::Analysis => (1, PartialSet::Curvature, true),
         }
     }
 }
@@ -202,6 +206,7 @@ impl SampledObject {
         let grid = self.grid();
         match (&grid.partials, grid.normals.is_some()) {
             (PartialSet::Curve(1), _) | (PartialSet::Shading, true) => SampleMode::Render,
+            (PartialSet::Curvature, true) => SampleMode::Analysis,
             (p, _) => SampleMode::Derivatives(p.max_order()),
         }
     }

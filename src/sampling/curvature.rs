@@ -1,0 +1,143 @@
+//! Gaussian and mean curvature of surface samples, kept with the samples they come from so a
+//! control point edit updates only the touched samples of a curvature map.
+//!
+//! From the first and second fundamental forms (E, F, G from Su, Sv; L, M, N the second
+//! partials along the unit normal): K = (LN − M²)/(EG − F²), H = (EN − 2FM + GL)/(2(EG − F²)),
+//! with the normal Su × Sv (a sphere with outward normals has H = −1/r). Principal curvatures
+//! are κ = H ± √(H² − K).
+
+use super::axis::HermiteTable;
+use super::grid::SampleGrid;
+use super::normals::NormalSource;
+use crate::geom::surface::regular_normal;
+use glam::DVec3;
+use std::ops::Range;
+
+/// [K, H] from Su, Sv, Suu, Suv, Svv and the unit normal n.
+#[inline]
+pub fn fundamental_forms(p: &[DVec3; 5], n: DVec3) -> [f64; 2] {
+    let [su, sv, suu, suv, svv] = *p;
+    let (e, f, g) = (su.dot(su), su.dot(sv), sv.dot(sv));
+    let (l, m, nn) = (suu.dot(n), suv.dot(n), svv.dot(n));
+    let det = e * g - f * f;
+    [
+        (l * nn - m * m) / det,
+        (e * nn - 2.0 * f * m + g * l) / (2.0 * det),
+    ]
+}
+
+/// Principal curvatures [κ_max, κ_min] from [K, H] (the discriminant clamped at 0 against
+/// rounding at umbilics).
+#[inline]
+pub fn principal([k, h]: [f64; 2]) -> [f64; 2] {
+    let r = (h * h - k).max(0.0).sqrt();
+    [h + r, h - r]
+}
+
+/// Storage slots of Su, Sv, Suu, Suv, Svv.
+fn slots(grid: &SampleGrid) -> Option<[usize; 5]> {
+    let p = &grid.partials;
+    Some([
+        p.index(1, 0)?,
+        p.index(0, 1)?,
+        p.index(2, 0)?,
+        p.index(1, 1)?,
+        p.index(0, 2)?,
+    ])
+}
+
+/// Recomputes [K, H] of the samples in `rows × cols` (after their partials and normals).
+pub fn update(
+    grid: &mut SampleGrid,
+    rows: Range<usize>,
+    cols: Range<usize>,
+    params: [&[f64]; 2],
+    model: &impl NormalSource,
+) {
+    let Some(idx) = slots(grid) else { return };
+    let (Some(curv), Some(normals)) = (grid.curvatures.as_mut(), grid.normals.as_ref()) else {
+        return;
+    };
+    let stride = grid.partials.len();
+    let mv = grid.dims[1];
+    let mut degenerate = Vec::new();
+    for i in rows {
+        for j in cols.clone() {
+            let s = &grid.data[(i * mv + j) * stride..(i * mv + j + 1) * stride];
+            let p = idx.map(|k| s[k]);
+            if regular_normal(p[0], p[1]).is_some() {
+                curv[i * mv + j] = fundamental_forms(&p, normals[i * mv + j]);
+            } else {
+                degenerate.push((i, j));
+            }
+        }
+    }
+    resolve_degenerate(grid, &degenerate, params, model);
+}
+
+/// [K, H] where the sampled Su × Sv vanishes: the model's limit next to the sample, or NaN
+/// (drawn as undefined) when the model cannot give one.
+pub(crate) fn resolve_degenerate(
+    grid: &mut SampleGrid,
+    samples: &[(usize, usize)],
+    params: [&[f64]; 2],
+    model: &impl NormalSource,
+) {
+    let mv = grid.dims[1];
+    let Some(curv) = grid.curvatures.as_mut() else {
+        return;
+    };
+    for &(i, j) in samples {
+        curv[i * mv + j] = model
+            .curvature_near(params[0][i], params[1][j])
+            .unwrap_or([f64::NAN; 2]);
+    }
+}
+
+/// Moves control point (k, l) of a polynomial surface on a `Curvature` grid by `delta`: the six
+/// partials of the samples in I_k × I_l gain M_u[a][k]·M_v[b][l]·Δ (the generic update's
+/// products in its order), and their normals and [K, H] are recomputed in the same pass.
+/// Samples with a degenerate Su × Sv are appended to `degenerate` (normal and curvature left
+/// for the caller's fallback). Returns the touched rectangle.
+pub(crate) fn translate(
+    tables: [&HermiteTable; 2],
+    point: [usize; 2],
+    delta: DVec3,
+    grid: &mut SampleGrid,
+    degenerate: &mut Vec<(usize, usize)>,
+) -> (Range<usize>, Range<usize>) {
+    let [tu, tv] = tables;
+    let [k, l] = point;
+    let (rows, cols) = (tu.range(k), tv.range(l));
+    // Basis value and first and second derivatives of column k (resp. l) at each sample.
+    let coeffs = |t: &HermiteTable, c: usize, j: usize| {
+        let col = c - t.first(j);
+        [0, 1, 2].map(|r| t.row(j, r).map_or(0.0, |row| row[col]))
+    };
+    let cv: Vec<[f64; 3]> = cols.clone().map(|j| coeffs(tv, l, j)).collect();
+    let mv = grid.dims[1];
+    let (Some(normals), Some(curv)) = (grid.normals.as_mut(), grid.curvatures.as_mut()) else {
+        return (rows, cols);
+    };
+    for i in rows.clone() {
+        let cu = coeffs(tu, k, i);
+        let (a, b) = (i * mv + cols.start, i * mv + cols.end);
+        let data = grid.data[a * 6..b * 6].as_chunks_mut::<6>().0;
+        for (jj, (s, cv)) in data.iter_mut().zip(&cv).enumerate() {
+            s[0] += delta * (cu[0] * cv[0]);
+            s[1] += delta * (cu[1] * cv[0]);
+            s[2] += delta * (cu[0] * cv[1]);
+            s[3] += delta * (cu[2] * cv[0]);
+            s[4] += delta * (cu[1] * cv[1]);
+            s[5] += delta * (cu[0] * cv[2]);
+            match regular_normal(s[1], s[2]) {
+                Some(n) => {
+                    normals[a + jj] = n;
+                    curv[a + jj] = fundamental_forms(&[s[1], s[2], s[3], s[4], s[5]], n);
+                }
+                None => degenerate.push((i, cols.start + jj)),
+            }
+        }
+    }
+    (rows, cols)
+}
