@@ -9,6 +9,7 @@
 use super::axis::HermiteTable;
 use super::grid::SampleGrid;
 use super::normals::NormalSource;
+use super::shading::{LANES, unit_normals};
 use crate::geom::surface::regular_normal;
 use glam::DVec3;
 use std::ops::Range;
@@ -119,25 +120,91 @@ pub(crate) fn translate(
     let (Some(normals), Some(curv)) = (grid.normals.as_mut(), grid.curvatures.as_mut()) else {
         return (rows, cols);
     };
+    let d = delta.to_array();
     for i in rows.clone() {
         let cu = coeffs(tu, k, i);
         let (a, b) = (i * mv + cols.start, i * mv + cols.end);
         let data = grid.data[a * 6..b * 6].as_chunks_mut::<6>().0;
-        for (jj, (s, cv)) in data.iter_mut().zip(&cv).enumerate() {
-            s[0] += delta * (cu[0] * cv[0]);
-            s[1] += delta * (cu[1] * cv[0]);
-            s[2] += delta * (cu[0] * cv[1]);
-            s[3] += delta * (cu[2] * cv[0]);
-            s[4] += delta * (cu[1] * cv[1]);
-            s[5] += delta * (cu[0] * cv[2]);
-            match regular_normal(s[1], s[2]) {
-                Some(n) => {
-                    normals[a + jj] = n;
-                    curv[a + jj] = fundamental_forms(&[s[1], s[2], s[3], s[4], s[5]], n);
+        for (s, cv) in data.iter_mut().zip(&cv) {
+            // Δ·(M_u[a] M_v[b]) per partial, component by component: 18 independent
+            // multiply-adds the compiler can pair.
+            let c = [
+                cu[0] * cv[0],
+                cu[1] * cv[0],
+                cu[0] * cv[1],
+                cu[2] * cv[0],
+                cu[1] * cv[1],
+                cu[0] * cv[2],
+            ];
+            for (p, &c) in s.iter_mut().zip(&c) {
+                let v: &mut [f64; 3] = p.as_mut();
+                for x in 0..3 {
+                    v[x] += d[x] * c;
                 }
-                None => degenerate.push((i, cols.start + jj)),
             }
         }
+        // The row segment is in L1 now: normals and [K, H] LANES samples at a time.
+        shape_of(data, &mut normals[a..b], &mut curv[a..b], |jj| {
+            degenerate.push((i, cols.start + jj))
+        });
     }
     (rows, cols)
+}
+
+/// Unit normals (exactly `regular_normal`'s) and [K, H] of `data`'s samples (S, Su, Sv, Suu,
+/// Suv, Svv each), LANES at a time so that the square roots and divisions vectorise; reports
+/// the index of every sample whose Su × Sv is degenerate (its outputs are left as they were).
+pub(crate) fn shape_of(
+    data: &[[DVec3; 6]],
+    normals: &mut [DVec3],
+    curv: &mut [[f64; 2]],
+    mut degenerate: impl FnMut(usize),
+) {
+    const L: usize = LANES;
+    let (data4, rest) = data.as_chunks::<L>();
+    let (normals4, normals_rest) = normals.as_chunks_mut::<L>();
+    let (curv4, curv_rest) = curv.as_chunks_mut::<L>();
+    for (g, ((d, n), c)) in data4.iter().zip(normals4).zip(curv4).enumerate() {
+        let part = |p: usize| [0, 1, 2].map(|x| std::array::from_fn::<f64, L, _>(|l| d[l][p][x]));
+        let (u, v) = (part(1), part(2));
+        let (nn, ok) = unit_normals::<L>(u, v);
+        let dot = |a: &[[f64; L]; 3], b: &[[f64; L]; 3]| -> [f64; L] {
+            std::array::from_fn(|l| a[0][l] * b[0][l] + a[1][l] * b[1][l] + a[2][l] * b[2][l])
+        };
+        let (e, f, gg) = (dot(&u, &u), dot(&u, &v), dot(&v, &v));
+        let (ll, m, n2) = (dot(&part(3), &nn), dot(&part(4), &nn), dot(&part(5), &nn));
+        // Through memory, so that the stores below do not pull the lanes apart (see
+        // shading::normals_of).
+        let stage: [[f64; L]; 6] = std::hint::black_box([
+            nn[0],
+            nn[1],
+            nn[2],
+            std::array::from_fn(|l| {
+                (ll[l] * n2[l] - m[l] * m[l]) / (e[l] * gg[l] - f[l] * f[l])
+            }),
+            std::array::from_fn(|l| {
+                (e[l] * n2[l] - 2.0 * f[l] * m[l] + gg[l] * ll[l])
+                    / (2.0 * (e[l] * gg[l] - f[l] * f[l]))
+            }),
+            ok,
+        ]);
+        for l in 0..L {
+            if stage[5][l] == 0.0 {
+                degenerate(g * L + l);
+                continue;
+            }
+            n[l] = DVec3::new(stage[0][l], stage[1][l], stage[2][l]);
+            c[l] = [stage[3][l], stage[4][l]];
+        }
+    }
+    let base = data4.len() * L;
+    for (jj, ((s, n), c)) in rest.iter().zip(normals_rest).zip(curv_rest).enumerate() {
+        match regular_normal(s[1], s[2]) {
+            Some(v) => {
+                *n = v;
+                *c = fundamental_forms(&[s[1], s[2], s[3], s[4], s[5]], v);
+            }
+            None => degenerate(base + jj),
+        }
+    }
 }
