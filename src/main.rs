@@ -3,6 +3,7 @@
 use clap::{Args, Parser, Subcommand};
 use prespline::cli::files::{SampleOverride, SamplesArg};
 use prespline::cli::{self, CliError};
+use prespline::render::maps::SurfaceMap;
 use prespline::render::{NetMode, OrbitCamera, ViewOptions, Wire};
 use prespline::view::scenario::Scenario;
 use std::io::Write;
@@ -111,6 +112,10 @@ enum Command {
         /// MSAA samples (1, 2, 4, 8); 0 picks 4 where supported.
         #[arg(long, default_value_t = 0)]
         msaa: u32,
+        /// Draw the osculating circle of curve NAME at parameter T, labelled with its
+        /// curvature, radius and torsion.
+        #[arg(long, value_name = "NAME@T", value_parser = parse_osculating)]
+        osculating: Option<(String, f64)>,
         #[command(flatten)]
         display: DisplayArgs,
         #[command(flatten)]
@@ -166,6 +171,14 @@ struct DisplayArgs {
     /// Draw curvature combs along curves.
     #[arg(long)]
     comb: bool,
+    /// Draw continuity badges (G0/G1/G2, C1/C2 from left and right derivatives) at curve
+    /// junctions and at knots of multiplicity > 1.
+    #[arg(long)]
+    badges: bool,
+    /// Colour surfaces by an analysis map, with a legend: gaussian, mean, kmax, kmin
+    /// (principal curvatures) or zebra (reflection lines).
+    #[arg(long, value_name = "MAP", value_parser = SurfaceMap::parse)]
+    analysis: Option<SurfaceMap>,
 }
 
 impl DisplayArgs {
@@ -181,6 +194,8 @@ impl DisplayArgs {
             normals: self.normals,
             frenet: self.frenet,
             curvature_comb: self.comb,
+            badges: self.badges,
+            analysis: self.analysis,
             ..ViewOptions::default()
         }
     }
@@ -251,11 +266,17 @@ fn main() -> ExitCode {
             camera,
             edits,
             msaa,
+            osculating,
             display,
             samples,
         } => cli::render::load_document(&scene, edits.as_deref(), &samples.counts())
-            .and_then(|doc| {
-                cli::render::run(&doc, &out, size.0, size.1, camera, display.options(), msaa)
+            .and_then(|mut doc| {
+                let mut options = display.options();
+                doc.set_analysis(options.analysis);
+                if let Some((name, t)) = &osculating {
+                    options.osculating_at = Some(cli::render::osculating_at(&doc, name, *t)?);
+                }
+                cli::render::run(&doc, &out, size.0, size.1, camera, options, msaa)
             })
             .map(|line| eprintln!("{line}")),
         Command::Convert {
@@ -273,6 +294,19 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// `NAME@T` of `--osculating`.
+fn parse_osculating(s: &str) -> Result<(String, f64), String> {
+    let (name, t) = s
+        .rsplit_once('@')
+        .ok_or_else(|| format!("'{s}' is not NAME@T"))?;
+    let t: f64 = t
+        .parse()
+        .ok()
+        .filter(|t: &f64| t.is_finite())
+        .ok_or_else(|| format!("'{t}' is not a parameter value"))?;
+    Ok((name.to_string(), t))
 }
 
 fn print(text: &str) -> Result<(), CliError> {

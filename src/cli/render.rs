@@ -60,6 +60,30 @@ pub fn load_document(
     Ok(doc)
 }
 
+/// The object index and parameter of `--osculating NAME@T`, checked: a curve object, T in its
+/// domain.
+pub fn osculating_at(doc: &Document, name: &str, t: f64) -> Result<(usize, f64), CliError> {
+    let i = doc
+        .objects
+        .iter()
+        .position(|o| o.name == name)
+        .ok_or_else(|| CliError(format!("--osculating: unknown object '{name}'")))?;
+    let model = doc.objects[i].sampled.model();
+    if model.is_surface() {
+        return Err(CliError(format!(
+            "--osculating: object '{name}' is a {}, not a curve",
+            model.type_name()
+        )));
+    }
+    let (a, b) = model.domain()[0];
+    if !(a..=b).contains(&t) {
+        return Err(CliError(format!(
+            "--osculating: parameter {t} is outside the domain [{a}, {b}] of object '{name}'"
+        )));
+    }
+    Ok((i, t))
+}
+
 /// Renders `doc` headless and writes `out` (PNG); returns a one-line summary.
 pub fn run(
     doc: &Document,

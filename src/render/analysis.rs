@@ -2,9 +2,12 @@
 //! (continuity badges) and the osculating circle with curvature and torsion at a parameter.
 //! Pure f64 computations from the model; drawing them is the overlays' business.
 
+use super::document::Document;
 use crate::geom::continuity::{JoinClass, classify};
 use crate::geom::differential::frenet_frame;
 use crate::geom::{BSplineCurve, ErbsCurve};
+use crate::gpu::font::{push_rect, push_text, text_size};
+use crate::gpu::{LineVertex, OverlayVertex};
 use crate::model::{Model, ModelRef};
 use glam::DVec3;
 
@@ -186,7 +189,7 @@ impl Osculating {
             .collect()
     }
 
-    /// One line of text: "t 1.25  k 0.8123  r 1.231  tau -0.0412".
+    /// "t 1.250  curvature 0.8123  radius 1.231  torsion -0.04120" (plain ASCII).
     pub fn describe(&self) -> String {
         format!(
             "t {}  curvature {}  radius {}  torsion {}",
@@ -219,6 +222,100 @@ pub fn nearest_sample(params: &[f64], positions: impl Iterator<Item = DVec3>, ta
         }
     }
     best.1
+}
+
+/// Badge colours (sRGB): C2 green, C1 / G2 teal, G1 yellow, G0 orange, a gap red.
+pub fn badge_color(class: JoinClass) -> [u8; 4] {
+    match class.label() {
+        "C2" => [70, 200, 110, 255],
+        "C1 G2" | "G2" => [60, 190, 200, 255],
+        "C1" => [120, 170, 240, 255],
+        "G1" => [235, 200, 60, 255],
+        "G0" => [240, 140, 50, 255],
+        _ => [235, 70, 60, 255],
+    }
+}
+
+/// Every continuity badge of the document as overlay quads: a dot on the join and its label
+/// beside it, placed by `project` (world → pixel, `None` behind the camera).
+pub fn badge_overlay(
+    doc: &Document,
+    project: impl Fn(DVec3) -> Option<(f64, f64)>,
+) -> Vec<OverlayVertex> {
+    let mut v = Vec::new();
+    let scale = 2.0;
+    for o in &doc.objects {
+        for j in curve_joins(o.sampled.model()) {
+            let Some((x, y)) = project(j.position) else {
+                continue;
+            };
+            let (x, y) = (x as f32, y as f32);
+            let color = badge_color(j.class);
+            push_rect(&mut v, x - 4.0, y - 4.0, 8.0, 8.0, [10, 12, 16, 255]);
+            push_rect(&mut v, x - 3.0, y - 3.0, 6.0, 6.0, color);
+            let label = j.class.label();
+            let [w, h] = text_size(label, scale);
+            let (bx, by) = (x + 8.0, y - h - 10.0);
+            push_rect(&mut v, bx, by, w + 8.0, h + 6.0, [10, 12, 16, 215]);
+            push_rect(&mut v, bx, by + h + 4.0, w + 8.0, 2.0, color);
+            push_text(&mut v, label, bx + 4.0, by + 3.0, scale, color);
+        }
+    }
+    v
+}
+
+/// The osculating circle (magenta), the radius to its centre and the tangent (thin), as lines.
+pub fn osculating_lines(o: &Osculating) -> Vec<LineVertex> {
+    let mut out = Vec::new();
+    let mut line = |a: DVec3, b: DVec3, color: [u8; 4]| {
+        out.push(LineVertex {
+            pos: a.as_vec3().to_array(),
+            color,
+        });
+        out.push(LineVertex {
+            pos: b.as_vec3().to_array(),
+            color,
+        });
+    };
+    let ring = o.circle(96);
+    for w in ring.windows(2) {
+        line(w[0], w[1], [230, 70, 230, 255]);
+    }
+    line(o.point, o.center(), [170, 90, 170, 255]);
+    let r = o.radius();
+    line(o.center() - o.tangent * (0.04 * r), o.center() + o.tangent * (0.04 * r), [230, 70, 230, 255]);
+    line(o.center() - o.normal * (0.04 * r), o.center() + o.normal * (0.04 * r), [230, 70, 230, 255]);
+    out
+}
+
+/// The osculating readout (curvature, radius, torsion) as a label next to the curve point,
+/// kept inside a `size` image.
+pub fn osculating_overlay(
+    name: &str,
+    o: &Osculating,
+    at: (f64, f64),
+    size: [f32; 2],
+) -> Vec<OverlayVertex> {
+    let mut v = Vec::new();
+    let scale = 2.0;
+    let text = format!(
+        "{name}  t = {}\ncurvature {}  radius {}\ntorsion {}",
+        short(o.t),
+        short(o.curvature),
+        short(o.radius()),
+        short(o.torsion)
+    );
+    let [w, h] = text_size(&text, scale);
+    let (px, py) = (at.0 as f32, at.1 as f32);
+    let x = if px + 14.0 + w + 10.0 <= size[0] {
+        px + 14.0
+    } else {
+        (px - 14.0 - w - 10.0).max(0.0)
+    };
+    let y = (py + 10.0).min(size[1] - h - 8.0).max(0.0);
+    push_rect(&mut v, x, y, w + 10.0, h + 8.0, [10, 12, 16, 215]);
+    push_text(&mut v, &text, x + 5.0, y + 4.0, scale, [240, 150, 240, 255]);
+    v
 }
 
 #[cfg(test)]

@@ -3,6 +3,10 @@
 use super::camera::OrbitCamera;
 use super::document::Document;
 use super::gpu_scene::{GpuScene, Highlight};
+use super::analysis::{
+    CurveEval, Osculating, badge_overlay, osculating_lines, osculating_overlay,
+};
+use super::maps::legend;
 use super::overlays::overlay_lines;
 use super::style::{Palette, ViewOptions};
 use crate::gpu::{GpuResult, OffscreenDesc, Pixels, Renderer};
@@ -63,9 +67,37 @@ fn record(
     frame.set_clear_color(Palette::default().background);
     frame.set_camera(camera.gpu(shot.width as f64 / shot.height as f64, &bounds));
     scene.draw(&mut frame, doc, &shot.options, &Highlight::default())?;
-    let lines = overlay_lines(doc, &shot.options, bounds.radius());
+    let mut lines = overlay_lines(doc, &shot.options, bounds.radius());
+    let (w, h) = (shot.width as f64, shot.height as f64);
+    let project = |p| camera.project(p, w, h, &bounds).map(|(x, y, _)| (x, y));
+    let mut overlay = Vec::new();
+    if let Some((i, t)) = shot.options.osculating_at
+        && let Some(o) = doc.objects.get(i).and_then(|o| {
+            let curve = CurveEval::of(o.sampled.model())?;
+            Osculating::at(&curve, t)
+        })
+    {
+        lines.extend(osculating_lines(&o));
+        if let Some(at) = project(o.point) {
+            overlay.extend(osculating_overlay(
+                &doc.objects[i].name,
+                &o,
+                at,
+                [w as f32, h as f32],
+            ));
+        }
+    }
     if !lines.is_empty() {
         frame.draw_lines3d(&lines)?;
+    }
+    if shot.options.badges {
+        overlay.extend(badge_overlay(doc, project));
+    }
+    if let Some(map) = shot.options.analysis {
+        overlay.extend(legend(map, doc.map_range(map), w as f32, h as f32));
+    }
+    if !overlay.is_empty() {
+        frame.draw_overlay(&overlay)?;
     }
     frame.finish()?;
     Ok(())
