@@ -538,3 +538,49 @@ fn the_comparisons_fail_on_perturbed_input() {
     g.pts[4] += DVec3::new(0.0, 0.0, 1e-6);
     assert!(caught(&|| assert_junctions(&g, "G1", "perturbed")));
 }
+
+// ---------------------------------------------------------------------------------------------
+// Continuity badges.
+
+#[test]
+fn badges_name_each_constructed_junction() {
+    use prespline::render::analysis::curve_joins;
+    // tests/data/badges.json: a cubic spline declared C0 whose junctions were built (by a
+    // script from the lecture's conditions, outside this crate) to be, in order: C2, C1 with
+    // equal curvature vectors, C1, G2 (derivatives scaled by γ, γ²), G1, G0.
+    let text = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/badges.json"),
+    )
+    .unwrap();
+    let m = one(&text);
+    let labels: Vec<&str> = curve_joins(m.as_ref())
+        .iter()
+        .map(|j| j.class.label())
+        .collect();
+    assert_eq!(labels, ["C2", "C1 G2", "C1", "G2", "G1", "G0"]);
+    // The independent evaluator agrees on the parametric part of each class.
+    let pw = piecewise(&m);
+    for (j, want) in labels.iter().enumerate() {
+        let t = pw.breaks[j + 1];
+        let (l, r) = (pw.limit(j, t, 2), pw.limit(j + 1, t, 2));
+        let c1 = close(l[1], r[1], l[1].length(), 1e-12);
+        let c2 = c1 && close(l[2], r[2], l[2].length(), 1e-12);
+        assert_eq!(c1, want.starts_with('C'), "junction {}", j + 1);
+        assert_eq!(c2, *want == "C2", "junction {}", j + 1);
+    }
+    // Catmull–Rom: uniform knots are C1 at every point; centripetal ones G1 (C1 in the knot
+    // parameter, written over [j, j+1]) unless neighbouring chords are equal.
+    let mut rng = Rng::new(3);
+    let p = random_points(&mut rng, 6);
+    for (par, want) in [("uniform", "C1"), ("centripetal", "G1")] {
+        let m = one(&format!(
+            r#"{{"objects": [{{"name": "c", "type": "catmull_rom", "points": {}, "parametrization": "{par}", "samples": 50}}]}}"#,
+            points_json(&p)
+        ));
+        let joins = curve_joins(m.as_ref());
+        assert_eq!(joins.len(), 4);
+        for j in joins {
+            assert_eq!(j.class.label(), want, "{par} at {}", j.t);
+        }
+    }
+}

@@ -200,9 +200,11 @@ mod tests {
 
     #[test]
     fn scale_ends_and_middle() {
-        assert_eq!(scale_color(-1.0), SCALE[0].1);
-        assert_eq!(scale_color(0.0), SCALE[2].1);
-        assert_eq!(scale_color(7.0), SCALE[4].1);
+        let near = |a: [f32; 3], b: [f32; 3]| (0..3).all(|i| (a[i] - b[i]).abs() < 1e-6);
+        assert!(near(scale_color(-1.0), SCALE[0].1));
+        assert!(near(scale_color(0.0), SCALE[2].1));
+        assert!(near(scale_color(7.0), SCALE[4].1));
+        assert!(!near(scale_color(0.1), SCALE[2].1));
         let c = scale_color(0.25);
         for i in 0..3 {
             let mid = 0.5 * (SCALE[2].1[i] + SCALE[3].1[i]);
