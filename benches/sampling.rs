@@ -13,8 +13,8 @@ use criterion::{BenchmarkId, Criterion, Throughput};
 use glam::{DMat4, DVec3};
 use prespline::geom::{BFunctionKind, BSplineCurve, ErbsSurface, KnotVector, TensorSurface};
 use prespline::model::{
-    CurveEdit, CurveModel, ErbsSurfaceEdit, ErbsSurfaceModel, KindEdit, LocalEdit, Model,
-    ObjectEdit, PointEdit, SplineForm, SurfaceEdit, SurfaceModel,
+    CurveEdit, CurveModel, ErbsSurfaceEdit, ErbsSurfaceModel, KindEdit, LocalEdit, LocalPath,
+    Model, ObjectEdit, PointEdit, SplineForm, SurfaceEdit, SurfaceModel,
 };
 use prespline::sampling::{SampleMode, SampledObject};
 use std::hint::black_box;
@@ -121,7 +121,7 @@ fn scenarios() -> Vec<(&'static str, &'static str, Vec<ObjectEdit>)> {
             "erbs",
             vec![
                 ErbsSurfaceEdit::Local(LocalEdit::Transform {
-                    local: [4, 5],
+                    local: LocalPath::top([4, 5]),
                     matrix: rotation_about(DVec3::new(4.5, 5.5, 0.0), 1e-3),
                 })
                 .into_object(),

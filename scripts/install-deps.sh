@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
 # Installs what prespline needs on Debian/Ubuntu when it is missing: a C++ compiler (glslang is
 # built from source by build.rs), the Vulkan loader, Mesa's lavapipe (software Vulkan), the
-# Khronos validation layers, Xvfb for the windowed tests, and the X11 client libraries winit
-# loads at run time. Does nothing when everything is present.
+# Khronos validation layers, Xvfb for the windowed tests, strace (for the test that saves are
+# fsynced), and the X11 client libraries winit loads at run time. Does nothing when everything
+# is present.
 set -euo pipefail
 
 packages=(
   g++ libvulkan1 mesa-vulkan-drivers vulkan-validationlayers
-  xvfb xauth libx11-6 libx11-xcb1 libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0
+  xvfb xauth strace libx11-6 libx11-xcb1 libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0
 )
 
 missing=()

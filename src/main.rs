@@ -1,10 +1,12 @@
 //! The `prespline` command line.
+#![deny(unsafe_code)]
 
 use clap::{Args, Parser, Subcommand};
 use prespline::cli::files::{SampleOverride, SamplesArg};
 use prespline::cli::{self, CliError};
 use prespline::render::maps::SurfaceMap;
 use prespline::render::{NetMode, OrbitCamera, ViewOptions, Wire};
+use prespline::sampling::budget::{self, MemoryBudget};
 use prespline::view::scenario::Scenario;
 use std::io::Write;
 use std::path::PathBuf;
@@ -36,6 +38,8 @@ enum Command {
         /// Apply the edits to the model and re-sample from scratch instead of the delta path.
         #[arg(long)]
         full: bool,
+        #[command(flatten)]
+        memory: MemoryArgs,
     },
     /// Open the interactive viewer on a scene (the built-in demo scene without SCENE).
     View {
@@ -61,6 +65,12 @@ enum Command {
         /// summary, Chrome trace, SVG plots) into DIR when the window closes.
         #[arg(long, value_name = "DIR")]
         profile: Option<PathBuf>,
+        /// Open the unsaved edits an earlier session left in NAME.autosave.json (beside
+        /// NAME.json; demo.autosave.json for the demo) instead of the scene.
+        #[arg(long)]
+        recover: bool,
+        #[command(flatten)]
+        memory: MemoryArgs,
     },
     /// Run a scripted, reproducible editing session and report where every millisecond goes.
     Bench {
@@ -91,6 +101,8 @@ enum Command {
         /// MSAA samples (1, 2, 4, 8); 0 picks 4 where supported.
         #[arg(long, default_value_t = 0)]
         msaa: u32,
+        #[command(flatten)]
+        memory: MemoryArgs,
     },
     /// Render a scene headless (no display needed) into a PNG image.
     Render {
@@ -120,6 +132,8 @@ enum Command {
         display: DisplayArgs,
         #[command(flatten)]
         samples: SamplesArgs,
+        #[command(flatten)]
+        memory: MemoryArgs,
     },
     /// Convert a scene between JSON and Wavefront OBJ (direction from the extensions).
     ///
@@ -147,6 +161,21 @@ struct SamplesArgs {
 impl SamplesArgs {
     fn counts(&self) -> SampleOverride {
         SampleOverride::from_args(&self.samples)
+    }
+}
+
+/// How much memory pre-evaluation may take.
+#[derive(Args, Clone, Copy)]
+struct MemoryArgs {
+    /// Refuse scenes whose pre-evaluated tables, samples and GPU mirrors would need more than
+    /// this (bytes, or with K, M, G, T: 512M, 4G). Default: half of physical memory.
+    #[arg(long, value_name = "SIZE", value_parser = budget::parse_size)]
+    memory_limit: Option<u64>,
+}
+
+impl MemoryArgs {
+    fn budget(self) -> MemoryBudget {
+        MemoryBudget::from_flag(self.memory_limit)
     }
 }
 
@@ -209,12 +238,14 @@ fn main() -> ExitCode {
             derivatives,
             edits,
             full,
+            memory,
         } => {
             let args = cli::sample::SampleArgs {
                 scene: &scene,
                 derivatives,
                 edits: edits.as_deref(),
                 full,
+                memory: memory.budget(),
             };
             cli::sample::run(&args).and_then(|text| print(&text))
         }
@@ -226,6 +257,8 @@ fn main() -> ExitCode {
             save_as,
             profile,
             samples,
+            recover,
+            memory,
         } => cli::view::run(&cli::view::ViewOptions {
             scene: scene.as_deref(),
             size,
@@ -234,6 +267,8 @@ fn main() -> ExitCode {
             save_as: save_as.as_deref(),
             profile: profile.as_deref(),
             samples: samples.counts(),
+            memory: memory.budget(),
+            recover,
         }),
         Command::Bench {
             scene,
@@ -245,6 +280,7 @@ fn main() -> ExitCode {
             naive,
             out,
             msaa,
+            memory,
         } => {
             let args = cli::bench::BenchArgs {
                 scene,
@@ -256,6 +292,7 @@ fn main() -> ExitCode {
                 naive,
                 out,
                 msaa,
+                memory: memory.budget(),
             };
             cli::bench::run(&args).map(|line| eprintln!("{line}"))
         }
@@ -269,16 +306,22 @@ fn main() -> ExitCode {
             osculating,
             display,
             samples,
-        } => cli::render::load_document(&scene, edits.as_deref(), &samples.counts())
-            .and_then(|mut doc| {
-                let mut options = display.options();
-                doc.set_analysis(options.analysis);
-                if let Some((name, t)) = &osculating {
-                    options.osculating_at = Some(cli::render::osculating_at(&doc, name, *t)?);
-                }
-                cli::render::run(&doc, &out, size.0, size.1, camera, options, msaa)
-            })
-            .map(|line| eprintln!("{line}")),
+            memory,
+        } => cli::render::load_document(
+            &scene,
+            edits.as_deref(),
+            &samples.counts(),
+            &memory.budget(),
+        )
+        .and_then(|mut doc| {
+            let mut options = display.options();
+            cli::render::show_analysis(&mut doc, options.analysis, &memory.budget())?;
+            if let Some((name, t)) = &osculating {
+                options.osculating_at = Some(cli::render::osculating_at(&doc, name, *t)?);
+            }
+            cli::render::run(&doc, &out, size.0, size.1, camera, options, msaa)
+        })
+        .map(|line| eprintln!("{line}")),
         Command::Convert {
             input,
             output,

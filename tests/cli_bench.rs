@@ -1,6 +1,8 @@
 //! `prespline bench` produces every report in one run (structure only — timings are never
 //! asserted in tests).
 
+mod common;
+
 use std::path::Path;
 use std::process::Command;
 
@@ -9,7 +11,7 @@ fn prespline() -> Command {
     let icd = prespline::gpu::LAVAPIPE_ICD;
     c.env("VK_DRIVER_FILES", icd)
         .env("VK_ICD_FILENAMES", icd)
-        .env("PRESPLINE_VALIDATION", "1");
+        .env("PRESPLINE_VALIDATION", "required");
     c
 }
 
@@ -77,7 +79,9 @@ fn check_reports(dir: &Path, frames: usize, warmup: usize) {
 
 #[test]
 fn bench_writes_every_report_for_both_modes() {
-    let out = std::env::temp_dir().join(format!("prespline-bench-{}", std::process::id()));
+    // A fresh directory: reports left by an earlier run must not pass for this one's.
+    let scratch = common::Scratch::new("cli-bench");
+    let out = scratch.join("out");
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/erbs_surface.json");
     let r = prespline()
         .arg("bench")
@@ -115,8 +119,8 @@ fn bench_writes_every_report_for_both_modes() {
 #[test]
 fn every_scenario_runs_headless() {
     for scenario in ["drag", "orbit", "idle"] {
-        let out =
-            std::env::temp_dir().join(format!("prespline-bench-{scenario}-{}", std::process::id()));
+        let scratch = common::Scratch::new("cli-bench");
+        let out = scratch.join(scenario);
         let r = prespline()
             .args([
                 "bench",

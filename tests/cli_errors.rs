@@ -1,25 +1,20 @@
 //! Bad input never panics: every class of malformed scene or edit file exits non-zero with one
 //! line naming the object, field and index, and prints nothing on stdout.
 
-use std::path::PathBuf;
+mod common;
+
+use common::Scratch;
 use std::process::Command;
 
-fn tmp(name: &str, text: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("prespline-cli-errors-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p
-}
-
-/// Runs `prespline sample` and returns (success, stdout, stderr).
+/// Runs `prespline sample` on its own copy of the scene (and edits) in a scratch directory of
+/// this call alone, so no test rewrites a file another test's child is reading; returns
+/// (success, stdout, stderr).
 fn sample(scene: &str, edits: Option<&str>) -> (bool, String, String) {
-    let s = tmp(&format!("scene-{:x}.json", hash(scene)), scene);
+    let dir = Scratch::new("cli-errors");
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_prespline"));
-    cmd.arg("sample").arg(&s);
+    cmd.arg("sample").arg(dir.file("scene.json", scene));
     if let Some(e) = edits {
-        cmd.arg("--edits")
-            .arg(tmp(&format!("edits-{:x}.json", hash(e)), e));
+        cmd.arg("--edits").arg(dir.file("edits.json", e));
     }
     let out = cmd.output().unwrap();
     (
@@ -27,12 +22,6 @@ fn sample(scene: &str, edits: Option<&str>) -> (bool, String, String) {
         String::from_utf8(out.stdout).unwrap(),
         String::from_utf8(out.stderr).unwrap(),
     )
-}
-
-fn hash(s: &str) -> u64 {
-    s.bytes().fold(0xcbf29ce484222325u64, |h, b| {
-        (h ^ b as u64).wrapping_mul(0x100000001b3)
-    })
 }
 
 fn expect_error(scene: &str, edits: Option<&str>, parts: &[&str]) {
@@ -335,7 +324,8 @@ fn files_and_options() {
     let err = String::from_utf8(out.stderr).unwrap();
     assert!(err.contains("cannot read /nonexistent/scene.json"), "{err}");
     assert_eq!(err.lines().count(), 1);
-    let s = tmp("ok.json", &scene(&[CURVE]));
+    let dir = Scratch::new("cli-errors");
+    let s = dir.file("ok.json", &scene(&[CURVE]));
     let out = Command::new(env!("CARGO_BIN_EXE_prespline"))
         .arg("sample")
         .arg(&s)
@@ -348,4 +338,294 @@ fn files_and_options() {
             .unwrap()
             .contains("exceeds the supported maximum")
     );
+}
+
+/// Scratch directories are unique per call (no two tests share a file), start empty even when
+/// an earlier run with the same process id left one behind, and are removed afterwards.
+#[test]
+fn scratch_directories_are_unique_and_cleared() {
+    let (a, b) = (Scratch::new("cli-errors"), Scratch::new("cli-errors"));
+    assert_ne!(a.path(), b.path());
+    let stale = a.path().to_path_buf();
+    a.file("result.json", "stale");
+    std::mem::forget(a); // as a crashed run leaves it
+    let again = Scratch::at(stale.clone());
+    assert_eq!(std::fs::read_dir(again.path()).unwrap().count(), 0);
+    drop(again);
+    assert!(!stale.exists(), "not removed after use");
+}
+
+/// Many tests sampling the same scene text at once each read their own file.
+#[test]
+fn concurrent_samples_of_one_scene_do_not_interfere() {
+    let text = scene(&[CURVE, SURF, ERBS]);
+    let runs: Vec<_> = (0..8)
+        .map(|_| {
+            let text = text.clone();
+            std::thread::spawn(move || sample(&text, None))
+        })
+        .collect();
+    for r in runs {
+        let (ok, stdout, stderr) = r.join().unwrap();
+        assert!(ok && stdout.starts_with("{\"objects\""), "{stderr}");
+    }
+}
+
+const BSURF: &str = r#"{"name": "b", "type": "bspline_surface", "degree": [2, 1], "knots": [[0,0,0,1,1,1],[0,0,1,2,2]], "points": [[[0,0,0],[0,1,0],[0,2,0]],[[1,0,0],[1,1,1],[1,2,0]],[[2,0,0],[2,1,0],[2,2,0]]], "samples": [4, 5]}"#;
+const ESURF: &str = r#"{"name": "es", "type": "erbs_surface", "knots": [[0,0,1,1],[0,0,1,2,2]], "local": [[{"points": [[[0,0,0],[0,1,0]],[[1,0,0],[1,1,0]]]}, {"points": [[[0,1,0]]]}, {"points": [[[0,2,0],[1,2,0]]]}], [{"points": [[[1,0,0]]]}, {"points": [[[1,1,1]]]}, {"points": [[[1,2,0]]]}]], "samples": [5, 6]}"#;
+
+#[test]
+fn bspline_surface_fields() {
+    let (ok, _, stderr) = sample(&scene(&[BSURF]), None);
+    assert!(ok, "the base surface is valid: {stderr}");
+    let bad = |from: &str, to: &str, parts: &[&str]| {
+        assert!(BSURF.contains(from), "{from}");
+        expect_error(&scene(&[&BSURF.replace(from, to)]), None, parts);
+    };
+    let at = "object 'b' (objects[0])";
+    bad(
+        "\"degree\": [2, 1]",
+        "\"degree\": [2]",
+        &[at, "field 'degree'", "expected [du, dv]"],
+    );
+    bad(
+        "\"degree\": [2, 1]",
+        "\"degree\": [3, 1]",
+        &[
+            at,
+            "field 'degree'",
+            "u direction",
+            "degree 3 needs at least 4 control points, got 3",
+        ],
+    );
+    bad(
+        "[0,0,0,1,1,1]",
+        "[0,0,1,1,1]",
+        &[
+            at,
+            "field 'knots'",
+            "u direction",
+            "expected 6 knots",
+            "got 5",
+        ],
+    );
+    bad(
+        "[0,0,1,2,2]",
+        "[0,0,2,1,2]",
+        &[
+            at,
+            "field 'knots'",
+            "v direction",
+            "knot 3 (1) is smaller than knot 2 (2)",
+        ],
+    );
+    bad(
+        "\"knots\": [[0,0,0,1,1,1],[0,0,1,2,2]]",
+        "\"knots\": [[0,0,0,1,1,1]]",
+        &[at, "field 'knots'", "expected [[u knots], [v knots]]"],
+    );
+    bad(
+        "[[2,0,0],[2,1,0],[2,2,0]]",
+        "[[2,0,0],[2,1,0]]",
+        &[at, "field 'points'", "row 2 has 2 entries, row 0 has 3"],
+    );
+    bad(
+        "[1,1,1]",
+        "[1,\"x\",1]",
+        &[
+            at,
+            "field 'points'",
+            "point [1][1] coordinate 1",
+            "expected a number, found a string",
+        ],
+    );
+    bad(
+        "\"samples\": [4, 5]",
+        "\"weights\": [[1,1,1],[1,1,1],[1,1,-1]], \"samples\": [4, 5]",
+        &[at, "field 'weights'", "is -1", "positive"],
+    );
+    bad(
+        "\"samples\": [4, 5]",
+        "\"samples\": [4, 1]",
+        &[at, "field 'samples'", "at least 2"],
+    );
+}
+
+#[test]
+fn erbs_surface_fields() {
+    let (ok, _, stderr) = sample(&scene(&[ESURF]), None);
+    assert!(ok, "the base surface is valid: {stderr}");
+    let bad = |from: &str, to: &str, parts: &[&str]| {
+        assert!(ESURF.contains(from), "{from}");
+        expect_error(&scene(&[&ESURF.replace(from, to)]), None, parts);
+    };
+    let at = "object 'es' (objects[0])";
+    bad(
+        "[[0,0,1,1],[0,0,1,2,2]]",
+        "[[0,0,1,1],[0,0,1,1,2]]",
+        &[
+            at,
+            "field 'knots'",
+            "v direction",
+            "knot 4 (2) must equal knot 3 (1)",
+        ],
+    );
+    bad(
+        "[[0,0,1,1],[0,0,1,2,2]]",
+        "[[0,1,1,1],[0,0,1,2,2]]",
+        &[
+            at,
+            "field 'knots'",
+            "u direction",
+            "knot 0 (0) must equal knot 1 (1)",
+        ],
+    );
+    bad(
+        "[[0,0,1,1],[0,0,1,2,2]]",
+        "[[0,0,1,1],[0,0,1,2]]",
+        &[
+            at,
+            "field 'knots'",
+            "v direction",
+            "expected 5 knots",
+            "got 4",
+        ],
+    );
+    bad(
+        "{\"points\": [[[1,1,1]]]}",
+        "{\"points\": [[[1,1,1]]], \"w\": 2}",
+        &[at, "local[1][1]", "unknown field 'w'"],
+    );
+    bad(
+        "{\"points\": [[[1,1,1]]]}",
+        "{\"points\": [[1,1,1]]}",
+        &[at, "local[1][1]", "field 'points'", "point [0][0]"],
+    );
+    bad(
+        "[{\"points\": [[[1,0,0]]]}, {\"points\": [[[1,1,1]]]}, {\"points\": [[[1,2,0]]]}]",
+        "[{\"points\": [[[1,0,0]]]}, {\"points\": [[[1,1,1]]]}]",
+        &[at, "field 'local'", "row 1 has 2 entries, row 0 has 3"],
+    );
+    bad(
+        "[[[0,2,0],[1,2,0]]]",
+        "[[[0,2,0],[1,2,0]],[[0,3,0]]]",
+        &[at, "local[0][2]", "field 'points'", "row 1 has 1 entries"],
+    );
+    bad(
+        "\"samples\": [5, 6]",
+        "\"bfunction\": \"x\", \"samples\": [5, 6]",
+        &[at, "field 'bfunction'", "unknown B-function 'x'"],
+    );
+    bad(
+        "\"samples\": [5, 6]",
+        "\"samples\": 5",
+        &[at, "field 'samples'", "expected [mu, mv]"],
+    );
+}
+
+/// The issue's example: a degree-60 B-spline curve with 5 000 000 samples and 20 derivatives
+/// needs ≈ 51 GB of Hermite tables. It must be refused before anything is allocated, with one
+/// line naming the object and the estimate — not abort the process in the allocator.
+#[test]
+fn a_request_too_large_for_memory_is_refused_in_one_line() {
+    let points: Vec<String> = (0..61).map(|i| format!("[{i}, {}, 0]", i % 3)).collect();
+    let knots: Vec<&str> = std::iter::repeat_n("0", 61)
+        .chain(std::iter::repeat_n("1", 61))
+        .collect();
+    let big = format!(
+        r#"{{"name": "big", "type": "bspline_curve", "degree": 60, "knots": [{}], "points": [{}], "samples": 5000000}}"#,
+        knots.join(","),
+        points.join(",")
+    );
+    let dir = Scratch::new("cli-errors");
+    let path = dir.file("big.json", &scene(&[CURVE, &big]));
+    let start = std::time::Instant::now();
+    let out = Command::new(env!("CARGO_BIN_EXE_prespline"))
+        .arg("sample")
+        .arg(&path)
+        .args(["--derivatives", "20"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    eprintln!("refused in {:?}: {stderr}", start.elapsed());
+    assert!(!out.status.success());
+    assert!(out.stdout.is_empty(), "partial output");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    for part in [
+        "error: ",
+        "big.json: object 'big' (objects[1])",
+        "needs about",
+        "GiB to pre-evaluate",
+        "Hermite tables",
+        "5000000 samples × 21 derivative orders × 61 basis functions",
+        "over the memory budget of",
+        "half of physical memory; --memory-limit overrides",
+    ] {
+        assert!(stderr.contains(part), "{stderr:?} lacks {part:?}");
+    }
+}
+
+/// `--memory-limit` applies to every command that pre-evaluates, and refuses before a window,
+/// a device or any output exists.
+#[test]
+fn memory_limit_applies_to_every_command() {
+    let dir = Scratch::new("cli-errors");
+    let path = dir.file("scene.json", &scene(&[SURF]));
+    let png = dir.join("out.png");
+    let out_dir = dir.join("bench");
+    let runs: [Vec<&std::ffi::OsStr>; 4] = [
+        vec!["sample".as_ref(), path.as_ref()],
+        vec![
+            "render".as_ref(),
+            path.as_ref(),
+            "--out".as_ref(),
+            png.as_ref(),
+        ],
+        vec!["view".as_ref(), path.as_ref()],
+        vec![
+            "bench".as_ref(),
+            path.as_ref(),
+            "--out".as_ref(),
+            out_dir.as_ref(),
+        ],
+    ];
+    for args in runs {
+        let out = Command::new(env!("CARGO_BIN_EXE_prespline"))
+            .args(&args)
+            .args(["--memory-limit", "2K"])
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8(out.stderr).unwrap();
+        assert!(!out.status.success(), "{args:?}: {stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{args:?}: {stderr}");
+        assert!(
+            stderr.contains("object 's' (objects[0]): needs about")
+                && stderr.contains("over the memory budget of 2.0 KiB (--memory-limit)"),
+            "{args:?}: {stderr}"
+        );
+    }
+    // Within the limit the same scene samples.
+    assert!(
+        !png.exists() && !out_dir.exists(),
+        "output written after refusing"
+    );
+    let out = Command::new(env!("CARGO_BIN_EXE_prespline"))
+        .arg("sample")
+        .arg(&path)
+        .args(["--memory-limit", "1M"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let bad = Command::new(env!("CARGO_BIN_EXE_prespline"))
+        .arg("sample")
+        .arg(&path)
+        .args(["--memory-limit", "lots"])
+        .output()
+        .unwrap();
+    assert!(!bad.status.success());
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--memory-limit"));
 }

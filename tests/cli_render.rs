@@ -1,5 +1,7 @@
 //! `prespline render` run the way a user runs it (on lavapipe).
 
+mod common;
+
 use std::path::Path;
 use std::process::Command;
 
@@ -8,14 +10,14 @@ fn prespline() -> Command {
     let icd = "/usr/share/vulkan/icd.d/lvp_icd.x86_64.json";
     c.env("VK_DRIVER_FILES", icd)
         .env("VK_ICD_FILENAMES", icd)
-        .env("PRESPLINE_VALIDATION", "1");
+        .env("PRESPLINE_VALIDATION", "required");
     c
 }
 
 #[test]
 fn renders_a_png_with_edits_and_camera() {
-    let dir = std::env::temp_dir().join(format!("prespline-cli-render-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch = common::Scratch::new("cli-render");
+    let dir = scratch.path();
     let edits = dir.join("edits.json");
     std::fs::write(
         &edits,
@@ -52,7 +54,8 @@ fn renders_a_png_with_edits_and_camera() {
 
 #[test]
 fn bad_input_is_one_line() {
-    let dir = std::env::temp_dir();
+    let scratch = common::Scratch::new("cli-render");
+    let dir = scratch.path();
     let r = prespline()
         .args(["render", "/nonexistent.json", "--out"])
         .arg(dir.join("x.png"))
@@ -70,11 +73,87 @@ fn bad_input_is_one_line() {
         let r = prespline()
             .arg("render")
             .arg(&scene)
-            .args(["--out", "/tmp/x.png", flag, value])
+            .arg("--out")
+            .arg(dir.join("x.png"))
+            .args([flag, value])
             .output()
             .unwrap();
         assert!(!r.status.success());
         let err = String::from_utf8_lossy(&r.stderr);
         assert!(err.contains(msg), "{flag} {value}: {err}");
+    }
+}
+
+/// `PRESPLINE_VALIDATION=required` (what every test run uses) fails with one line when the
+/// Khronos layer is missing, instead of rendering unvalidated; `1` renders without it.
+#[test]
+fn required_validation_fails_without_the_layer() {
+    let scratch = common::Scratch::new("cli-render");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/bezier_curve.json");
+    let out = scratch.join("x.png");
+    let render = |mode: &str| {
+        prespline()
+            .env("PRESPLINE_VALIDATION", mode)
+            // An empty layer search path: the loader finds no layer at all.
+            .env("VK_LAYER_PATH", scratch.path())
+            .env_remove("VK_ADD_LAYER_PATH")
+            .arg("render")
+            .arg(&scene)
+            .args(["--size", "64x64", "--out"])
+            .arg(&out)
+            .output()
+            .unwrap()
+    };
+    let r = render("required");
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(!r.status.success(), "rendered unvalidated: {err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("validation layer") && err.contains("vulkan-validationlayers"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    let r = render("1");
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+}
+
+/// The display flags draw what the goldens of `render_golden` show: `--normals --wire 1`,
+/// `--frenet` and `--no-local` run the way a user runs them, against the same golden images.
+#[test]
+fn display_flags_draw_what_the_goldens_show() {
+    let scratch = common::Scratch::new("cli-render");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for (example, flags, golden) in [
+        (
+            "bspline_surface.json",
+            &["--normals", "--wire", "1"][..],
+            "bspline_surface_normals_wire",
+        ),
+        ("helix.json", &["--frenet"][..], "helix_frenet"),
+        (
+            "erbs_surface.json",
+            &["--no-local"][..],
+            "erbs_surface_no_local",
+        ),
+    ] {
+        let out = scratch.join(format!("{golden}.png"));
+        let r = prespline()
+            .arg("render")
+            .arg(root.join("examples").join(example))
+            .args(["--size", "640x400", "--msaa", "4"])
+            .args(flags)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        let expected =
+            prespline::gpu::Pixels::read_png(&root.join(format!("tests/golden/{golden}.png")))
+                .unwrap();
+        let actual = prespline::gpu::Pixels::read_png(&out).unwrap();
+        common::compare_images(&expected, &actual, common::GOLDEN.channel)
+            .unwrap()
+            .check(&common::GOLDEN)
+            .unwrap_or_else(|e| panic!("{example} {flags:?} against {golden}: {e}"));
     }
 }

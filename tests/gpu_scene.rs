@@ -142,7 +142,7 @@ fn synthetic_scene_matches_golden() {
         .filter(|p| p[..3] != [63, 63, 75])
         .count();
     assert!(lit > (W * H / 6) as usize, "only {lit} pixels drawn");
-    common::assert_golden("scene", &pixels, 2, 0.002);
+    common::assert_golden("scene", &pixels);
 
     r.destroy_mirror(mirror);
     r.destroy_offscreen(target).expect("destroy target");

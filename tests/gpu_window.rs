@@ -1,6 +1,8 @@
 //! Swapchain smoke test: a real winit window (X11, e.g. under Xvfb), a few presented frames,
-//! a resize, a switch away from vsync, and a leak-free teardown. Skipped without `DISPLAY`.
-//! winit allows one event loop per process, so this binary holds exactly one test.
+//! a resize, a switch away from vsync, and a leak-free teardown. Skipped without `DISPLAY`,
+//! except under `make test` and CI, where that fails.
+//! winit allows one event loop per process, so this binary holds exactly one windowed test
+//! (the other only runs it again in child processes).
 //!
 //! `Xvfb :99 -screen 0 1280x1024x24 & DISPLAY=:99 cargo test --test gpu_window`
 
@@ -231,8 +233,7 @@ impl ApplicationHandler for App {
 
 #[test]
 fn swapchain_presents_resizes_and_tears_down() {
-    if std::env::var_os("DISPLAY").is_none() {
-        eprintln!("skipped: no DISPLAY (run under Xvfb to test the swapchain)");
+    if !common::display() {
         return;
     }
     force_driver_files(LAVAPIPE_ICD);
@@ -245,7 +246,7 @@ fn swapchain_presents_resizes_and_tears_down() {
     let event_loop = match EventLoop::builder().with_any_thread(true).build() {
         Ok(el) => el,
         Err(e) => {
-            eprintln!("skipped: cannot open the display: {e}");
+            common::precondition(false, &format!("cannot open the display: {e}"));
             return;
         }
     };
@@ -281,4 +282,35 @@ fn swapchain_presents_resizes_and_tears_down() {
         "swapchain extent {:?}",
         app.last_extent
     );
+}
+
+/// Under `make test` (PRESPLINE_STRICT=1) or CI, a missing display fails this binary's test
+/// instead of skipping it: run again without DISPLAY in a child process (which opens no event
+/// loop of its own here).
+#[test]
+fn without_a_display_strict_runs_fail() {
+    if std::env::var_os("PRESPLINE_WINDOW_CHILD").is_some() {
+        return;
+    }
+    for (var, value, fails) in [
+        ("PRESPLINE_STRICT", "1", true),
+        ("CI", "1", true),
+        ("CI", "", false),
+    ] {
+        let out = std::process::Command::new(std::env::current_exe().unwrap())
+            .args(["--exact", "swapchain_presents_resizes_and_tears_down"])
+            .env("PRESPLINE_WINDOW_CHILD", "1")
+            .env_remove("DISPLAY")
+            .env_remove("PRESPLINE_STRICT")
+            .env_remove("CI")
+            .env(var, value)
+            .output()
+            .unwrap();
+        let text = format!(
+            "{}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert_eq!(!out.status.success(), fails, "{var}={value}:\n{text}");
+    }
 }

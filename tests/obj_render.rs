@@ -32,11 +32,6 @@ fn render(scene: &Scene, options: ViewOptions) -> prespline::gpu::Pixels {
     pixels
 }
 
-/// The goldens' tolerance (tests/render_golden.rs): lavapipe is deterministic; the slack
-/// absorbs rounding differences between driver builds.
-const TOLERANCE: u8 = 2;
-const MAX_FRACTION: f64 = 0.002;
-
 #[test]
 fn imported_vase_matches_the_golden() {
     let import = load_obj(&example("vase.obj")).unwrap();
@@ -48,7 +43,7 @@ fn imported_vase_matches_the_golden() {
             ..ViewOptions::default()
         },
     );
-    common::assert_golden("obj_vase", &px, TOLERANCE, MAX_FRACTION);
+    common::assert_golden("obj_vase", &px);
 }
 
 #[test]

@@ -315,7 +315,7 @@ fn erbs_curve(bf: BFunctionKind) -> SceneObject {
         panic!("erbs_curve.json holds an ERBS curve first")
     };
     let c = c.curve();
-    let e = ErbsCurve::new(c.knots().to_vec(), c.local_curves().to_vec(), bf).unwrap();
+    let e = ErbsCurve::with_locals(c.knots().clone(), c.local_curves().to_vec(), bf).unwrap();
     o.model = Model::ErbsCurve(ErbsCurveModel::new(e, o.model.sample_dims()[0]).unwrap());
     o
 }
@@ -327,7 +327,7 @@ fn erbs_surface(bf: BFunctionKind) -> SceneObject {
         panic!("erbs_surface.json holds an ERBS surface first")
     };
     let s = s.surface();
-    let e = ErbsSurface::new(s.knots().clone(), s.count(), s.local_patches().to_vec(), bf).unwrap();
+    let e = ErbsSurface::with_locals(s.knots().clone(), s.local_patches().to_vec(), bf).unwrap();
     o.model = Model::ErbsSurface(ErbsSurfaceModel::new(e, o.model.sample_dims()).unwrap());
     o
 }

@@ -9,7 +9,7 @@
 mod oracle;
 
 use oracle::bfunction::{self, BFunction, EXPO_SCALE};
-use oracle::compare::compare_output;
+use oracle::compare::{compare_output, nan_max};
 use oracle::eval::{
     self, Basis, Homogeneous, Point3, bspline_derivatives, project_curve_derivatives,
 };
@@ -193,7 +193,7 @@ fn expo_bfunction_matches_mpmath() {
     let orders = table[0].1.len();
     // Per-order magnitude over the table, the natural scale of errors in derivative r.
     let scale: Vec<f64> = (0..orders)
-        .map(|r| table.iter().map(|(_, d)| d[r].abs()).fold(1.0, f64::max))
+        .map(|r| table.iter().map(|(_, d)| d[r].abs()).fold(1.0, nan_max))
         .collect();
     let mut worst_abs = vec![0.0f64; orders];
     let mut worst_rel = vec![0.0f64; orders];
@@ -202,12 +202,12 @@ fn expo_bfunction_matches_mpmath() {
         let ours = BFunction::Expo.derivatives(*t, orders - 1);
         for r in 0..orders {
             let err = (ours[r] - reference[r]).abs();
-            worst_abs[r] = worst_abs[r].max(err);
-            worst_rel[r] = worst_rel[r].max(err / scale[r]);
+            worst_abs[r] = nan_max(worst_abs[r], err);
+            worst_rel[r] = nan_max(worst_rel[r], err / scale[r]);
             // Pointwise relative accuracy where the value is not tiny compared to its order.
             if reference[r].abs() > 1e-6 * scale[r] {
                 let rel = err / reference[r].abs();
-                worst_pointwise[r] = worst_pointwise[r].max(rel);
+                worst_pointwise[r] = nan_max(worst_pointwise[r], rel);
                 assert!(
                     rel < 1e-13,
                     "B^({r})({t}): {} vs {} (rel {rel:e})",
@@ -309,7 +309,7 @@ fn bfunction_derivatives_match_finite_differences() {
             for r in 0..=6 {
                 let scale = 1.0 + d[r + 1].abs() + d[r].abs();
                 let err = (fd[r] - d[r + 1]).abs() / scale;
-                worst = worst.max(err);
+                worst = nan_max(worst, err);
                 assert!(
                     err < 1e-5,
                     "{b:?}: B^({}) at {t}: {} vs FD {}",
@@ -563,10 +563,10 @@ fn scaled_difference(a: &[Vec<Point3>], b: &[Vec<Point3>]) -> f64 {
         let scale = a
             .iter()
             .flat_map(|d| d[r])
-            .fold(1.0f64, |m, x| m.max(x.abs()));
+            .fold(1.0f64, |m, x| nan_max(m, x.abs()));
         for (x, y) in a.iter().zip(b) {
             for k in 0..3 {
-                worst = worst.max((x[r][k] - y[r][k]).abs() / scale);
+                worst = nan_max(worst, (x[r][k] - y[r][k]).abs() / scale);
             }
         }
     }
@@ -610,7 +610,7 @@ fn bspline_curves_match_cox_de_boor_basis_functions() {
             })
             .collect();
         let diff = scaled_difference(&ours, &theirs);
-        worst = worst.max(diff);
+        worst = nan_max(worst, diff);
         assert!(
             diff < 1e-12,
             "seed {seed}: hodograph path vs basis functions differ by {diff:e}"
@@ -686,7 +686,7 @@ fn bspline_surfaces_match_cox_de_boor_basis_functions() {
             }
         }
         let diff = scaled_difference(&ours, &theirs);
-        worst = worst.max(diff);
+        worst = nan_max(worst, diff);
         assert!(
             diff < 1e-12,
             "seed {seed}: surface paths differ by {diff:e}"
@@ -787,7 +787,7 @@ fn derivatives_match_finite_differences() {
                 for cell in grid.iter().flatten() {
                     for (a, row) in cell.iter().enumerate() {
                         for (b, v) in row.iter().enumerate() {
-                            scale[a][b] = v.iter().fold(scale[a][b], |m, x| m.max(x.abs()));
+                            scale[a][b] = v.iter().fold(scale[a][b], |m, x| nan_max(m, x.abs()));
                         }
                     }
                 }
@@ -813,14 +813,15 @@ fn derivatives_match_finite_differences() {
                         for b in 0..=order {
                             // Scale: the sample grid may straddle only knots, where expo-rational
                             // ERBS derivatives vanish; include the values at this point.
-                            let local = |d: Point3, s: f64| d.iter().fold(s, |m, x| m.max(x.abs()));
+                            let local =
+                                |d: Point3, s: f64| d.iter().fold(s, |m, x| nan_max(m, x.abs()));
                             let su = local(exact[a + 1][b], scale[a + 1][b]);
                             let sv = local(exact[a][b + 1], scale[a][b + 1]);
                             for k in 0..3 {
                                 let idx = (a * (order + 1) + b) * 3 + k;
                                 let eu = (fd_u[idx] - exact[a + 1][b][k]).abs() / su;
                                 let ev = (fd_v[idx] - exact[a][b + 1][k]).abs() / sv;
-                                worst = worst.max(eu).max(ev);
+                                worst = nan_max(nan_max(worst, eu), ev);
                                 assert!(
                                     eu < 1e-6 && ev < 1e-6,
                                     "seed {seed} {} ({a},{b})[{k}] at ({u},{v}): u {eu:e}, v {ev:e}",
@@ -835,7 +836,7 @@ fn derivatives_match_finite_differences() {
                 let mut scale = vec![1.0f64; order + 2];
                 for t in &params[0] {
                     for (r, v) in object.curve_derivatives(*t, order + 1).iter().enumerate() {
-                        scale[r] = v.iter().fold(scale[r], |m, x| m.max(x.abs()));
+                        scale[r] = v.iter().fold(scale[r], |m, x| nan_max(m, x.abs()));
                     }
                 }
                 for (t, h) in interior_params(object, 0, &mut rng, 8) {
@@ -854,10 +855,10 @@ fn derivatives_match_finite_differences() {
                     for r in 0..=order {
                         let s = exact[r + 1]
                             .iter()
-                            .fold(scale[r + 1], |m, x| m.max(x.abs()));
+                            .fold(scale[r + 1], |m, x| nan_max(m, x.abs()));
                         for k in 0..3 {
                             let e = (fd[r * 3 + k] - exact[r + 1][k]).abs() / s;
-                            worst = worst.max(e);
+                            worst = nan_max(worst, e);
                             assert!(
                                 e < 1e-6,
                                 "seed {seed} {} order {} at {t}: {} vs FD {} ({e:e})",
@@ -906,7 +907,7 @@ fn erbs_interpolates_local_curves_at_knots() {
             let ours = object.curve_derivatives(t, smooth);
             let direct = eval::erbs_local_curve_derivatives(knots, l, local, t, smooth);
             for r in 0..=smooth {
-                let scale = 1.0 + direct[r].iter().fold(0.0f64, |m, x| m.max(x.abs()));
+                let scale = 1.0 + direct[r].iter().fold(0.0f64, |m, x| nan_max(m, x.abs()));
                 for k in 0..3 {
                     assert!(
                         close(ours[r][k], direct[r][k], 1e-13 * scale),
@@ -1246,7 +1247,7 @@ fn affine_transform_of_all_locals_transforms_the_erbs() {
                     .iter()
                     .chain(&after)
                     .flatten()
-                    .fold(0.0f64, |m, x| m.max(x.abs()));
+                    .fold(0.0f64, |m, x| nan_max(m, x.abs()));
             for (r, (x, y)) in before.iter().zip(&after).enumerate() {
                 let expected = if r == 0 {
                     oracle::scene::affine(&matrix, *x)
@@ -1503,6 +1504,39 @@ fn comparison_detects_mismatches() {
         !compare_output(&scene, n + 1, &out, 1e-12).ok(),
         "wrong derivative count"
     );
+}
+
+/// Negative controls of the error measure: a small object is held to its own size (a floor
+/// of 1 on the scale let errors 1000× larger through on a millimetre-sized curve), and a NaN on
+/// the oracle side is a mismatch that makes the maximum error NaN.
+#[test]
+fn comparison_is_relative_to_each_object_and_catches_nan() {
+    let scene = Scene::from_json(&json!({"objects": [
+        {"name": "tiny", "type": "bezier_curve",
+         "points": [[0.001, 0.001, 0], [0.001, 0.01, 0], [0.01, 0.01, 0], [0.01, 0.001, 0]],
+         "samples": 5}]}))
+    .unwrap();
+    let out = scene.sample_json(2);
+    assert!(compare_output(&scene, 2, &out, 1e-12).ok());
+    let mut off = out.clone();
+    let x = off["objects"][0]["samples"][2][0][1].as_f64().unwrap();
+    // 1e-10 of this object's size: far above the tolerance, far below 1e-12 × 1.
+    off["objects"][0]["samples"][2][0][1] = json!(x + 1e-10 * 0.01);
+    let report = compare_output(&scene, 2, &off, 1e-12);
+    assert_eq!(report.mismatch_count, 1, "{}", report.describe());
+
+    let mut poisoned = scene.clone();
+    if let Shape::Curve { points, .. } = &mut poisoned.objects[0].shape {
+        points[1][1] = f64::NAN;
+    }
+    let report = compare_output(&poisoned, 2, &out, 1e-12);
+    assert!(!report.ok() && report.mismatch_count > 0);
+    assert!(
+        report.max_relative_error.is_nan(),
+        "{}",
+        report.max_relative_error
+    );
+    assert!(nan_max(0.0, f64::NAN).is_nan() && nan_max(f64::NAN, 1.0).is_nan());
 }
 
 /// The generator really produces the features the agreement test relies on.

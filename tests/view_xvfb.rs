@@ -1,16 +1,25 @@
-//! The viewer under X (Xvfb in `make test`) with lavapipe: a scripted session drags a control
-//! point along z, moves a circle point by a typed exact amount, rotates an ERBS local patch,
-//! undoes once and saves. The saved scene must hold exactly the expected control data, and a
-//! screenshot must match the golden image. Skipped (with a note) when DISPLAY is not set.
+//! The viewer under X (Xvfb in `make test`) with lavapipe and the validation layer required: a
+//! scripted session drags a control point along z, moves a circle point by a typed exact
+//! amount, rotates an ERBS local patch, undoes once and saves. The saved scene must hold exactly
+//! the expected control data, and a screenshot must match the golden image. Unsaved edits go to
+//! the autosave within a second and on quit, and `--recover` brings them back. Every run has a
+//! time limit and a scratch directory of its own (also its working directory, where the demo's
+//! autosave goes). Skipped (with a note) when DISPLAY is not set, except under `make test` and
+//! CI, where that fails.
 
 mod common;
 
+use common::Scratch;
 use glam::DVec3;
 use prespline::gpu::Pixels;
 use prespline::model::Model;
 use prespline::scene::Scene;
 use prespline::scene::demo::demo_scene;
-use std::process::Command;
+use std::process::{Command, Output};
+use std::time::{Duration, Instant};
+
+/// Longest a scripted viewer run may take (a few seconds normally).
+const LIMIT: Duration = Duration::from_secs(180);
 
 const SCRIPT: &str = r#"[
  {"frame": 3, "move_to": {"object": "bspline_surface", "point": [3, 4]}},
@@ -41,24 +50,26 @@ const SCRIPT: &str = r#"[
 
 #[test]
 fn scripted_session_saves_exact_edits_and_matches_the_golden() {
-    if !display() {
+    if !common::display() {
         return;
     }
-    let dir = std::env::temp_dir().join(format!("prespline-view-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = Scratch::new("view-xvfb");
     let shot = dir.join("shot.png");
     let saved = dir.join("saved.json");
-    let script = dir.join("script.json");
-    std::fs::write(&script, SCRIPT.replace("SHOT", shot.to_str().unwrap())).unwrap();
-    let out = prespline()
+    let script = dir.file(
+        "script.json",
+        &SCRIPT.replace("SHOT", shot.to_str().unwrap()),
+    );
+    let out = run(prespline(&dir)
         .args(["view", "--size", "960x600", "--script"])
         .arg(&script)
         .arg("--save-as")
-        .arg(&saved)
-        .output()
-        .unwrap();
+        .arg(&saved));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "viewer failed: {err}");
+    // Saved before quitting: no autosave is left behind.
+    assert!(!dir.join("demo.autosave.json").exists(), "{err}");
+    assert!(!err.contains("unsaved edits"), "{err}");
 
     // Exact control data: only the two confirmed moves remain; the rotation was undone.
     let before = demo_scene();
@@ -98,46 +109,43 @@ fn scripted_session_saves_exact_edits_and_matches_the_golden() {
     }
 
     let pixels = Pixels::read_png(&shot).unwrap();
-    common::assert_golden("view_session", &pixels, 2, 0.002);
+    common::assert_golden("view_session", &pixels);
 }
 
-fn display() -> bool {
-    let ok = std::env::var_os("DISPLAY").is_some_and(|d| !d.is_empty());
-    if !ok {
-        eprintln!("skipped: DISPLAY is not set (make test runs this under Xvfb)");
-    }
-    ok
-}
-
-fn prespline() -> Command {
+/// `prespline` on lavapipe with the validation layer required, in `dir`.
+fn prespline(dir: &Scratch) -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_prespline"));
     let icd = prespline::gpu::LAVAPIPE_ICD;
     c.env("VK_DRIVER_FILES", icd)
         .env("VK_ICD_FILENAMES", icd)
-        .env("PRESPLINE_VALIDATION", "1");
+        .env("PRESPLINE_VALIDATION", "required")
+        .current_dir(dir.path());
     c
+}
+
+fn run(command: &mut Command) -> Output {
+    common::output_with_timeout(command, LIMIT)
 }
 
 #[test]
 fn view_profile_writes_the_reports_when_the_window_closes() {
-    if !display() {
+    if !common::display() {
         return;
     }
-    let dir = std::env::temp_dir().join(format!("prespline-view-profile-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let script = dir.join("script.json");
-    std::fs::write(&script, r#"[{"frame": 2, "move": [300, 200]}, {"frame": 3, "wheel": 1}, {"frame": 8, "quit": true}]"#).unwrap();
+    let dir = Scratch::new("view-xvfb");
+    let script = dir.file(
+        "script.json",
+        r#"[{"frame": 2, "move": [300, 200]}, {"frame": 3, "wheel": 1}, {"frame": 8, "quit": true}]"#,
+    );
     let example =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/bspline_surface.json");
-    let out = prespline()
+    let out = run(prespline(&dir)
         .arg("view")
         .arg(&example)
         .args(["--size", "320x240", "--script"])
         .arg(&script)
         .arg("--profile")
-        .arg(dir.join("profile"))
-        .output()
-        .unwrap();
+        .arg(dir.join("profile")));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{err}");
     assert!(err.contains("profile of"), "{err}");
@@ -155,11 +163,12 @@ fn view_profile_writes_the_reports_when_the_window_closes() {
 
 #[test]
 fn bench_runs_in_a_window() {
-    if !display() {
+    if !common::display() {
         return;
     }
-    let dir = std::env::temp_dir().join(format!("prespline-bench-window-{}", std::process::id()));
-    let out = prespline()
+    let scratch = Scratch::new("view-xvfb");
+    let dir = scratch.join("bench");
+    let out = run(prespline(&scratch)
         .args([
             "bench",
             "--window",
@@ -173,9 +182,7 @@ fn bench_runs_in_a_window() {
             "320x200",
             "--out",
         ])
-        .arg(&dir)
-        .output()
-        .unwrap();
+        .arg(&dir));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{err}");
     let csv = std::fs::read_to_string(dir.join("frames.csv")).unwrap();
@@ -187,16 +194,263 @@ fn bench_runs_in_a_window() {
     assert!(dir.join("frame_times.svg").is_file());
 }
 
+/// Runs the viewer on `scene` with `script` (JSON text) in `dir`; returns the child to watch.
+fn spawn_view(
+    dir: &Scratch,
+    scene: &std::path::Path,
+    script: &str,
+    extra: &[&str],
+) -> std::process::Child {
+    let script = dir.file("script.json", script);
+    prespline(dir)
+        .arg("view")
+        .arg(scene)
+        .args(["--size", "480x320", "--script"])
+        .arg(&script)
+        .args(extra)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+/// Unsaved edits reach NAME.autosave.json about a second after the edit, while the viewer is
+/// still open (not only when it closes); its path is printed when the viewer closes; opening
+/// the scene again prints a notice, and `--recover` opens the edits, which a clean save then
+/// writes to the scene and removes from the autosave.
+#[test]
+fn unsaved_edits_survive_in_the_autosave_and_come_back_with_recover() {
+    if !common::display() {
+        return;
+    }
+    let dir = Scratch::new("view-xvfb");
+    let example =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/bspline_surface.json");
+    let scene = dir.join("surface.json");
+    std::fs::copy(&example, &scene).unwrap();
+    let autosave = dir.join("surface.autosave.json");
+    let original = Scene::load(&scene).unwrap();
+
+    // A drag, then nothing for seconds before the script quits.
+    let mut child = spawn_view(
+        &dir,
+        &scene,
+        r#"[{"frame": 3, "move_to": {"object": "bumps", "point": [3, 3]}},
+            {"frame": 4, "press": "left"}, {"frame": 5, "move_by": [0, -30]},
+            {"frame": 6, "move_by": [0, -30]}, {"frame": 7, "release": "left"},
+            {"t": 6.0, "quit": true}]"#,
+        &[],
+    );
+    let start = Instant::now();
+    let mut appeared = None;
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        if appeared.is_none() && autosave.exists() {
+            appeared = Some(Instant::now());
+        }
+        assert!(start.elapsed() < LIMIT, "the viewer did not quit");
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    // Written by the timer about a second after the drag, seconds before the script's quit
+    // at t = 6 s writes it again on the way out.
+    let before_exit = appeared.map(|t| t.elapsed());
+    let seen_while_open = before_exit.is_some_and(|d| d > Duration::from_secs(2));
+    let mut err = String::new();
+    std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
+    assert!(status.success(), "{err}");
+    assert!(
+        seen_while_open,
+        "the autosave was not written while the viewer was open ({before_exit:?} before it closed): {err}"
+    );
+    assert!(
+        err.contains(&format!("unsaved edits kept in {}", autosave.display())),
+        "the autosave's path is not printed on close: {err}"
+    );
+    let kept = Scene::load(&autosave).unwrap();
+    assert_ne!(kept, original, "the drag is in the autosave");
+    assert_eq!(
+        Scene::load(&scene).unwrap(),
+        original,
+        "the scene file is untouched"
+    );
+
+    // Opening the scene again: a one-line notice.
+    let out = run(prespline(&dir)
+        .arg("view")
+        .arg(&scene)
+        .args(["--size", "320x240", "--script"])
+        .arg(dir.file("quit.json", r#"[{"frame": 2, "quit": true}]"#)));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let notice: Vec<&str> = err.lines().filter(|l| l.contains("--recover")).collect();
+    assert_eq!(notice.len(), 1, "{err}");
+    assert!(notice[0].contains(&autosave.display().to_string()), "{err}");
+    assert_eq!(
+        Scene::load(&autosave).unwrap(),
+        kept,
+        "the notice alone changes nothing"
+    );
+
+    // --recover opens the edits; Ctrl+S writes them to the scene and removes the autosave.
+    let out = run(prespline(&dir)
+        .arg("view")
+        .arg(&scene)
+        .arg("--recover")
+        .args(["--size", "320x240", "--script"])
+        .arg(dir.file(
+            "save.json",
+            r#"[{"frame": 2, "key": "s", "ctrl": true}, {"frame": 4, "quit": true}]"#,
+        )));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert_eq!(
+        Scene::load(&scene).unwrap(),
+        kept,
+        "the recovered edits were saved"
+    );
+    assert!(
+        !autosave.exists(),
+        "a clean save removes the autosave: {err}"
+    );
+    assert!(!err.contains("unsaved edits"), "{err}");
+
+    // Nothing to recover now: one clear line.
+    let out = run(prespline(&dir).arg("view").arg(&scene).arg("--recover"));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("--recover") && err.contains("no autosave"),
+        "{err}"
+    );
+}
+
+/// The demo's autosave is demo.autosave.json in the working directory.
+#[test]
+fn the_demo_autosaves_in_the_working_directory() {
+    if !common::display() {
+        return;
+    }
+    let dir = Scratch::new("view-xvfb");
+    let out = run(prespline(&dir)
+        .args(["view", "--size", "320x240", "--script"])
+        .arg(dir.file(
+            "script.json",
+            r#"[{"frame": 3, "move_to": {"object": "nurbs_circle", "point": 2}},
+                {"frame": 4, "press": "left"}, {"frame": 5, "release": "left"},
+                {"frame": 6, "key": "g"}, {"frame": 7, "key": "z"}, {"frame": 8, "type": "1"},
+                {"frame": 9, "key": "enter"}, {"frame": 11, "quit": true}]"#,
+        )));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let autosave = dir.join("demo.autosave.json");
+    assert!(
+        err.contains("unsaved edits kept in demo.autosave.json"),
+        "{err}"
+    );
+    let kept = Scene::load(&autosave).unwrap();
+    assert_ne!(kept, demo_scene());
+}
+
+/// With the validation layer missing, a run that requires it fails with one line instead of
+/// running unvalidated.
+#[test]
+fn a_missing_validation_layer_fails_the_viewer() {
+    if !common::display() {
+        return;
+    }
+    let dir = Scratch::new("view-xvfb");
+    let out = run(prespline(&dir)
+        .env("VK_LAYER_PATH", dir.path())
+        .env_remove("VK_ADD_LAYER_PATH")
+        .args(["view", "--size", "320x240", "--script"])
+        .arg(dir.file("quit.json", r#"[{"frame": 2, "quit": true}]"#)));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success(),
+        "ran without the validation layer: {err}"
+    );
+    assert!(err.contains("validation layer"), "{err}");
+}
+
+/// Under `make test` (PRESPLINE_STRICT=1) or CI, a missing display fails these tests instead of
+/// skipping them: each is run again without DISPLAY in a child process of this binary.
+#[test]
+fn without_a_display_strict_runs_fail() {
+    for (var, value, fails) in [
+        ("PRESPLINE_STRICT", "1", true),
+        ("CI", "true", true),
+        ("PRESPLINE_STRICT", "0", false),
+    ] {
+        let out = Command::new(std::env::current_exe().unwrap())
+            .args([
+                "--exact",
+                "scripted_session_saves_exact_edits_and_matches_the_golden",
+            ])
+            .env_remove("DISPLAY")
+            .env_remove("PRESPLINE_STRICT")
+            .env_remove("CI")
+            .env(var, value)
+            .output()
+            .unwrap();
+        let text = format!(
+            "{}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert_eq!(!out.status.success(), fails, "{var}={value}:\n{text}");
+        if fails {
+            assert!(text.contains("DISPLAY is not set"), "{text}");
+        }
+    }
+}
+
+/// An error that ends the viewer (here a screenshot that cannot be written) still keeps the
+/// unsaved edits and says where.
+#[test]
+fn an_error_exit_keeps_the_unsaved_edits() {
+    if !common::display() {
+        return;
+    }
+    let dir = Scratch::new("view-xvfb");
+    let out = run(prespline(&dir)
+        .args(["view", "--size", "320x240", "--script"])
+        .arg(dir.file(
+            "script.json",
+            r#"[{"frame": 3, "move_to": {"object": "nurbs_circle", "point": 2}},
+                {"frame": 4, "press": "left"}, {"frame": 5, "release": "left"},
+                {"frame": 6, "key": "g"}, {"frame": 7, "key": "x"}, {"frame": 8, "type": "2"},
+                {"frame": 9, "key": "enter"},
+                {"frame": 11, "screenshot": "/nonexistent/directory/shot.png"},
+                {"frame": 30, "quit": true}]"#,
+        )));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success(),
+        "the screenshot cannot succeed: {err}"
+    );
+    assert!(err.contains("/nonexistent/directory/shot.png"), "{err}");
+    assert!(
+        err.contains("unsaved edits kept in demo.autosave.json"),
+        "{err}"
+    );
+    assert_ne!(
+        Scene::load(&dir.join("demo.autosave.json")).unwrap(),
+        demo_scene()
+    );
+}
+
 /// Insert a knot at the cursor, drag one of the new control points, save: the net is refined and
 /// the point moved. The same session with two undos before saving gives back the original
 /// scene bit for bit (the file text is the exact, shortest round-trip serialisation).
 #[test]
 fn knot_insertion_drag_and_two_undos_restore_the_scene_exactly() {
-    if !display() {
+    if !common::display() {
         return;
     }
-    let dir = std::env::temp_dir().join(format!("prespline-view-refine-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = Scratch::new("view-xvfb");
     let steps = r#"
  {"frame": 3, "move_to": {"object": "bspline_surface", "point": [3, 4]}},
  {"frame": 4, "press": "left"},
@@ -210,7 +464,7 @@ fn knot_insertion_drag_and_two_undos_restore_the_scene_exactly() {
  {"frame": 12, "move_by": [0, -30]},
  {"frame": 13, "move_by": [0, -30]},
  {"frame": 14, "release": "left"},"#;
-    let run = |name: &str, undo: &str| {
+    let session = |name: &str, undo: &str| {
         let saved = dir.join(format!("{name}.json"));
         let script = dir.join(format!("{name}-script.json"));
         let text = format!(
@@ -219,20 +473,18 @@ fn knot_insertion_drag_and_two_undos_restore_the_scene_exactly() {
  {{"frame": 22, "quit": true}}]"#
         );
         std::fs::write(&script, text).unwrap();
-        let out = prespline()
+        let out = run(prespline(&dir)
             .args(["view", "--size", "960x600", "--script"])
             .arg(&script)
             .arg("--save-as")
-            .arg(&saved)
-            .output()
-            .unwrap();
+            .arg(&saved));
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(out.status.success(), "viewer failed: {err}");
         std::fs::read_to_string(&saved).unwrap()
     };
     let original = prespline::scene::scene_to_json(&demo_scene());
 
-    let refined = run("refined", "");
+    let refined = session("refined", "");
     let after = prespline::scene::parse_scene(&refined).unwrap();
     let (Model::Surface(s0), Model::Surface(s1)) =
         (&demo_scene().objects[0].model, &after.objects[0].model)
@@ -261,7 +513,7 @@ fn knot_insertion_drag_and_two_undos_restore_the_scene_exactly() {
     assert_eq!(moved, vec![(4, 4)], "exactly the dragged new point moved");
     assert_ne!(refined, original);
 
-    let undone = run(
+    let undone = session(
         "undone",
         r#"
  {"frame": 16, "key": "z", "ctrl": true},

@@ -8,6 +8,7 @@ use crate::gpu::{FRAMES_IN_FLIGHT, OffscreenDesc, Renderer, RendererDesc};
 use crate::profile::{
     FrameRecord, Phase, Progress, Recorder, RunInfo, Summary, compare, write_all,
 };
+use crate::sampling::budget::MemoryBudget;
 use crate::scene::Scene;
 use crate::scene::demo::demo_scene;
 use crate::view::app::{self, ViewArgs};
@@ -27,6 +28,8 @@ pub struct BenchArgs {
     pub naive: bool,
     pub out: PathBuf,
     pub msaa: u32,
+    /// What pre-evaluation and the GPU mirrors may take.
+    pub memory: MemoryBudget,
 }
 
 /// Runs the benchmark, writes the reports and returns the closing line.
@@ -41,6 +44,7 @@ pub fn run(args: &BenchArgs) -> Result<String, CliError> {
         ),
         None => (demo_scene(), "demo".to_string()),
     };
+    super::render::check_drawable(&scene, Path::new(&scene_name), &args.memory)?;
     let modes: &[bool] = if args.naive { &[false, true] } else { &[false] };
     let mut summaries = Vec::new();
     let mut written = Vec::new();
@@ -209,6 +213,7 @@ fn run_window(
         warmup: args.warmup,
         max_frames: Some(args.warmup + args.frames),
         naive,
+        autosave: None,
     })
     .map_err(CliError)?;
     Ok((run.frames, run.device))

@@ -4,9 +4,12 @@ use super::CliError;
 use super::files::{SampleOverride, load_scene};
 use crate::gpu::{Renderer, RendererDesc, ValidationMode};
 use crate::render::offscreen::{Shot, render_document};
+use crate::render::maps::SurfaceMap;
 use crate::render::{Document, OrbitCamera, ViewOptions};
-use crate::scene::SceneError;
-use crate::scene::edit::parse_edits;
+use crate::sampling::SampleMode;
+use crate::sampling::budget::{MemoryBudget, Uses, check_scene};
+use crate::scene::edit::{apply_all, parse_edits};
+use crate::scene::{Scene, SceneError};
 use std::path::Path;
 use std::time::Instant;
 
@@ -30,10 +33,12 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
 }
 
 /// Validation layer policy for interactive commands: on in debug builds or with
-/// `PRESPLINE_VALIDATION=1`, when the layer is installed.
+/// `PRESPLINE_VALIDATION=1`, when the layer is installed; `PRESPLINE_VALIDATION=required`
+/// refuses to run without it (tests must not pass unvalidated); `0` turns it off.
 pub fn validation_mode() -> ValidationMode {
     let env = std::env::var("PRESPLINE_VALIDATION").ok();
     match env.as_deref() {
+        Some("required") => ValidationMode::Required,
         Some("1") => ValidationMode::IfAvailable,
         Some("0") => ValidationMode::Off,
         _ if cfg!(debug_assertions) => ValidationMode::IfAvailable,
@@ -41,23 +46,62 @@ pub fn validation_mode() -> ValidationMode {
     }
 }
 
-/// Loads a scene (JSON or OBJ) and applies an edits file (through the delta path).
+/// What drawing commands (`render`, `view`, `bench`) keep per object.
+pub const DRAW_USES: Uses = Uses {
+    gpu: true,
+    json_text: false,
+};
+
+/// Refuses a scene whose pre-evaluation and GPU mirrors would not fit `budget` (one line naming
+/// the object and the estimate).
+pub fn check_drawable(scene: &Scene, path: &Path, budget: &MemoryBudget) -> Result<(), CliError> {
+    check_scene(scene, SampleMode::Render, DRAW_USES, budget)
+        .map(|_| ())
+        .map_err(|e| CliError::in_file(path, e))
+}
+
+/// Loads a scene (JSON or OBJ), checks it against the memory budget and applies an edits file
+/// (through the delta path; edits that refine the model are budgeted too).
 pub fn load_document(
     scene_path: &Path,
     edits: Option<&Path>,
     samples: &SampleOverride,
+    budget: &MemoryBudget,
 ) -> Result<Document, CliError> {
     let scene = load_scene(scene_path, samples)?;
+    check_drawable(&scene, scene_path, budget)?;
+    let Some(path) = edits else {
+        return Ok(Document::new(&scene));
+    };
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| CliError(format!("cannot read {}: {e}", path.display())))?;
+    let edits = parse_edits(&text, &scene).map_err(|e| CliError::in_file(path, e))?;
+    // Knot insertion and degree elevation grow the tables: budget the edited model too.
+    let mut refined = scene.clone();
+    apply_all(&mut refined, &edits).map_err(|e| CliError::in_file(path, e))?;
+    check_drawable(&refined, scene_path, budget)?;
     let mut doc = Document::new(&scene);
-    if let Some(path) = edits {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| CliError(format!("cannot read {}: {e}", path.display())))?;
-        for e in parse_edits(&text, &scene).map_err(|e| CliError::in_file(path, e))? {
-            doc.apply(&e)
-                .map_err(|err| CliError::in_file(path, SceneError(err.to_string())))?;
-        }
+    for e in edits {
+        doc.apply(&e)
+            .map_err(|err| CliError::in_file(path, SceneError(err.to_string())))?;
     }
     Ok(doc)
+}
+
+/// Shows `map` on the document's surfaces (`--analysis`). A curvature map keeps second
+/// partials and K, H per sample: the scene is budgeted for that first (one line naming the
+/// object when it does not fit).
+pub fn show_analysis(
+    doc: &mut Document,
+    map: Option<SurfaceMap>,
+    budget: &MemoryBudget,
+) -> Result<(), CliError> {
+    if let Some(m) = map.filter(|m| m.needs_curvature()) {
+        check_scene(&doc.to_scene(), SampleMode::Analysis, DRAW_USES, budget)
+            .map_err(|e| CliError(format!("--analysis {}: {e}", m.name())))?;
+    }
+    doc.set_analysis(map);
+    Ok(())
 }
 
 /// The object index and parameter of `--osculating NAME@T`, checked: a curve object, T in its

@@ -2,6 +2,7 @@
 //! DESIGN.md JSON contract on stdout.
 
 use super::CliError;
+use crate::sampling::budget::{MemoryBudget, Uses, check_scene};
 use crate::sampling::{SampleMode, SampledObject};
 use crate::scene::edit::{apply_all, parse_edits};
 use std::fmt::Write;
@@ -18,6 +19,8 @@ pub struct SampleArgs<'a> {
     pub edits: Option<&'a Path>,
     /// Apply edits to the model and re-sample from scratch instead of the delta path.
     pub full: bool,
+    /// What pre-evaluation and the output text may take.
+    pub memory: MemoryBudget,
 }
 
 /// Runs the command and returns the complete output text (nothing is printed on error, so a
@@ -39,8 +42,20 @@ pub fn run(args: &SampleArgs) -> Result<String, CliError> {
         None => Vec::new(),
     };
     let mode = SampleMode::Derivatives(args.derivatives);
-    if args.full {
-        apply_all(&mut scene, &edits).map_err(|e| CliError(e.to_string()))?;
+    let uses = Uses {
+        gpu: false,
+        json_text: true,
+    };
+    check_scene(&scene, mode, uses, &args.memory).map_err(|e| CliError::in_file(args.scene, e))?;
+    if !edits.is_empty() {
+        // Knot insertion and degree elevation grow the tables: budget the edited model too.
+        let mut refined = scene.clone();
+        apply_all(&mut refined, &edits).map_err(|e| CliError(e.to_string()))?;
+        check_scene(&refined, mode, uses, &args.memory)
+            .map_err(|e| CliError::in_file(args.scene, e))?;
+        if args.full {
+            scene = refined;
+        }
     }
     let mut objects: Vec<SampledObject> = scene
         .objects

@@ -3,10 +3,16 @@
 use super::CliError;
 use super::files::{SampleOverride, load_scene};
 use crate::profile::{RunInfo, Summary, write_all};
+use crate::sampling::budget::MemoryBudget;
+use crate::scene::Scene;
 use crate::scene::demo::demo_scene;
 use crate::view::app::{self, ViewArgs};
+use crate::view::autosave::{Autosave, autosave_path, newer_autosave, previous_path};
 use crate::view::script::parse_script;
 use std::path::Path;
+
+/// Where Ctrl+S writes the demo scene.
+const DEMO_SAVE: &str = "prespline-demo.json";
 
 /// Command-line options of `prespline view`.
 #[derive(Debug, Clone, Copy)]
@@ -19,15 +25,31 @@ pub struct ViewOptions<'a> {
     pub profile: Option<&'a Path>,
     /// `--samples` overrides for the loaded scene.
     pub samples: SampleOverride,
+    /// What pre-evaluation and the GPU mirrors may take.
+    pub memory: MemoryBudget,
+    /// Open the scene's autosave (unsaved edits of an earlier session) instead of the scene.
+    pub recover: bool,
 }
 
 pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
-    if !app::display_available() {
-        return Err(CliError(
-            "no display: DISPLAY is not set (prespline view needs X11 or XWayland; headless: `prespline render` or `prespline bench`, or `make run` which falls back to a headless demo)".into(),
-        ));
-    }
+    let autosave_file = autosave_path(opts.scene);
     let (scene, title, default_save) = match opts.scene {
+        _ if opts.recover => {
+            if !autosave_file.exists() {
+                return Err(CliError(format!(
+                    "--recover: there is no autosave {} to open",
+                    autosave_file.display()
+                )));
+            }
+            let mut scene =
+                Scene::load(&autosave_file).map_err(|e| CliError::in_file(&autosave_file, e))?;
+            opts.samples.apply(&mut scene)?;
+            let (title, save) = match opts.scene {
+                Some(p) => (p.display().to_string(), p.to_path_buf()),
+                None => ("demo".to_string(), Path::new(DEMO_SAVE).to_path_buf()),
+            };
+            (scene, format!("{title} (recovered)"), save)
+        }
         Some(p) => (
             load_scene(p, &opts.samples)?,
             p.display().to_string(),
@@ -36,9 +58,29 @@ pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
         None => (
             demo_scene(),
             "demo".to_string(),
-            Path::new("prespline-demo.json").to_path_buf(),
+            Path::new(DEMO_SAVE).to_path_buf(),
         ),
     };
+    let autosave = if opts.recover {
+        Autosave::recovered(autosave_file)
+    } else {
+        if let Some(newer) = newer_autosave(opts.scene) {
+            eprintln!(
+                "note: {} holds unsaved edits newer than {}; `--recover` opens them (this session keeps them as {} when it autosaves)",
+                newer.display(),
+                opts.scene
+                    .map_or("the demo".to_string(), |p| p.display().to_string()),
+                previous_path(&newer).display()
+            );
+        }
+        Autosave::new(autosave_file)
+    };
+    super::render::check_drawable(&scene, Path::new(&title), &opts.memory)?;
+    if !app::display_available() {
+        return Err(CliError(
+            "no display: DISPLAY is not set (prespline view needs X11 or XWayland; headless: `prespline render` or `prespline bench`, or `make run` which falls back to a headless demo)".into(),
+        ));
+    }
     let script = match opts.script {
         Some(p) => {
             let text = std::fs::read_to_string(p)
@@ -59,6 +101,7 @@ pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
         warmup: 0,
         max_frames: None,
         naive: false,
+        autosave: Some(autosave),
     };
     let title = args.title.clone();
     let run = app::run(args).map_err(CliError)?;

@@ -307,10 +307,10 @@ mod tests {
     fn lecture_de_casteljau_example() {
         let c = lecture();
         let p = c.eval(1.0 / 3.0);
-        assert!((p - DVec3::new(10.0 / 3.0, 7.0, 0.0)).abs().max_element() < 1e-14);
+        assert!((p - DVec3::new(10.0 / 3.0, 7.0, 0.0)).max_abs() < 1e-14);
         let d = c.derivatives(1.0 / 3.0, 1);
-        assert!((d[0] - p).abs().max_element() < 1e-14);
-        assert!((d[1] - DVec3::new(12.0, 9.0, 0.0)).abs().max_element() < 1e-13);
+        assert!((d[0] - p).max_abs() < 1e-14);
+        assert!((d[1] - DVec3::new(12.0, 9.0, 0.0)).max_abs() < 1e-13);
     }
 
     #[test]

@@ -96,6 +96,44 @@ impl BSplineCurve {
         self.points[i] = p;
     }
 
+    /// Replaces every control point by `f(point)` (weights unchanged), e.g. an affine map.
+    pub fn map_points(&mut self, f: impl Fn(DVec3) -> DVec3) {
+        for p in &mut self.points {
+            *p = f(*p);
+        }
+    }
+
+    /// Replaces all control points (same count), exactly.
+    pub fn set_points(&mut self, points: &[DVec3]) {
+        self.points.copy_from_slice(points);
+    }
+
+    /// The same curve with its parameter mapped affinely so that the domain becomes [a, b]:
+    /// knots t ↦ a + (t − t_d)(b − a)/(t_n − t_d), the domain's ends exactly. The k-th
+    /// derivative scales by the inverse factor's k-th power; the shape is unchanged.
+    pub fn reparametrized(&self, (a, b): (f64, f64)) -> GeomResult<Self> {
+        let (d0, d1) = self.domain();
+        if !(a.is_finite() && b.is_finite() && a < b) {
+            return Err(GeomError::new(
+                "interval",
+                format!("[{a}, {b}] is not a finite interval with a < b"),
+            ));
+        }
+        let scale = (b - a) / (d1 - d0);
+        self.with_knots_mapped(|t| match t {
+            t if t == d0 => a,
+            t if t == d1 => b,
+            t => a + (t - d0) * scale,
+        })
+    }
+
+    /// The same control points on knots mapped by an increasing `f` (a reparametrisation).
+    pub fn with_knots_mapped(&self, f: impl Fn(f64) -> f64) -> GeomResult<Self> {
+        let mut c = self.clone();
+        c.knots = KnotVector::new(self.knots.iter().map(|&t| f(t)).collect())?;
+        Ok(c)
+    }
+
     /// Sets weight `i`, making the curve rational (other weights 1) if it was not.
     pub fn set_weight(&mut self, i: usize, w: f64) {
         let n = self.points.len();

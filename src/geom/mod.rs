@@ -25,7 +25,7 @@ pub use bezier::BezierCurve;
 pub use bfunction::{BFunction, BFunctionKind};
 pub use bspline::BSplineCurve;
 pub use catmull_rom::{CatmullRom, Parametrization};
-pub use erbs::{ErbsCurve, ErbsSurface};
+pub use erbs::{ErbsCurve, ErbsSurface, LocalCurve, LocalPatch};
 pub use error::GeomError;
 pub use knots::KnotVector;
 pub use spline::{BezierSpline, Handles, JoinContinuity};

@@ -15,19 +15,40 @@ pub trait Point:
     + AddAssign
     + Mul<f64, Output = Self>
 {
-    /// Largest absolute component, used for relative tolerances.
+    /// Largest absolute component, used for relative tolerances; NaN when any component is
+    /// NaN (glam's `max_element` would drop it).
     fn max_abs(self) -> f64;
 }
 
 impl Point for DVec3 {
     fn max_abs(self) -> f64 {
-        self.abs().max_element()
+        if self.is_nan() {
+            f64::NAN
+        } else {
+            self.abs().max_element()
+        }
     }
 }
 
 impl Point for DVec4 {
     fn max_abs(self) -> f64 {
-        self.abs().max_element()
+        if self.is_nan() {
+            f64::NAN
+        } else {
+            self.abs().max_element()
+        }
+    }
+}
+
+/// The larger of two numbers, NaN when either is NaN (`f64::max` returns the other one), so a
+/// NaN folded into a running maximum stays visible.
+#[inline]
+#[must_use]
+pub fn nan_max(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.max(b)
     }
 }
 

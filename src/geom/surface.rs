@@ -202,6 +202,73 @@ impl TensorSurface {
         homogeneous(&self.points, self.weights.as_deref())
     }
 
+    /// The same net on knots of direction `dir` mapped by an increasing `f` (a
+    /// reparametrisation of that direction).
+    pub fn with_knots_mapped(&self, dir: usize, f: impl Fn(f64) -> f64) -> GeomResult<Self> {
+        let mut s = self.clone();
+        s.knots[dir] = KnotVector::new(self.knots[dir].iter().map(|&t| f(t)).collect())?;
+        Ok(s)
+    }
+
+    /// Splits at an interior parameter t of direction `dir` into two surfaces meeting along
+    /// the isoline there (knots inserted to multiplicity d, then the net cut), exactly as
+    /// [`super::BSplineCurve::split`] does for every line of the net.
+    pub fn split(&self, dir: usize, t: f64) -> GeomResult<(Self, Self)> {
+        let (a, b) = self.domain()[dir];
+        if !(t > a && t < b) {
+            return Err(GeomError::new(
+                "parameter",
+                format!("{t} is not inside ({a}, {b})"),
+            ));
+        }
+        let p = self.degree[dir];
+        let s = self.knots[dir].multiplicity(t);
+        let c = if s < p {
+            self.with_knot(dir, t, p - s)
+        } else {
+            self.clone()
+        };
+        let u = &c.knots[dir];
+        let first = u.iter().position(|&x| x == t).expect("t was inserted");
+        let mult = u.multiplicity(t);
+        let right_start = if mult == p + 1 { first } else { first - 1 };
+        let mut lk = u[..first].to_vec();
+        lk.extend(std::iter::repeat_n(t, p + 1));
+        let mut rk = vec![t; p + 1];
+        rk.extend_from_slice(&u[first + mult..]);
+        let left = c.sliced(dir, 0..first, KnotVector::new(lk)?);
+        let right = c.sliced(dir, right_start..c.count[dir], KnotVector::new(rk)?);
+        Ok((left, right))
+    }
+
+    /// The control points with index in `range` along `dir`, on new knots for that direction.
+    fn sliced(&self, dir: usize, range: std::ops::Range<usize>, knots: KnotVector) -> Self {
+        let [nu, nv] = self.count;
+        let keep = |k: usize| {
+            let (i, j) = (k / nv, k % nv);
+            range.contains(if dir == 0 { &i } else { &j })
+        };
+        let points = (0..nu * nv)
+            .filter(|&k| keep(k))
+            .map(|k| self.points[k])
+            .collect();
+        let weights = self
+            .weights
+            .as_ref()
+            .map(|w| (0..nu * nv).filter(|&k| keep(k)).map(|k| w[k]).collect());
+        let mut count = self.count;
+        count[dir] = range.len();
+        let mut out = Self {
+            degree: self.degree,
+            knots: self.knots.clone(),
+            count,
+            points,
+            weights,
+        };
+        out.knots[dir] = knots;
+        out
+    }
+
     /// SurfaceKnotIns (NURBS Book A5.3): inserts `t` `times` times in direction `dir` (0: u,
     /// 1: v) by CurveKnotIns on every line of the net; the surface is unchanged. `t` must lie
     /// in the domain and the final multiplicity may not exceed that direction's degree.

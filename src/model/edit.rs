@@ -2,8 +2,8 @@
 //! kinds, and the frame-merging of edits.
 
 use super::{
-    BezierSplineEdit, CatmullRomEdit, CurveEdit, ErbsCurveEdit, ErbsSurfaceEdit, Index2, Model,
-    ModelRef, SurfaceEdit,
+    BezierSplineEdit, CatmullRomEdit, CurveEdit, ErbsCurveEdit, ErbsSurfaceEdit, Index2,
+    LocalPath, Model, ModelRef, SurfaceEdit,
 };
 use std::fmt::Debug;
 
@@ -33,8 +33,8 @@ impl EditError {
 pub enum Target {
     Point(Index2),
     Weight(Index2),
-    /// An ERBS local curve or patch (its transform and its control points).
-    Local(Index2),
+    /// An ERBS local curve or patch (its transform and its control points), by path.
+    Local(LocalPath<Index2>),
     Structure,
 }
 

@@ -1,10 +1,16 @@
-//! ERBS curves and surfaces: the models and their edits, which act on local curves and patches.
+//! ERBS curves and surfaces: the models and their edits. Edits address local curves and patches
+//! by a path descending through ERBS locals (hierarchical editing), and refine: a knot inserted
+//! into the object or into an ERBS local, a polynomial local turned into an ERBS local of its own.
+//! One generic edit type serves both kinds through [`ErbsNet`].
 
 use super::edit::{EditError, KindEdit, ObjectEdit, Target};
-use super::points::{check_index, check_vector};
-use super::{Index2, MAX_CURVE_SAMPLES, check_samples, check_surface_samples};
-use crate::geom::{ErbsCurve, ErbsSurface};
+use super::points::check_vector;
+use super::{Index2, MAX_CURVE_SAMPLES, MAX_DEGREE, check_samples, check_surface_samples};
+use crate::geom::erbs::{ErbsCurve, ErbsSurface, LocalCurve, LocalPatch, MAX_NESTING};
+use crate::geom::{BFunctionKind, GeomError};
 use glam::{DMat4, DVec3, DVec4};
+use std::fmt::Debug;
+use std::hash::Hash;
 
 /// An ERBS curve with its sample count.
 #[derive(Debug, Clone, PartialEq)]
@@ -50,90 +56,170 @@ impl ErbsSurfaceModel {
     }
 }
 
-/// Local curves (index `L`) whose control points (index `P`) can be edited.
-pub trait LocalNet<L, P> {
-    fn check_local(&self, l: L) -> Result<(), EditError>;
-    fn check_local_point(&self, l: L, p: P) -> Result<(), EditError>;
-    fn local_points(&self, l: L) -> &[DVec3];
-    fn transform_local(&mut self, l: L, a: &DMat4);
-    fn translate_local_point(&mut self, l: L, p: P, delta: DVec3);
-    fn set_local_points(&mut self, l: L, points: &[DVec3]);
+/// The path to a local curve or patch: one index (curves) or index pair (surfaces) per ERBS
+/// level, from the object's own locals down. At most [`MAX_NESTING`] steps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct LocalPath<I> {
+    len: u8,
+    steps: [I; MAX_NESTING],
+}
+
+impl<I: Copy + Default> LocalPath<I> {
+    /// `None` for an empty or too long path.
+    pub fn new(steps: &[I]) -> Option<Self> {
+        if steps.is_empty() || steps.len() > MAX_NESTING {
+            return None;
+        }
+        let mut s = [I::default(); MAX_NESTING];
+        s[..steps.len()].copy_from_slice(steps);
+        Some(Self {
+            len: steps.len() as u8,
+            steps: s,
+        })
+    }
+
+    /// A top-level local.
+    pub fn top(i: I) -> Self {
+        Self::new(&[i]).expect("one step")
+    }
+
+    pub fn steps(&self) -> &[I] {
+        &self.steps[..self.len as usize]
+    }
+
+    /// The path one level deeper.
+    pub fn child(&self, i: I) -> Option<Self> {
+        let mut v = self.steps().to_vec();
+        v.push(i);
+        Self::new(&v)
+    }
+
+    /// Whether this path is `prefix` or lies below it.
+    pub fn starts_with(&self, prefix: &LocalPath<I>) -> bool
+    where
+        I: PartialEq,
+    {
+        self.steps().starts_with(prefix.steps())
+    }
+
+    /// The same path with index pairs for both kinds (what [`Target`] compares).
+    pub fn key(&self) -> LocalPath<Index2>
+    where
+        I: Into<Index2>,
+    {
+        LocalPath {
+            len: self.len,
+            steps: self.steps.map(Into::into),
+        }
+    }
+}
+
+impl LocalPath<Index2> {
+    /// The curve form of a path of single indices.
+    pub fn to_curve(&self) -> Option<LocalPath<usize>> {
+        let steps: Option<Vec<usize>> = self
+            .steps()
+            .iter()
+            .map(|i| match *i {
+                Index2::One(k) => Some(k),
+                Index2::Two(..) => None,
+            })
+            .collect();
+        LocalPath::new(&steps?)
+    }
+
+    /// The surface form of a path of index pairs.
+    pub fn to_surface(&self) -> Option<LocalPath<[usize; 2]>> {
+        let steps: Option<Vec<[usize; 2]>> = self
+            .steps()
+            .iter()
+            .map(|i| match *i {
+                Index2::Two(k, l) => Some([k, l]),
+                Index2::One(_) => None,
+            })
+            .collect();
+        LocalPath::new(&steps?)
+    }
+}
+
+impl Default for Index2 {
+    fn default() -> Self {
+        Index2::One(0)
+    }
+}
+
+/// What the ERBS edits need of an ERBS curve or surface: locals by path, their control points,
+/// refinement and construction. Implemented once per kind, so [`ErbsEdit`] is written once.
+pub trait ErbsNet: Clone + PartialEq + Debug + Sized {
+    /// A local's index at one level, and a control point's index in a polynomial local.
+    type Index: Copy + Default + PartialEq + Eq + Hash + Debug + Into<Index2>;
+    type Local: Clone + PartialEq + Debug;
+    /// Where a refinement inserts: t (curves), or a direction and t (surfaces).
+    type Knot: Copy + PartialEq + Debug;
+    /// A degree (curves) or degrees per direction (surfaces).
+    type Degree: Copy + PartialEq + Debug;
+    /// How many locals a construction makes.
+    type Count: Copy + PartialEq + Debug;
+    type Model: Clone + PartialEq + Debug;
+
+    fn of(model: &Self::Model) -> &Self;
+    fn of_mut(model: &mut Self::Model) -> &mut Self;
+
+    fn local_at(&self, path: &[Self::Index]) -> Option<&Self::Local>;
+    /// An error naming the first step of `path` that does not exist.
+    fn check_path(&self, path: &[Self::Index]) -> Result<(), EditError>;
+    /// The control points of a polynomial local (none for an ERBS local).
+    fn points(local: &Self::Local) -> Option<&[DVec3]>;
+    fn check_point(local: &Self::Local, p: Self::Index) -> Result<(), EditError>;
+    fn as_erbs(local: &Self::Local) -> Option<&Self>;
+    fn wrap(e: Self) -> Self::Local;
+
+    fn transform_local(&mut self, path: &[Self::Index], a: &DMat4);
+    fn translate_local_point(&mut self, path: &[Self::Index], p: Self::Index, d: DVec3);
+    fn set_local_points(&mut self, path: &[Self::Index], points: &[DVec3]);
+    fn set_local(&mut self, path: &[Self::Index], local: Self::Local);
+
+    /// Local refinement (see [`ErbsCurve::insert_knot`]).
+    fn refine(&self, at: Self::Knot, degree: Option<Self::Degree>) -> Result<Self, GeomError>;
+    /// An ERBS local Hermite-interpolating a polynomial local (see [`ErbsCurve::from_curve`]).
+    fn build(
+        local: &Self::Local,
+        count: Self::Count,
+        degree: Self::Degree,
+        bf: BFunctionKind,
+    ) -> Result<Self, GeomError>;
+    fn bfunction(&self) -> BFunctionKind;
+    fn check_degree(d: Self::Degree) -> Result<(), EditError>;
+
+    fn into_object(e: ErbsEdit<Self>) -> ObjectEdit;
+    fn from_object(e: &ObjectEdit) -> Option<&ErbsEdit<Self>>;
 }
 
 /// An edit of one local curve or patch.
 #[derive(Debug, Clone, PartialEq)]
-pub enum LocalEdit<L, P> {
-    /// Map every control point by p ↦ (A·[p;1]).xyz, A affine.
-    Transform { local: L, matrix: DMat4 },
-    /// Translate one control point of the local.
-    MovePoint { local: L, point: P, delta: DVec3 },
-    /// Set every control point exactly (undo).
-    SetPoints { local: L, points: Vec<DVec3> },
+pub enum LocalEdit<I> {
+    /// Map every control point (at any depth) by p ↦ (A·[p;1]).xyz, A affine.
+    Transform { local: LocalPath<I>, matrix: DMat4 },
+    /// Translate one control point of a polynomial local.
+    MovePoint {
+        local: LocalPath<I>,
+        point: I,
+        delta: DVec3,
+    },
+    /// Set every control point of a polynomial local exactly (undo).
+    SetPoints {
+        local: LocalPath<I>,
+        points: Vec<DVec3>,
+    },
 }
 
-impl<L, P> LocalEdit<L, P>
-where
-    L: Copy + PartialEq + Into<Index2>,
-    P: Copy + PartialEq,
-{
-    pub fn local(&self) -> L {
+impl<I: Copy + Default + PartialEq> LocalEdit<I> {
+    pub fn local(&self) -> LocalPath<I> {
         match self {
             LocalEdit::Transform { local, .. }
             | LocalEdit::MovePoint { local, .. }
             | LocalEdit::SetPoints { local, .. } => *local,
         }
-    }
-
-    pub fn validate(&self, net: &impl LocalNet<L, P>) -> Result<(), EditError> {
-        net.check_local(self.local())?;
-        match self {
-            LocalEdit::Transform { matrix, .. } => check_affine(matrix),
-            LocalEdit::MovePoint {
-                local,
-                point,
-                delta,
-            } => {
-                net.check_local_point(*local, *point)?;
-                check_vector("delta", *delta)
-            }
-            LocalEdit::SetPoints { local, points } => {
-                if points.len() != net.local_points(*local).len() {
-                    return Err(EditError::new(
-                        "points",
-                        format!(
-                            "{} points for a local with {}",
-                            points.len(),
-                            net.local_points(*local).len()
-                        ),
-                    ));
-                }
-                points.iter().try_for_each(|&p| check_vector("points", p))
-            }
-        }
-    }
-
-    pub fn apply(&self, net: &mut impl LocalNet<L, P>) {
-        match self {
-            LocalEdit::Transform { local, matrix } => net.transform_local(*local, matrix),
-            LocalEdit::MovePoint {
-                local,
-                point,
-                delta,
-            } => net.translate_local_point(*local, *point, *delta),
-            LocalEdit::SetPoints { local, points } => net.set_local_points(*local, points),
-        }
-    }
-
-    #[must_use]
-    pub fn inverse(&self, net: &impl LocalNet<L, P>) -> Self {
-        LocalEdit::SetPoints {
-            local: self.local(),
-            points: net.local_points(self.local()).to_vec(),
-        }
-    }
-
-    pub fn target(&self) -> Target {
-        Target::Local(self.local().into())
     }
 
     /// Transforms compose (A2·A1), moves of one local point add up, the last set wins.
@@ -168,6 +254,36 @@ where
     }
 }
 
+/// Edits of an ERBS curve or surface.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ErbsEdit<N: ErbsNet> {
+    Local(LocalEdit<N::Index>),
+    /// Local refinement of the object (`local: None`) or of the ERBS local at `local`: a knot
+    /// between two others becomes the centre of a new Hermite local of `degree` (default: its
+    /// neighbours' larger degree).
+    InsertKnot {
+        local: Option<LocalPath<N::Index>>,
+        at: N::Knot,
+        degree: Option<N::Degree>,
+    },
+    /// The polynomial local at `local` becomes an ERBS local of its own, built from it.
+    ToErbs {
+        local: LocalPath<N::Index>,
+        count: N::Count,
+        degree: N::Degree,
+    },
+    /// Put back the local at `local` exactly (undo).
+    SetLocal {
+        local: LocalPath<N::Index>,
+        to: Box<N::Local>,
+    },
+    /// Put back the whole object exactly (undo of a refinement of the object).
+    Restore(Box<N>),
+}
+
+pub type ErbsCurveEdit = ErbsEdit<ErbsCurve>;
+pub type ErbsSurfaceEdit = ErbsEdit<ErbsSurface>;
+
 /// A finite affine matrix: last row (0, 0, 0, 1).
 fn check_affine(m: &DMat4) -> Result<(), EditError> {
     if !m.is_finite() {
@@ -188,55 +304,230 @@ fn check_affine(m: &DMat4) -> Result<(), EditError> {
     Ok(())
 }
 
-impl LocalNet<usize, usize> for ErbsCurve {
-    fn check_local(&self, l: usize) -> Result<(), EditError> {
-        check_index("local", l, self.local_curves().len())
-    }
+fn local_of<'a, N: ErbsNet>(
+    net: &'a N,
+    path: &LocalPath<N::Index>,
+) -> Result<&'a N::Local, EditError> {
+    net.check_path(path.steps())?;
+    net.local_at(path.steps())
+        .ok_or_else(|| EditError::new("local", format!("no local at {:?}", path.steps())))
+}
 
-    fn check_local_point(&self, l: usize, p: usize) -> Result<(), EditError> {
-        check_index("point", p, self.local_curves()[l].points().len())
-    }
-
-    fn local_points(&self, l: usize) -> &[DVec3] {
-        self.local_curves()[l].points()
-    }
-
-    fn transform_local(&mut self, l: usize, a: &DMat4) {
-        ErbsCurve::transform_local(self, l, a);
-    }
-
-    fn translate_local_point(&mut self, l: usize, p: usize, delta: DVec3) {
-        ErbsCurve::translate_local_point(self, l, p, delta);
-    }
-
-    fn set_local_points(&mut self, l: usize, points: &[DVec3]) {
-        ErbsCurve::set_local_points(self, l, points);
+/// The error for step `depth` of a path (`what` the index problem).
+fn step_error(depth: usize, what: EditError) -> EditError {
+    if depth == 0 {
+        what
+    } else {
+        EditError::new(
+            "local",
+            format!("step {depth} of the path: {}", what.message),
+        )
     }
 }
 
-impl LocalNet<[usize; 2], [usize; 2]> for ErbsSurface {
-    fn check_local(&self, [k, l]: [usize; 2]) -> Result<(), EditError> {
-        check_pair("local", [k, l], self.count())
+fn polynomial_points<N: ErbsNet>(local: &N::Local) -> Result<&[DVec3], EditError> {
+    N::points(local).ok_or_else(|| {
+        EditError::new(
+            "point",
+            "an ERBS local has no control points of its own: address one of its locals",
+        )
+    })
+}
+
+fn geom(e: GeomError) -> EditError {
+    EditError::new(e.field, e.message)
+}
+
+impl<N: ErbsNet> ErbsEdit<N> {
+    fn validate_net(&self, net: &N) -> Result<(), EditError> {
+        match self {
+            ErbsEdit::Local(e) => {
+                let local = local_of(net, &e.local())?;
+                match e {
+                    LocalEdit::Transform { matrix, .. } => check_affine(matrix),
+                    LocalEdit::MovePoint { point, delta, .. } => {
+                        polynomial_points::<N>(local)?;
+                        N::check_point(local, *point)?;
+                        check_vector("delta", *delta)
+                    }
+                    LocalEdit::SetPoints { points, .. } => {
+                        let own = polynomial_points::<N>(local)?;
+                        if points.len() != own.len() {
+                            return Err(EditError::new(
+                                "points",
+                                format!("{} points for a local with {}", points.len(), own.len()),
+                            ));
+                        }
+                        points.iter().try_for_each(|&p| check_vector("points", p))
+                    }
+                }
+            }
+            ErbsEdit::InsertKnot { local, at, degree } => {
+                if let Some(d) = degree {
+                    N::check_degree(*d)?;
+                }
+                let target = match local {
+                    None => net,
+                    Some(path) => N::as_erbs(local_of(net, path)?).ok_or_else(|| {
+                        EditError::new(
+                            "insert_knot",
+                            "the local is not an ERBS curve: only ERBS locals are refined (turn it into one first)",
+                        )
+                    })?,
+                };
+                target.refine(*at, *degree).map(|_| ()).map_err(geom)
+            }
+            ErbsEdit::ToErbs {
+                local,
+                count,
+                degree,
+            } => {
+                N::check_degree(*degree)?;
+                let l = local_of(net, local)?;
+                polynomial_points::<N>(l)
+                    .map_err(|_| EditError::new("to_erbs", "the local already is an ERBS local"))?;
+                if local.steps().len() >= MAX_NESTING {
+                    return Err(EditError::new(
+                        "to_erbs",
+                        format!("ERBS locals nest at most {MAX_NESTING} levels deep"),
+                    ));
+                }
+                N::build(l, *count, *degree, net.bfunction())
+                    .map(|_| ())
+                    .map_err(geom)
+            }
+            ErbsEdit::SetLocal { local, .. } => local_of(net, local).map(|_| ()),
+            ErbsEdit::Restore(_) => Ok(()),
+        }
     }
 
-    fn check_local_point(&self, [k, l]: [usize; 2], p: [usize; 2]) -> Result<(), EditError> {
-        check_pair("point", p, self.local_patch(k, l).count())
+    fn apply_net(&self, net: &mut N) {
+        match self {
+            ErbsEdit::Local(e) => match e {
+                LocalEdit::Transform { local, matrix } => {
+                    net.transform_local(local.steps(), matrix)
+                }
+                LocalEdit::MovePoint {
+                    local,
+                    point,
+                    delta,
+                } => net.translate_local_point(local.steps(), *point, *delta),
+                LocalEdit::SetPoints { local, points } => {
+                    net.set_local_points(local.steps(), points)
+                }
+            },
+            ErbsEdit::InsertKnot { local, at, degree } => match local {
+                None => {
+                    if let Ok(r) = net.refine(*at, *degree) {
+                        *net = r;
+                    }
+                }
+                Some(path) => {
+                    let refined = net
+                        .local_at(path.steps())
+                        .and_then(N::as_erbs)
+                        .and_then(|e| e.refine(*at, *degree).ok());
+                    if let Some(r) = refined {
+                        net.set_local(path.steps(), N::wrap(r));
+                    }
+                }
+            },
+            ErbsEdit::ToErbs {
+                local,
+                count,
+                degree,
+            } => {
+                let bf = net.bfunction();
+                let built = net
+                    .local_at(local.steps())
+                    .and_then(|l| N::build(l, *count, *degree, bf).ok());
+                if let Some(e) = built {
+                    net.set_local(local.steps(), N::wrap(e));
+                }
+            }
+            ErbsEdit::SetLocal { local, to } => net.set_local(local.steps(), (**to).clone()),
+            ErbsEdit::Restore(to) => *net = (**to).clone(),
+        }
     }
 
-    fn local_points(&self, [k, l]: [usize; 2]) -> &[DVec3] {
-        self.local_patch(k, l).points()
+    fn inverse_net(&self, net: &N) -> Self {
+        let set_local = |path: LocalPath<N::Index>| match net.local_at(path.steps()) {
+            Some(l) => ErbsEdit::SetLocal {
+                local: path,
+                to: Box::new(l.clone()),
+            },
+            None => ErbsEdit::Restore(Box::new(net.clone())),
+        };
+        match self {
+            ErbsEdit::Local(e) => {
+                let path = e.local();
+                match net.local_at(path.steps()).and_then(N::points) {
+                    Some(points) => ErbsEdit::Local(LocalEdit::SetPoints {
+                        local: path,
+                        points: points.to_vec(),
+                    }),
+                    None => set_local(path),
+                }
+            }
+            ErbsEdit::InsertKnot { local: Some(p), .. }
+            | ErbsEdit::ToErbs { local: p, .. }
+            | ErbsEdit::SetLocal { local: p, .. } => set_local(*p),
+            ErbsEdit::InsertKnot { local: None, .. } | ErbsEdit::Restore(_) => {
+                ErbsEdit::Restore(Box::new(net.clone()))
+            }
+        }
+    }
+}
+
+impl<N: ErbsNet> KindEdit for ErbsEdit<N> {
+    type Model = N::Model;
+
+    fn validate(&self, m: &N::Model) -> Result<(), EditError> {
+        self.validate_net(N::of(m))
     }
 
-    fn transform_local(&mut self, [k, l]: [usize; 2], a: &DMat4) {
-        ErbsSurface::transform_local(self, k, l, a);
+    fn apply(&self, m: &mut N::Model) {
+        self.apply_net(N::of_mut(m));
     }
 
-    fn translate_local_point(&mut self, [k, l]: [usize; 2], [a, b]: [usize; 2], delta: DVec3) {
-        ErbsSurface::translate_local_point(self, k, l, a, b, delta);
+    fn inverse(&self, m: &N::Model) -> Self {
+        self.inverse_net(N::of(m))
     }
 
-    fn set_local_points(&mut self, [k, l]: [usize; 2], points: &[DVec3]) {
-        ErbsSurface::set_local_points(self, k, l, points);
+    fn target(&self) -> Target {
+        match self {
+            ErbsEdit::Local(e) => Target::Local(e.local().key()),
+            _ => Target::Structure,
+        }
+    }
+
+    fn merge(&self, next: &Self) -> Option<Self> {
+        match (self, next) {
+            (ErbsEdit::Local(a), ErbsEdit::Local(b)) => a.merge(b).map(ErbsEdit::Local),
+            _ => None,
+        }
+    }
+
+    fn into_object(self) -> ObjectEdit {
+        N::into_object(self)
+    }
+
+    fn from_object(e: &ObjectEdit) -> Option<&Self> {
+        N::from_object(e)
+    }
+}
+
+fn check_count(field: &'static str, i: usize, n: usize) -> Result<(), EditError> {
+    if i < n {
+        Ok(())
+    } else {
+        Err(EditError::new(
+            field,
+            format!(
+                "index {i} out of range (valid: 0..={})",
+                n.saturating_sub(1)
+            ),
+        ))
     }
 }
 
@@ -258,67 +549,240 @@ fn check_pair(
     ))
 }
 
-/// Edits of an [`ErbsCurveModel`].
-#[derive(Debug, Clone, PartialEq)]
-pub enum ErbsCurveEdit {
-    Local(LocalEdit<usize, usize>),
+fn check_max_degree(field: &'static str, d: usize) -> Result<(), EditError> {
+    if d > MAX_DEGREE {
+        return Err(EditError::new(
+            field,
+            format!("degree {d} exceeds the supported maximum {MAX_DEGREE}"),
+        ));
+    }
+    Ok(())
 }
 
-/// Edits of an [`ErbsSurfaceModel`].
-#[derive(Debug, Clone, PartialEq)]
-pub enum ErbsSurfaceEdit {
-    Local(LocalEdit<[usize; 2], [usize; 2]>),
-}
+impl ErbsNet for ErbsCurve {
+    type Index = usize;
+    type Local = LocalCurve;
+    type Knot = f64;
+    type Degree = usize;
+    type Count = usize;
+    type Model = ErbsCurveModel;
 
-/// The [`KindEdit`] of an ERBS kind whose edits are local edits.
-macro_rules! erbs_kind_edit {
-    ($edit:ident, $variant:ident, $model:ident, $geom:ident) => {
-        impl KindEdit for $edit {
-            type Model = $model;
+    fn of(m: &ErbsCurveModel) -> &Self {
+        &m.curve
+    }
 
-            fn validate(&self, m: &$model) -> Result<(), EditError> {
-                match self {
-                    $edit::Local(e) => e.validate(&m.$geom),
+    fn of_mut(m: &mut ErbsCurveModel) -> &mut Self {
+        &mut m.curve
+    }
+
+    fn local_at(&self, path: &[usize]) -> Option<&LocalCurve> {
+        ErbsCurve::local_at(self, path)
+    }
+
+    fn check_path(&self, path: &[usize]) -> Result<(), EditError> {
+        let mut level = self;
+        for (depth, &l) in path.iter().enumerate() {
+            check_count("local", l, level.local_curves().len())
+                .map_err(|e| step_error(depth, e))?;
+            match (&level.local_curves()[l], depth + 1 < path.len()) {
+                (LocalCurve::Erbs(e), true) => level = e,
+                (LocalCurve::Spline { .. }, true) => {
+                    return Err(EditError::new(
+                        "local",
+                        format!("step {depth} of the path is a polynomial local: it has no locals"),
+                    ));
                 }
-            }
-
-            fn apply(&self, m: &mut $model) {
-                match self {
-                    $edit::Local(e) => e.apply(&mut m.$geom),
-                }
-            }
-
-            fn inverse(&self, m: &$model) -> Self {
-                match self {
-                    $edit::Local(e) => $edit::Local(e.inverse(&m.$geom)),
-                }
-            }
-
-            fn target(&self) -> Target {
-                match self {
-                    $edit::Local(e) => e.target(),
-                }
-            }
-
-            fn merge(&self, next: &Self) -> Option<Self> {
-                match (self, next) {
-                    ($edit::Local(a), $edit::Local(b)) => a.merge(b).map($edit::Local),
-                }
-            }
-
-            fn into_object(self) -> ObjectEdit {
-                ObjectEdit::$variant(self)
-            }
-
-            fn from_object(e: &ObjectEdit) -> Option<&Self> {
-                match e {
-                    ObjectEdit::$variant(e) => Some(e),
-                    _ => None,
-                }
+                _ => {}
             }
         }
-    };
+        Ok(())
+    }
+
+    fn points(local: &LocalCurve) -> Option<&[DVec3]> {
+        local.points()
+    }
+
+    fn check_point(local: &LocalCurve, p: usize) -> Result<(), EditError> {
+        check_count("point", p, local.points().map_or(0, <[DVec3]>::len))
+    }
+
+    fn as_erbs(local: &LocalCurve) -> Option<&Self> {
+        match local {
+            LocalCurve::Erbs(e) => Some(e),
+            LocalCurve::Spline { .. } => None,
+        }
+    }
+
+    fn wrap(e: Self) -> LocalCurve {
+        LocalCurve::Erbs(Box::new(e))
+    }
+
+    fn transform_local(&mut self, path: &[usize], a: &DMat4) {
+        ErbsCurve::transform_local(self, path, a);
+    }
+
+    fn translate_local_point(&mut self, path: &[usize], p: usize, d: DVec3) {
+        ErbsCurve::translate_local_point(self, path, p, d);
+    }
+
+    fn set_local_points(&mut self, path: &[usize], points: &[DVec3]) {
+        ErbsCurve::set_local_points(self, path, points);
+    }
+
+    fn set_local(&mut self, path: &[usize], local: LocalCurve) {
+        ErbsCurve::set_local(self, path, local);
+    }
+
+    fn refine(&self, t: f64, degree: Option<usize>) -> Result<Self, GeomError> {
+        self.insert_knot(t, degree).map(|(c, _)| c)
+    }
+
+    fn build(
+        local: &LocalCurve,
+        n: usize,
+        degree: usize,
+        bf: BFunctionKind,
+    ) -> Result<Self, GeomError> {
+        match local {
+            LocalCurve::Spline { curve, .. } => ErbsCurve::from_curve(curve, n, degree, bf, false),
+            LocalCurve::Erbs(_) => Err(GeomError::new("to_erbs", "already an ERBS local")),
+        }
+    }
+
+    fn bfunction(&self) -> BFunctionKind {
+        ErbsCurve::bfunction(self)
+    }
+
+    fn check_degree(d: usize) -> Result<(), EditError> {
+        check_max_degree("degree", d)
+    }
+
+    fn into_object(e: ErbsEdit<Self>) -> ObjectEdit {
+        ObjectEdit::ErbsCurve(e)
+    }
+
+    fn from_object(e: &ObjectEdit) -> Option<&ErbsEdit<Self>> {
+        match e {
+            ObjectEdit::ErbsCurve(e) => Some(e),
+            _ => None,
+        }
+    }
 }
 
-erbs_kind_edit!(ErbsCurveEdit, ErbsCurve, ErbsCurveModel, curve);
-erbs_kind_edit!(ErbsSurfaceEdit, ErbsSurface, ErbsSurfaceModel, surface);
+impl ErbsNet for ErbsSurface {
+    type Index = [usize; 2];
+    type Local = LocalPatch;
+    type Knot = (usize, f64);
+    type Degree = [usize; 2];
+    type Count = [usize; 2];
+    type Model = ErbsSurfaceModel;
+
+    fn of(m: &ErbsSurfaceModel) -> &Self {
+        &m.surface
+    }
+
+    fn of_mut(m: &mut ErbsSurfaceModel) -> &mut Self {
+        &mut m.surface
+    }
+
+    fn local_at(&self, path: &[[usize; 2]]) -> Option<&LocalPatch> {
+        ErbsSurface::local_at(self, path)
+    }
+
+    fn check_path(&self, path: &[[usize; 2]]) -> Result<(), EditError> {
+        let mut level = self;
+        for (depth, &[k, l]) in path.iter().enumerate() {
+            check_pair("local", [k, l], level.count()).map_err(|e| step_error(depth, e))?;
+            match (level.local_patch(k, l), depth + 1 < path.len()) {
+                (LocalPatch::Erbs(e), true) => level = e,
+                (LocalPatch::Spline { .. }, true) => {
+                    return Err(EditError::new(
+                        "local",
+                        format!("step {depth} of the path is a polynomial patch: it has no locals"),
+                    ));
+                }
+                _ => {}
+            }
+        }
+        Ok(())
+    }
+
+    fn points(local: &LocalPatch) -> Option<&[DVec3]> {
+        local.net().map(|(_, p)| p)
+    }
+
+    fn check_point(local: &LocalPatch, p: [usize; 2]) -> Result<(), EditError> {
+        check_pair("point", p, local.net().map_or([0, 0], |(c, _)| c))
+    }
+
+    fn as_erbs(local: &LocalPatch) -> Option<&Self> {
+        match local {
+            LocalPatch::Erbs(e) => Some(e),
+            LocalPatch::Spline { .. } => None,
+        }
+    }
+
+    fn wrap(e: Self) -> LocalPatch {
+        LocalPatch::Erbs(Box::new(e))
+    }
+
+    fn transform_local(&mut self, path: &[[usize; 2]], a: &DMat4) {
+        ErbsSurface::transform_local(self, path, a);
+    }
+
+    fn translate_local_point(&mut self, path: &[[usize; 2]], p: [usize; 2], d: DVec3) {
+        ErbsSurface::translate_local_point(self, path, p, d);
+    }
+
+    fn set_local_points(&mut self, path: &[[usize; 2]], points: &[DVec3]) {
+        ErbsSurface::set_local_points(self, path, points);
+    }
+
+    fn set_local(&mut self, path: &[[usize; 2]], local: LocalPatch) {
+        ErbsSurface::set_local(self, path, local);
+    }
+
+    fn refine(
+        &self,
+        (dir, t): (usize, f64),
+        degree: Option<[usize; 2]>,
+    ) -> Result<Self, GeomError> {
+        if dir > 1 {
+            return Err(GeomError::new("insert_knot", "the direction is u or v"));
+        }
+        self.insert_knot(dir, t, degree).map(|(s, _)| s)
+    }
+
+    fn build(
+        local: &LocalPatch,
+        count: [usize; 2],
+        degree: [usize; 2],
+        bf: BFunctionKind,
+    ) -> Result<Self, GeomError> {
+        match local {
+            LocalPatch::Spline { surface, .. } => {
+                ErbsSurface::from_surface(surface, count, degree, bf, [false, false])
+            }
+            LocalPatch::Erbs(_) => Err(GeomError::new("to_erbs", "already an ERBS local")),
+        }
+    }
+
+    fn bfunction(&self) -> BFunctionKind {
+        ErbsSurface::bfunction(self)
+    }
+
+    fn check_degree([du, dv]: [usize; 2]) -> Result<(), EditError> {
+        check_max_degree("degree", du.max(dv))
+    }
+
+    fn into_object(e: ErbsEdit<Self>) -> ObjectEdit {
+        ObjectEdit::ErbsSurface(e)
+    }
+
+    fn from_object(e: &ObjectEdit) -> Option<&ErbsEdit<Self>> {
+        match e {
+            ObjectEdit::ErbsSurface(e) => Some(e),
+            _ => None,
+        }
+    }
+}

@@ -18,7 +18,8 @@ mod surface;
 pub use curve::{CurveEdit, CurveModel};
 pub use edit::{Edit, EditError, KindEdit, ObjectEdit, Target, edit_kind_mismatch, merge_edits};
 pub use erbs::{
-    ErbsCurveEdit, ErbsCurveModel, ErbsSurfaceEdit, ErbsSurfaceModel, LocalEdit, LocalNet,
+    ErbsCurveEdit, ErbsCurveModel, ErbsEdit, ErbsNet, ErbsSurfaceEdit, ErbsSurfaceModel, LocalEdit,
+    LocalPath,
 };
 pub use points::{PointEdit, PointNet};
 pub use splines::{

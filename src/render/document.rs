@@ -3,11 +3,12 @@
 
 use super::camera::Bounds;
 use super::maps::{SurfaceMap, symmetric_range};
+use crate::geom::erbs::{ErbsCurve, ErbsSurface};
 use crate::geom::knots::uniform_params;
-use crate::geom::{BezierCurve, TensorSurface};
+use crate::geom::{LocalCurve as GeomLocalCurve, LocalPatch as GeomLocalPatch};
 use crate::model::{
     BezierSplineEdit, CatmullRomEdit, CurveEdit, Edit, EditError, ErbsCurveEdit, ErbsSurfaceEdit,
-    Index2, KindEdit, LocalEdit, ModelRef, ObjectEdit, PointEdit, SurfaceEdit,
+    Index2, KindEdit, LocalEdit, LocalPath, Model, ModelRef, ObjectEdit, PointEdit, SurfaceEdit,
 };
 use crate::sampling::{DirtyRegion, SampleMode, SampledObject};
 use crate::scene::{Scene, SceneObject};
@@ -42,7 +43,7 @@ pub enum Handle {
     },
     LocalPoint {
         object: usize,
-        local: Index2,
+        local: LocalPath<Index2>,
         point: Index2,
     },
 }
@@ -66,24 +67,24 @@ pub enum Controls {
         cols: usize,
         points: Vec<DVec3>,
     },
-    /// ERBS curve: each local curve's control points and samples over its support.
+    /// ERBS curve: every polynomial local at any depth (in path order) with its control
+    /// points and samples over its support.
     LocalCurves(Vec<LocalCurve>),
-    /// ERBS surface: each local patch's control net and a small grid of samples, row-major.
-    LocalPatches {
-        rows: usize,
-        cols: usize,
-        patches: Vec<LocalPatch>,
-    },
+    /// ERBS surface: every polynomial local patch at any depth with its control net and a small
+    /// grid of samples.
+    LocalPatches(Vec<LocalPatch>),
 }
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct LocalCurve {
+    pub path: LocalPath<Index2>,
     pub points: Vec<DVec3>,
     pub samples: Vec<DVec3>,
 }
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct LocalPatch {
+    pub path: LocalPath<Index2>,
     pub net_rows: usize,
     pub net_cols: usize,
     pub points: Vec<DVec3>,
@@ -273,19 +274,8 @@ impl Document {
                     points: s.points().to_vec(),
                 }
             }
-            ModelRef::ErbsCurve(c) => {
-                Controls::LocalCurves(c.curve().local_curves().iter().map(local_curve).collect())
-            }
-            ModelRef::ErbsSurface(s) => {
-                let s = s.surface();
-                let [rows, cols] = s.count();
-                let patches = s.local_patches().iter().map(local_patch).collect();
-                Controls::LocalPatches {
-                    rows,
-                    cols,
-                    patches,
-                }
-            }
+            ModelRef::ErbsCurve(c) => Controls::LocalCurves(curve_leaves(c.curve(), None)),
+            ModelRef::ErbsSurface(s) => Controls::LocalPatches(patch_leaves(s.surface(), None)),
         }
     }
 
@@ -301,6 +291,25 @@ impl Document {
                     (Handle::Point { object, point }, q)
                 })
                 .collect()
+        };
+        let local_points = |path: LocalPath<Index2>, pts: &[DVec3], cols: usize| {
+            pts.iter()
+                .enumerate()
+                .map(|(q, &p)| {
+                    let point = match q.checked_div(cols) {
+                        None => Index2::One(q),
+                        Some(a) => Index2::Two(a, q % cols),
+                    };
+                    (
+                        Handle::LocalPoint {
+                            object,
+                            local: path,
+                            point,
+                        },
+                        p,
+                    )
+                })
+                .collect::<Vec<_>>()
         };
         match self.objects[i].sampled.model() {
             ModelRef::CatmullRom(c) => polygon(c.spline().points().to_vec()),
@@ -337,46 +346,17 @@ impl Document {
                     })
                     .collect()
             }
-            ModelRef::ErbsCurve(c) => c
-                .curve()
-                .local_curves()
-                .iter()
-                .enumerate()
-                .flat_map(|(l, lc)| {
-                    lc.points().iter().enumerate().map(move |(q, &p)| {
-                        (
-                            Handle::LocalPoint {
-                                object,
-                                local: Index2::One(l),
-                                point: Index2::One(q),
-                            },
-                            p,
-                        )
-                    })
+            ModelRef::ErbsCurve(c) => each_curve_leaf(c.curve(), None)
+                .into_iter()
+                .flat_map(|(path, l)| local_points(path, l.points().unwrap_or(&[]), 0))
+                .collect(),
+            ModelRef::ErbsSurface(s) => each_patch_leaf(s.surface(), None)
+                .into_iter()
+                .flat_map(|(path, p)| match p.net() {
+                    Some(([_, nc], pts)) => local_points(path, pts, nc),
+                    None => Vec::new(),
                 })
                 .collect(),
-            ModelRef::ErbsSurface(s) => {
-                let s = s.surface();
-                let cols = s.count()[1];
-                s.local_patches()
-                    .iter()
-                    .enumerate()
-                    .flat_map(|(idx, p)| {
-                        let nc = p.count()[1];
-                        p.points().iter().enumerate().map(move |(q, &pos)| {
-                            let local = Index2::Two(idx / cols, idx % cols);
-                            (
-                                Handle::LocalPoint {
-                                    object,
-                                    local,
-                                    point: Index2::Two(q / nc, q % nc),
-                                },
-                                pos,
-                            )
-                        })
-                    })
-                    .collect()
-            }
         }
     }
 
@@ -425,26 +405,26 @@ impl Document {
             .into_object(),
             (
                 Handle::LocalPoint {
-                    local: Index2::One(local),
+                    local,
                     point: Index2::One(point),
                     ..
                 },
                 ModelRef::ErbsCurve(_),
             ) => ErbsCurveEdit::Local(LocalEdit::MovePoint {
-                local,
+                local: local.to_curve()?,
                 point,
                 delta,
             })
             .into_object(),
             (
                 Handle::LocalPoint {
-                    local: Index2::Two(k, l),
+                    local,
                     point: Index2::Two(a, b),
                     ..
                 },
                 ModelRef::ErbsSurface(_),
             ) => ErbsSurfaceEdit::Local(LocalEdit::MovePoint {
-                local: [k, l],
+                local: local.to_surface()?,
                 point: [a, b],
                 delta,
             })
@@ -457,96 +437,244 @@ impl Document {
         })
     }
 
-    /// Every control point of an ERBS local curve or patch.
-    pub fn local_points(&self, object: usize, local: Index2) -> Option<Vec<DVec3>> {
-        match (self.objects.get(object)?.sampled.model(), local) {
-            (ModelRef::ErbsCurve(c), Index2::One(l)) => {
-                Some(c.curve().local_curves().get(l)?.points().to_vec())
+    /// Every control point of the ERBS local at `local`, at any depth.
+    pub fn local_points(&self, object: usize, local: LocalPath<Index2>) -> Option<Vec<DVec3>> {
+        let points: Vec<DVec3> = match self.objects.get(object)?.sampled.model() {
+            ModelRef::ErbsCurve(c) => {
+                let root = c.curve().local_at(local.to_curve()?.steps())?;
+                each_curve_leaf_of(root, local)
+                    .into_iter()
+                    .flat_map(|(_, l)| l.points().unwrap_or(&[]).to_vec())
+                    .collect()
             }
-            (ModelRef::ErbsSurface(s), Index2::Two(k, l)) => {
-                let s = s.surface();
-                let [nu, nv] = s.count();
-                (k < nu && l < nv).then(|| s.local_patch(k, l).points().to_vec())
+            ModelRef::ErbsSurface(s) => {
+                let root = s.surface().local_at(local.to_surface()?.steps())?;
+                each_patch_leaf_of(root, local)
+                    .into_iter()
+                    .flat_map(|(_, p)| p.net().map_or(Vec::new(), |(_, pts)| pts.to_vec()))
+                    .collect()
             }
-            _ => None,
-        }
+            _ => return None,
+        };
+        (!points.is_empty()).then_some(points)
     }
 
-    /// The edit that maps an ERBS local curve or patch by the affine `matrix`.
-    pub fn transform_local(
-        &self,
+    /// The edit that sets the ERBS local at `local` exactly to its state in `origin` mapped
+    /// by `matrix` (a transform taken from a gesture's start rather than by increments).
+    pub fn set_local_transformed(
         object: usize,
-        local: Index2,
-        matrix: glam::DMat4,
+        local: LocalPath<Index2>,
+        origin: &Model,
+        matrix: &glam::DMat4,
     ) -> Option<Edit> {
-        let edit: ObjectEdit = match (self.objects.get(object)?.sampled.model(), local) {
-            (ModelRef::ErbsCurve(_), Index2::One(l)) => {
-                ErbsCurveEdit::Local(LocalEdit::Transform { local: l, matrix }).into_object()
+        let f = |p: DVec3| matrix.transform_point3(p);
+        let edit = match origin {
+            Model::ErbsCurve(m) => {
+                let path = local.to_curve()?;
+                let mut l = m.curve().local_at(path.steps())?.clone();
+                l.map_points(&f);
+                ErbsCurveEdit::SetLocal {
+                    local: path,
+                    to: Box::new(l),
+                }
+                .into_object()
             }
-            (ModelRef::ErbsSurface(_), Index2::Two(k, l)) => {
-                ErbsSurfaceEdit::Local(LocalEdit::Transform {
-                    local: [k, l],
-                    matrix,
-                })
+            Model::ErbsSurface(m) => {
+                let path = local.to_surface()?;
+                let mut p = m.surface().local_at(path.steps())?.clone();
+                p.map_points(&f);
+                ErbsSurfaceEdit::SetLocal {
+                    local: path,
+                    to: Box::new(p),
+                }
                 .into_object()
             }
             _ => return None,
         };
         Some(Edit { object, edit })
     }
+
+    /// The edit that maps an ERBS local curve or patch by the affine `matrix`.
+    pub fn transform_local(
+        &self,
+        object: usize,
+        local: LocalPath<Index2>,
+        matrix: glam::DMat4,
+    ) -> Option<Edit> {
+        let edit: ObjectEdit = match self.objects.get(object)?.sampled.model() {
+            ModelRef::ErbsCurve(_) => ErbsCurveEdit::Local(LocalEdit::Transform {
+                local: local.to_curve()?,
+                matrix,
+            })
+            .into_object(),
+            ModelRef::ErbsSurface(_) => ErbsSurfaceEdit::Local(LocalEdit::Transform {
+                local: local.to_surface()?,
+                matrix,
+            })
+            .into_object(),
+            _ => return None,
+        };
+        Some(Edit { object, edit })
+    }
 }
 
-/// One ERBS local curve or patch's display data.
+/// Display data of the polynomial locals under one ERBS local.
 #[derive(Debug, Clone, PartialEq)]
 pub enum LocalControls {
-    Curve(LocalCurve),
-    Patch(LocalPatch),
+    Curves(Vec<LocalCurve>),
+    Patches(Vec<LocalPatch>),
 }
 
 impl Document {
-    /// Display data of one ERBS local curve/patch of object `i` (what an edit of that local
-    /// changes), without recomputing the others.
-    pub fn local_controls(&self, i: usize, local: Index2) -> Option<LocalControls> {
-        match (self.objects[i].sampled.model(), local) {
-            (ModelRef::ErbsCurve(c), Index2::One(l)) => Some(LocalControls::Curve(local_curve(
-                c.curve().local_curves().get(l)?,
-            ))),
-            (ModelRef::ErbsSurface(s), Index2::Two(k, l)) => {
-                let s = s.surface();
-                let [nu, nv] = s.count();
-                (k < nu && l < nv).then(|| LocalControls::Patch(local_patch(s.local_patch(k, l))))
+    /// Display data of the polynomial locals at or below `local` of object `i` (what an edit of
+    /// that local changes), without recomputing the others.
+    pub fn local_controls(&self, i: usize, local: LocalPath<Index2>) -> Option<LocalControls> {
+        match self.objects[i].sampled.model() {
+            ModelRef::ErbsCurve(c) => {
+                Some(LocalControls::Curves(curve_leaves(c.curve(), Some(local))))
             }
+            ModelRef::ErbsSurface(s) => Some(LocalControls::Patches(patch_leaves(
+                s.surface(),
+                Some(local),
+            ))),
             _ => None,
         }
     }
 }
 
-fn local_patch(p: &TensorSurface) -> LocalPatch {
-    let [nr, nc] = p.count();
-    let [(u0, u1), (v0, v1)] = p.domain();
-    let us = uniform_params(u0, u1, LOCAL_PATCH_SAMPLES);
-    let vs = uniform_params(v0, v1, LOCAL_PATCH_SAMPLES);
-    let grid = us
-        .iter()
-        .flat_map(|&u| vs.iter().map(move |&v| (u, v)))
-        .map(|(u, v)| (p.eval(u, v), p.normal(u, v)))
-        .collect();
-    LocalPatch {
-        net_rows: nr,
-        net_cols: nc,
-        points: p.points().to_vec(),
-        grid,
+/// Every polynomial local of an ERBS curve at any depth with its path, in depth-first path
+/// order; only those at or below `under` if given.
+fn each_curve_leaf(
+    c: &ErbsCurve,
+    under: Option<LocalPath<Index2>>,
+) -> Vec<(LocalPath<Index2>, &GeomLocalCurve)> {
+    let mut out = Vec::new();
+    for (l, local) in c.local_curves().iter().enumerate() {
+        let path = LocalPath::top(Index2::One(l));
+        collect_curve_leaves(local, path, under, &mut out);
+    }
+    out
+}
+
+fn each_curve_leaf_of(
+    root: &GeomLocalCurve,
+    path: LocalPath<Index2>,
+) -> Vec<(LocalPath<Index2>, &GeomLocalCurve)> {
+    let mut out = Vec::new();
+    collect_curve_leaves(root, path, None, &mut out);
+    out
+}
+
+fn collect_curve_leaves<'a>(
+    local: &'a GeomLocalCurve,
+    path: LocalPath<Index2>,
+    under: Option<LocalPath<Index2>>,
+    out: &mut Vec<(LocalPath<Index2>, &'a GeomLocalCurve)>,
+) {
+    match local {
+        GeomLocalCurve::Spline { .. } => {
+            if under.is_none_or(|u| path.starts_with(&u)) {
+                out.push((path, local));
+            }
+        }
+        GeomLocalCurve::Erbs(e) => {
+            for (l, child) in e.local_curves().iter().enumerate() {
+                if let Some(p) = path.child(Index2::One(l)) {
+                    collect_curve_leaves(child, p, under, out);
+                }
+            }
+        }
     }
 }
 
-fn local_curve(c: &BezierCurve) -> LocalCurve {
-    let (a, b) = c.interval();
-    let samples = uniform_params(a, b, LOCAL_CURVE_SAMPLES)
-        .into_iter()
-        .map(|t| c.eval(t))
-        .collect();
-    LocalCurve {
-        points: c.points().to_vec(),
-        samples,
+fn each_patch_leaf(
+    s: &ErbsSurface,
+    under: Option<LocalPath<Index2>>,
+) -> Vec<(LocalPath<Index2>, &GeomLocalPatch)> {
+    let mut out = Vec::new();
+    let nv = s.count()[1];
+    for (idx, p) in s.local_patches().iter().enumerate() {
+        let path = LocalPath::top(Index2::Two(idx / nv, idx % nv));
+        collect_patch_leaves(p, path, under, &mut out);
+    }
+    out
+}
+
+fn each_patch_leaf_of(
+    root: &GeomLocalPatch,
+    path: LocalPath<Index2>,
+) -> Vec<(LocalPath<Index2>, &GeomLocalPatch)> {
+    let mut out = Vec::new();
+    collect_patch_leaves(root, path, None, &mut out);
+    out
+}
+
+fn collect_patch_leaves<'a>(
+    patch: &'a GeomLocalPatch,
+    path: LocalPath<Index2>,
+    under: Option<LocalPath<Index2>>,
+    out: &mut Vec<(LocalPath<Index2>, &'a GeomLocalPatch)>,
+) {
+    match patch {
+        GeomLocalPatch::Spline { .. } => {
+            if under.is_none_or(|u| path.starts_with(&u)) {
+                out.push((path, patch));
+            }
+        }
+        GeomLocalPatch::Erbs(e) => {
+            let nv = e.count()[1];
+            for (idx, child) in e.local_patches().iter().enumerate() {
+                if let Some(p) = path.child(Index2::Two(idx / nv, idx % nv)) {
+                    collect_patch_leaves(child, p, under, out);
+                }
+            }
+        }
     }
 }
+
+fn curve_leaves(c: &ErbsCurve, under: Option<LocalPath<Index2>>) -> Vec<LocalCurve> {
+    each_curve_leaf(c, under)
+        .into_iter()
+        .map(|(path, l)| {
+            let (a, b) = l.domain();
+            let samples = uniform_params(a, b, LOCAL_CURVE_SAMPLES)
+                .into_iter()
+                .map(|t| l.eval(t))
+                .collect();
+            LocalCurve {
+                path,
+                points: l.points().unwrap_or(&[]).to_vec(),
+                samples,
+            }
+        })
+        .collect()
+}
+
+fn patch_leaves(s: &ErbsSurface, under: Option<LocalPatchPath>) -> Vec<LocalPatch> {
+    each_patch_leaf(s, under)
+        .into_iter()
+        .filter_map(|(path, p)| {
+            let GeomLocalPatch::Spline { surface, .. } = p else {
+                return None;
+            };
+            let [nr, nc] = surface.count();
+            let [(u0, u1), (v0, v1)] = surface.domain();
+            let us = uniform_params(u0, u1, LOCAL_PATCH_SAMPLES);
+            let vs = uniform_params(v0, v1, LOCAL_PATCH_SAMPLES);
+            let grid = us
+                .iter()
+                .flat_map(|&u| vs.iter().map(move |&v| (u, v)))
+                .map(|(u, v)| (surface.eval(u, v), surface.normal(u, v)))
+                .collect();
+            Some(LocalPatch {
+                path,
+                net_rows: nr,
+                net_cols: nc,
+                points: surface.points().to_vec(),
+                grid,
+            })
+        })
+        .collect()
+}
+
+type LocalPatchPath = LocalPath<Index2>;

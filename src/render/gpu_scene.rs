@@ -10,7 +10,7 @@ use crate::gpu::{
     FRAMES_IN_FLIGHT, Frame, GpuResult, GridShape, Mirror, PointRun, PointStyle, PolylineStyle,
     Renderer, SurfaceGrid, SurfaceStyle,
 };
-use crate::model::{Edit, Index2, ModelRef, Target};
+use crate::model::{Edit, Index2, LocalPath, ModelRef, Target};
 use crate::sampling::{DirtyRegion, DirtySet};
 use glam::DVec3;
 
@@ -24,14 +24,22 @@ enum ControlLayout {
         rows: usize,
         cols: usize,
     },
-    /// Per local curve: (sample offset, control-point offset, control-point count).
-    LocalCurves(Vec<(usize, usize, usize)>),
-    /// Per local patch: (grid offset, control-point offset, net rows, net cols); local patches
-    /// form a `cols`-wide grid.
-    LocalPatches {
-        cols: usize,
-        patches: Vec<(usize, usize, usize, usize)>,
-    },
+    /// Per polynomial local curve at any depth: its path, sample offset, control-point
+    /// offset and control-point count.
+    LocalCurves(Vec<LocalEntry>),
+    /// Per polynomial local patch at any depth: its path, grid offset, control-point offset,
+    /// net rows and columns.
+    LocalPatches(Vec<LocalEntry>),
+}
+
+/// Where one local's display floats sit in the control mirror.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct LocalEntry {
+    path: LocalPath<Index2>,
+    samples: usize,
+    points: usize,
+    rows: usize,
+    cols: usize,
 }
 
 struct ObjectGpu {
@@ -64,7 +72,7 @@ pub struct Highlight {
     pub hovered: Option<Handle>,
     pub selected: Option<Handle>,
     /// A selected ERBS local curve/patch (drawn emphasised).
-    pub selected_local: Option<(usize, Index2)>,
+    pub selected_local: Option<(usize, LocalPath<Index2>)>,
     /// The object under the cursor (its controls show in [`NetMode::Focused`]).
     pub hovered_object: Option<usize>,
 }
@@ -174,23 +182,32 @@ impl GpuScene {
         }
     }
 
-    /// Recomputes one ERBS local's display floats (samples or grid, control points).
-    fn note_local(&mut self, doc: &Document, object: usize, local: Index2) {
+    /// Recomputes the display floats (samples or grid, control points) of the polynomial locals
+    /// at or below one ERBS local; falls back to all controls if the layout no longer fits.
+    fn note_local(&mut self, doc: &Document, object: usize, local: LocalPath<Index2>) {
         let o = &mut self.objects[object];
-        let (ranges, floats): (Vec<std::ops::Range<usize>>, Vec<Vec<f32>>) =
-            match (&o.layout, doc.local_controls(object, local)) {
-                (ControlLayout::LocalCurves(locals), Some(LocalControls::Curve(c))) => {
-                    let Index2::One(l) = local else { return };
-                    let (so, po, count) = locals[l];
+        let mut updates: Vec<(std::ops::Range<usize>, Vec<f32>)> = Vec::new();
+        let fits = match (&o.layout, doc.local_controls(object, local)) {
+            (ControlLayout::LocalCurves(entries), Some(LocalControls::Curves(curves))) => {
+                curves.iter().all(|c| {
+                    let Some(e) = entries.iter().find(|e| e.path == c.path) else {
+                        return false;
+                    };
                     let mut s = Vec::new();
                     c.samples.iter().for_each(|&q| push3(&mut s, q));
                     let mut p = Vec::new();
                     c.points.iter().for_each(|&q| push3(&mut p, q));
-                    (vec![so..so + s.len(), po..po + count * 3], vec![s, p])
-                }
-                (ControlLayout::LocalPatches { cols, patches }, Some(LocalControls::Patch(p))) => {
-                    let Index2::Two(k, l) = local else { return };
-                    let (go, po, nr, nc) = patches[k * cols + l];
+                    let ok = p.len() == e.rows * 3;
+                    updates.push((e.samples..e.samples + s.len(), s));
+                    updates.push((e.points..e.points + p.len(), p));
+                    ok
+                })
+            }
+            (ControlLayout::LocalPatches(entries), Some(LocalControls::Patches(patches))) => {
+                patches.iter().all(|p| {
+                    let Some(e) = entries.iter().find(|e| e.path == p.path) else {
+                        return false;
+                    };
                     let mut g = Vec::new();
                     for &(pos, n) in &p.grid {
                         push3(&mut g, pos);
@@ -198,11 +215,18 @@ impl GpuScene {
                     }
                     let mut q = Vec::new();
                     p.points.iter().for_each(|&x| push3(&mut q, x));
-                    (vec![go..go + g.len(), po..po + nr * nc * 3], vec![g, q])
-                }
-                _ => return self.note_controls(doc, object),
-            };
-        for (r, f) in ranges.into_iter().zip(floats) {
+                    let ok = (p.net_rows, p.net_cols) == (e.rows, e.cols);
+                    updates.push((e.samples..e.samples + g.len(), g));
+                    updates.push((e.points..e.points + q.len(), q));
+                    ok
+                })
+            }
+            _ => false,
+        };
+        if !fits {
+            return self.note_controls(doc, object);
+        }
+        for (r, f) in updates {
             o.controls_cache[r.clone()].copy_from_slice(&f);
             for d in &mut o.controls_dirty {
                 d.insert(r.clone());
@@ -363,9 +387,11 @@ impl GpuScene {
                     &points(index_in(hl.hovered, &pick), index_in(hl.selected, &pick)),
                 )?;
             }
-            ControlLayout::LocalCurves(locals) => {
-                for (l, &(so, po, count)) in locals.iter().enumerate() {
-                    let chosen = hl.selected_local == Some((i, Index2::One(l)));
+            ControlLayout::LocalCurves(entries) => {
+                for e in entries {
+                    let chosen = hl
+                        .selected_local
+                        .is_some_and(|(o, p)| o == i && e.path.starts_with(&p));
                     if opts.local_curves || chosen {
                         let color = if chosen {
                             palette.selected_local
@@ -381,7 +407,7 @@ impl GpuScene {
                             frame,
                             &o.controls,
                             PointRun {
-                                offset: so,
+                                offset: e.samples,
                                 stride: 3,
                                 count: LOCAL_CURVE_SAMPLES,
                             },
@@ -390,17 +416,17 @@ impl GpuScene {
                     }
                     if nets || chosen {
                         let run = PointRun {
-                            offset: po,
+                            offset: e.points,
                             stride: 3,
-                            count,
+                            count: e.rows,
                         };
                         polyline(frame, &o.controls, run, &net)?;
                         let pick = |h: Handle| match h {
                             Handle::LocalPoint {
-                                local: Index2::One(x),
+                                local,
                                 point: Index2::One(q),
                                 ..
-                            } if x == l => Some(q as u32),
+                            } if local == e.path => Some(q as u32),
                             _ => None,
                         };
                         frame.draw_points(
@@ -411,11 +437,12 @@ impl GpuScene {
                     }
                 }
             }
-            ControlLayout::LocalPatches { cols, patches } => {
+            ControlLayout::LocalPatches(entries) => {
                 let k = LOCAL_PATCH_SAMPLES as u32;
-                for (idx, &(go, po, nr, nc)) in patches.iter().enumerate() {
-                    let local = Index2::Two(idx / cols, idx % cols);
-                    let chosen = hl.selected_local == Some((i, local));
+                for e in entries {
+                    let chosen = hl
+                        .selected_local
+                        .is_some_and(|(o, p)| o == i && e.path.starts_with(&p));
                     if opts.local_curves || chosen {
                         let color = if chosen {
                             palette.selected_local
@@ -423,26 +450,26 @@ impl GpuScene {
                             palette.local
                         };
                         let sg = SurfaceGrid {
-                            offset: go,
+                            offset: e.samples,
                             shape: GridShape { rows: k, cols: k },
                         };
                         // Outline and centre lines only: full wire grids of every patch bury the surface.
                         frame.draw_wire(&o.controls, sg, (k - 1) / 2, color)?;
                     }
                     if nets || chosen {
-                        control_net(frame, &o.controls, po, nr, nc, &net)?;
+                        control_net(frame, &o.controls, e.points, e.rows, e.cols, &net)?;
                         let pick = |h: Handle| match h {
                             Handle::LocalPoint {
-                                local: l,
+                                local,
                                 point: Index2::Two(a, b),
                                 ..
-                            } if l == local => Some((a * nc + b) as u32),
+                            } if local == e.path => Some((a * e.cols + b) as u32),
                             _ => None,
                         };
                         let run = PointRun {
-                            offset: po,
+                            offset: e.points,
                             stride: 3,
-                            count: nr * nc,
+                            count: e.rows * e.cols,
                         };
                         frame.draw_points(
                             &o.controls,
@@ -552,34 +579,43 @@ fn control_floats(c: &Controls) -> (ControlLayout, Vec<f32>) {
             }
         }
         Controls::LocalCurves(locals) => {
-            let mut offs = Vec::new();
+            let mut entries = Vec::with_capacity(locals.len());
             for l in locals {
-                offs.push((out.len(), 0, l.points.len()));
+                entries.push(LocalEntry {
+                    path: l.path,
+                    samples: out.len(),
+                    points: 0,
+                    rows: l.points.len(),
+                    cols: 1,
+                });
                 l.samples.iter().for_each(|&q| push3(&mut out, q));
             }
-            for (l, o) in locals.iter().zip(offs.iter_mut()) {
-                o.1 = out.len();
+            for (l, e) in locals.iter().zip(entries.iter_mut()) {
+                e.points = out.len();
                 l.points.iter().for_each(|&q| push3(&mut out, q));
             }
-            ControlLayout::LocalCurves(offs)
+            ControlLayout::LocalCurves(entries)
         }
-        Controls::LocalPatches { cols, patches, .. } => {
-            let mut offs = Vec::new();
+        Controls::LocalPatches(patches) => {
+            let mut entries = Vec::with_capacity(patches.len());
             for p in patches {
-                offs.push((out.len(), 0, p.net_rows, p.net_cols));
+                entries.push(LocalEntry {
+                    path: p.path,
+                    samples: out.len(),
+                    points: 0,
+                    rows: p.net_rows,
+                    cols: p.net_cols,
+                });
                 for &(pos, n) in &p.grid {
                     push3(&mut out, pos);
                     push3(&mut out, n);
                 }
             }
-            for (p, o) in patches.iter().zip(offs.iter_mut()) {
-                o.1 = out.len();
+            for (p, e) in patches.iter().zip(entries.iter_mut()) {
+                e.points = out.len();
                 p.points.iter().for_each(|&q| push3(&mut out, q));
             }
-            ControlLayout::LocalPatches {
-                cols: *cols,
-                patches: offs,
-            }
+            ControlLayout::LocalPatches(entries)
         }
     };
     (layout, out)

@@ -1,64 +1,200 @@
-//! Pre-evaluation data of one ERBS direction: sample parameters, the knot interval of each
-//! sample, the blend weights with derivatives, and each local curve's sample range.
+//! Pre-evaluation data of one ERBS direction at given parameters: the interval of each sample,
+//! the blend weights of its two locals with derivatives, and for each local the samples it
+//! covers as pieces (two for the local that wraps around a closed direction).
 
-use crate::geom::BFunctionKind;
-use crate::geom::erbs::{blend_weights, erbs_interval};
-use crate::geom::knots::uniform_params;
+use crate::geom::erbs::{ErbsKnots, blend_weights};
 use crate::geom::point::binomial;
+use crate::geom::{BFunction, BFunctionKind};
 use std::ops::Range;
+
+/// Samples of a level covered by one local: the local is evaluated at param − shift there
+/// (shift T where a closed direction wraps). `offset` is where these samples start in the
+/// local's own sample list, which runs over its pieces in increasing local parameter.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Piece {
+    pub samples: Range<usize>,
+    pub shift: f64,
+    pub offset: usize,
+}
+
+impl Piece {
+    /// The level samples of local samples `local` (clipped to this piece), or `None`.
+    pub fn level_range(&self, local: &Range<usize>) -> Option<Range<usize>> {
+        let lo = local.start.max(self.offset);
+        let hi = local.end.min(self.offset + self.samples.len());
+        (lo < hi)
+            .then(|| self.samples.start + lo - self.offset..self.samples.start + hi - self.offset)
+    }
+}
 
 #[derive(Debug, Clone)]
 pub struct ErbsAxis {
     pub params: Vec<f64>,
-    /// Knot interval i (1 ≤ i ≤ n−1) of each sample.
+    /// Interval of each sample.
     pub spans: Vec<usize>,
     order: usize,
-    /// Per sample: W^(r) for the left local curve (1 − B) at [0..=g], then the right one (B).
+    /// Per sample: W^(0..=g) of the interval's left local (1 − B), then of its right one (B).
     blend: Vec<f64>,
-    /// Per local curve l: the samples in its support, those with interval l or l+1.
-    ranges: Vec<Range<usize>>,
+    /// Per local: the samples it covers.
+    pieces: Vec<Vec<Piece>>,
 }
 
 impl ErbsAxis {
-    pub fn new(knots: &[f64], bf: BFunctionKind, samples: usize, order: usize) -> Self {
-        let n = knots.len() - 2;
-        let params = uniform_params(knots[1], knots[n], samples);
-        let spans: Vec<usize> = params.iter().map(|&t| erbs_interval(knots, t)).collect();
-        let mut blend = Vec::with_capacity(samples * 2 * (order + 1));
+    pub fn new(knots: &ErbsKnots, bf: BFunctionKind, params: Vec<f64>, order: usize) -> Self {
+        let spans: Vec<usize> = params.iter().map(|&t| knots.locate(t)).collect();
+        let mut blend = Vec::with_capacity(params.len() * 2 * (order + 1));
         for (&t, &i) in params.iter().zip(&spans) {
-            let [left, right] = blend_weights(&bf, knots, i, t, order);
+            let [left, right] = blend_weights(&bf, knots.interval(i), t, order);
             blend.extend_from_slice(&left);
             blend.extend_from_slice(&right);
         }
-        let ranges = (0..n)
-            .map(|l| {
-                let start = spans.partition_point(|&i| i < l);
-                let end = spans.partition_point(|&i| i <= l + 1);
-                start..end
-            })
-            .collect();
+        let pieces = pieces(knots, &params, &spans);
         Self {
             params,
             spans,
             order,
             blend,
-            ranges,
+            pieces,
         }
     }
 
-    /// Samples in the support of local curve l.
-    pub fn range(&self, l: usize) -> Range<usize> {
-        self.ranges[l].clone()
+    /// The same parameters on knots with one more centre inserted strictly inside interval i
+    /// (see [`ErbsKnots::insert`]): samples outside that interval keep their weights (their
+    /// interval's knots are the same), only those inside are evaluated again.
+    pub fn refined(&self, knots: &ErbsKnots, bf: BFunctionKind, i: usize) -> Self {
+        let g1 = self.order + 1;
+        let mut spans = Vec::with_capacity(self.params.len());
+        let mut blend = Vec::with_capacity(self.blend.len());
+        for (j, &t) in self.params.iter().enumerate() {
+            let old = self.spans[j];
+            if old == i {
+                let s = knots.locate(t);
+                let [left, right] = blend_weights(&bf, knots.interval(s), t, self.order);
+                blend.extend_from_slice(&left);
+                blend.extend_from_slice(&right);
+                spans.push(s);
+            } else {
+                blend.extend_from_slice(&self.blend[2 * g1 * j..2 * g1 * (j + 1)]);
+                spans.push(if old > i { old + 1 } else { old });
+            }
+        }
+        let pieces = pieces(knots, &self.params, &spans);
+        Self {
+            params: self.params.clone(),
+            spans,
+            order: self.order,
+            blend,
+            pieces,
+        }
     }
 
-    /// Blend weights W_l^(0..=g) of local curve l at sample j (l must be active there).
+    pub fn len(&self) -> usize {
+        self.params.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.params.is_empty()
+    }
+
+    /// Blend weights W^(0..=g) of local l at sample j (l must be active there).
     #[inline]
     pub fn weights(&self, j: usize, l: usize) -> &[f64] {
         let g1 = self.order + 1;
-        let side = if self.spans[j] == l { 1 } else { 0 };
+        let side = usize::from(self.spans[j] != l);
         let base = (2 * j + side) * g1;
         &self.blend[base..base + g1]
     }
+
+    /// Number of locals of the direction.
+    pub fn locals(&self) -> usize {
+        self.pieces.len()
+    }
+
+    pub fn pieces(&self, l: usize) -> &[Piece] {
+        &self.pieces[l]
+    }
+
+    /// The parameters local l is evaluated at, in its own increasing order.
+    pub fn local_params(&self, l: usize) -> Vec<f64> {
+        self.pieces[l]
+            .iter()
+            .flat_map(|p| {
+                self.params[p.samples.clone()]
+                    .iter()
+                    .map(move |&t| t - p.shift)
+            })
+            .collect()
+    }
+
+    /// How many samples local l covers.
+    pub fn local_len(&self, l: usize) -> usize {
+        self.pieces[l].iter().map(|p| p.samples.len()).sum()
+    }
+
+    /// The samples a refinement inside interval i changes: those strictly inside it, and
+    /// those at its two knots as well when the B-function's derivatives up to the sampled
+    /// order do not all vanish at 0 and 1 (the expo-rational one's all do).
+    pub fn touched_by_refinement(
+        &self,
+        knots: &ErbsKnots,
+        i: usize,
+        bf: BFunctionKind,
+    ) -> Range<usize> {
+        let (a, b) = knots.interval(i);
+        let mut d = vec![0.0; self.order + 1];
+        let flat = [0.0, 1.0].iter().all(|&w| {
+            bf.derivatives(w, &mut d);
+            d[1..].iter().all(|&x| x == 0.0)
+        });
+        let (lo, hi) = if flat {
+            (
+                self.params.partition_point(|&t| t <= a),
+                self.params.partition_point(|&t| t < b),
+            )
+        } else {
+            (
+                self.params.partition_point(|&t| t < a),
+                self.params.partition_point(|&t| t <= b),
+            )
+        };
+        lo..hi.max(lo)
+    }
+}
+
+/// For every local, the runs of consecutive samples where it is active with one shift, ordered
+/// by local parameter.
+fn pieces(knots: &ErbsKnots, params: &[f64], spans: &[usize]) -> Vec<Vec<Piece>> {
+    let n = knots.locals();
+    let mut runs: Vec<Vec<(Range<usize>, f64)>> = vec![Vec::new(); n];
+    for (j, &i) in spans.iter().enumerate() {
+        let (right, shift) = knots.right(i);
+        for (l, s) in [(i, 0.0), (right, shift)] {
+            match runs[l].last_mut() {
+                Some((r, rs)) if r.end == j && *rs == s => r.end += 1,
+                _ => runs[l].push((j..j + 1, s)),
+            }
+        }
+    }
+    runs.into_iter()
+        .map(|mut r| {
+            r.sort_by(|a, b| {
+                let (ta, tb) = (params[a.0.start] - a.1, params[b.0.start] - b.1);
+                ta.total_cmp(&tb)
+            });
+            let mut offset = 0;
+            r.into_iter()
+                .map(|(samples, shift)| {
+                    let p = Piece {
+                        offset,
+                        shift,
+                        samples,
+                    };
+                    offset += p.samples.len();
+                    p
+                })
+                .collect()
+        })
+        .collect()
 }
 
 /// Leibniz terms ∂^r(W·c) = Σ_k C(r,k) W^(r−k) c^(k), per output order, as (C(r,k), r−k, k).

@@ -1,56 +1,169 @@
-//! Pre-evaluated ERBS surfaces: local patches sampled on their support sub-grids at the parent's
-//! parameters, blended by the Leibniz rule in both directions.
+//! Pre-evaluated ERBS surfaces, hierarchically: every local patch is pre-sampled on its support
+//! sub-grid at its parent's parameters (a polynomial patch in two passes, an ERBS patch as a
+//! level of its own), and blended by the Leibniz rule in both directions. An edit at any depth
+//! returns the change of that level's samples over the edited patch's support; each parent
+//! blends it in over the same samples.
 
 use super::axis::HermiteTable;
 use super::dirty::DirtyRegion;
-use super::erbs_axis::ErbsAxis;
+use super::erbs_axis::{ErbsAxis, Piece};
 use super::grid::{PartialSet, SampleGrid};
 use super::normals::NormalSource;
 use super::object::Sampler;
 use super::shading::{self, ShadingGrid};
 use super::spline_surface::{Rect, two_pass};
-use crate::geom::ErbsSurface;
-use crate::geom::knots::KnotVector;
+use crate::geom::erbs::{ErbsSurface, LocalPatch};
+use crate::geom::knots::uniform_params;
 use crate::geom::point::binomial;
-use crate::model::{ErbsSurfaceEdit, ErbsSurfaceModel, KindEdit, LocalEdit};
+use crate::model::{ErbsEdit, ErbsSurfaceEdit, ErbsSurfaceModel, KindEdit, LocalEdit};
 use glam::{DMat4, DVec3};
 use std::ops::Range;
 
-/// One local patch's pre-evaluation on its support rows × cols: Bernstein-Hermite tables per
-/// direction and the patch's own partials there.
+/// A change of a level's samples over `rows × cols`, `stride` vectors per sample, row-major.
 #[derive(Debug, Clone)]
-struct LocalPatch {
-    rows: Range<usize>,
-    cols: Range<usize>,
-    tables: [HermiteTable; 2],
-    samples: Vec<DVec3>,
+pub(crate) struct Patch {
+    pub rows: Range<usize>,
+    pub cols: Range<usize>,
+    pub values: Vec<DVec3>,
+}
+
+/// What reaches a local patch at the end of a path.
+pub(crate) enum PatchOp<'a> {
+    Transform(&'a DMat4),
+    MovePoint([usize; 2], DVec3),
+    Replace(&'a LocalPatch),
+}
+
+/// One local patch's pre-evaluation on its support sub-grid (local rows × local cols).
+#[derive(Debug, Clone)]
+enum PatchLevel {
+    Spline {
+        tables: Box<[HermiteTable; 2]>,
+        samples: Vec<DVec3>,
+    },
+    Erbs(Box<SurfaceLevel>),
+}
+
+impl PatchLevel {
+    fn new(patch: &LocalPatch, params: [Vec<f64>; 2], set: &PartialSet) -> Self {
+        let g = set.max_order();
+        match patch {
+            LocalPatch::Spline { surface, .. } => {
+                let [ku, kv] = surface.knots();
+                let [du, dv] = surface.degree();
+                let [nu, nv] = surface.count();
+                let [pu, pv] = params;
+                let tables = [
+                    HermiteTable::at_params(ku, du, nu, pu, g),
+                    HermiteTable::at_params(kv, dv, nv, pv, g),
+                ];
+                let (rows, cols) = (tables[0].len(), tables[1].len());
+                let mut samples = vec![DVec3::ZERO; rows * cols * set.len()];
+                sample_spline(&tables, surface.points(), nv, set, &mut samples);
+                PatchLevel::Spline {
+                    tables: Box::new(tables),
+                    samples,
+                }
+            }
+            LocalPatch::Erbs(e) => {
+                PatchLevel::Erbs(Box::new(SurfaceLevel::new(e, params, set.clone(), false)))
+            }
+        }
+    }
+
+    fn samples(&self) -> &[DVec3] {
+        match self {
+            PatchLevel::Spline { samples, .. } => samples,
+            PatchLevel::Erbs(s) => &s.grid.data,
+        }
+    }
+
+    fn transform(&mut self, a: &DMat4, stride: usize) -> Vec<DVec3> {
+        match self {
+            PatchLevel::Spline { samples, .. } => transform_samples(samples, a, stride),
+            PatchLevel::Erbs(s) => s.transform_all(a),
+        }
+    }
+}
+
+/// Samples a polynomial patch on its tables' sub-grid: the shading kernel for S, Su, Sv of
+/// degrees 1..=3, the generic two passes otherwise.
+fn sample_spline(
+    tables: &[HermiteTable; 2],
+    points: &[DVec3],
+    nv: usize,
+    set: &PartialSet,
+    out: &mut [DVec3],
+) {
+    let [tu, tv] = tables;
+    let (rows, cols) = (tu.len(), tv.len());
+    if *set == PartialSet::Shading && shading::surface_supported([tu.degree(), tv.degree()]) {
+        let grid = ShadingGrid {
+            data: out,
+            normals: None,
+            width: cols,
+        };
+        shading::sample_surface(tu, tv, points, nv, 0..rows, 0..cols, grid, &mut Vec::new());
+        return;
+    }
+    let rect = Rect {
+        rows: 0..rows,
+        cols: 0..cols,
+        origin: (0, 0),
+        width: cols,
+        stride: set.len(),
+    };
+    two_pass(tu, tv, points, nv, &set.list(), &rect, out);
+}
+
+/// Applies A to every sample (slot 0 as a point, the partials as vectors); returns the change.
+fn transform_samples(samples: &mut [DVec3], a: &DMat4, stride: usize) -> Vec<DVec3> {
+    let mut delta = vec![DVec3::ZERO; samples.len()];
+    for (d, s) in delta
+        .chunks_exact_mut(stride)
+        .zip(samples.chunks_exact_mut(stride))
+    {
+        for (q, (d, s)) in d.iter_mut().zip(s).enumerate() {
+            let moved = if q == 0 {
+                a.transform_point3(*s)
+            } else {
+                a.transform_vector3(*s)
+            };
+            *d = moved - *s;
+            *s = moved;
+        }
+    }
+    delta
 }
 
 /// For output partial (a, b): Σ over (a', b') ≤ (a, b) of C(a,a')C(b,b') Wu^(a−a') Wv^(b−b') s^(a'b').
 type BlendTerm = (f64, usize, usize, usize);
 
+/// An ERBS surface pre-evaluated at given parameters per direction.
 #[derive(Debug, Clone)]
-pub struct ErbsSurfaceSampler {
-    model: ErbsSurfaceModel,
+pub(crate) struct SurfaceLevel {
     axes: [ErbsAxis; 2],
     partials: Vec<(usize, usize)>,
     terms: Vec<Vec<BlendTerm>>,
-    patches: Vec<LocalPatch>,
-    grid: SampleGrid,
-    /// Reused buffer for an edit's change of one patch's samples: a fresh allocation of that
-    /// size is mapped and zeroed by the kernel on every edit.
-    scratch: Vec<DVec3>,
+    /// Row-major [nu][nv].
+    patches: Vec<PatchLevel>,
+    pub grid: SampleGrid,
 }
 
-impl ErbsSurfaceSampler {
-    pub fn new(model: ErbsSurfaceModel, set: PartialSet, normals: bool) -> Self {
+impl SurfaceLevel {
+    pub fn new(
+        surface: &ErbsSurface,
+        params: [Vec<f64>; 2],
+        set: PartialSet,
+        normals: bool,
+    ) -> Self {
         let g = set.max_order();
-        let surface = model.surface();
-        let samples = model.samples();
         let [ku, kv] = surface.knots();
+        let [pu, pv] = params;
+        let dims = [pu.len(), pv.len()];
         let axes = [
-            ErbsAxis::new(ku, surface.bfunction(), samples[0], g),
-            ErbsAxis::new(kv, surface.bfunction(), samples[1], g),
+            ErbsAxis::new(ku, surface.bfunction(), pu, g),
+            ErbsAxis::new(kv, surface.bfunction(), pv, g),
         ];
         let partials = set.list();
         let slot = |a: usize, b: usize| {
@@ -77,220 +190,312 @@ impl ErbsSurfaceSampler {
             })
             .collect();
         let [nu, nv] = surface.count();
-        let stride = set.len();
-        let mut patches = Vec::with_capacity(nu * nv);
-        for k in 0..nu {
-            for l in 0..nv {
-                let p = surface.local_patch(k, l);
-                let [da, db] = p.degree();
-                let (rows, cols) = (axes[0].range(k), axes[1].range(l));
-                let tu = HermiteTable::at_params(
-                    &KnotVector::bezier(da, ku[k], ku[k + 2]),
-                    da,
-                    da + 1,
-                    axes[0].params[rows.clone()].to_vec(),
-                    g,
-                );
-                let tv = HermiteTable::at_params(
-                    &KnotVector::bezier(db, kv[l], kv[l + 2]),
-                    db,
-                    db + 1,
-                    axes[1].params[cols.clone()].to_vec(),
-                    g,
-                );
-                let n = rows.len() * cols.len() * stride;
-                patches.push(LocalPatch {
-                    rows,
-                    cols,
-                    tables: [tu, tv],
-                    samples: vec![DVec3::ZERO; n],
-                });
-            }
-        }
-        let grid = SampleGrid::new(samples, set, normals);
-        let mut s = Self {
-            model,
+        let patches = (0..nu * nv)
+            .map(|idx| {
+                let (k, l) = (idx / nv, idx % nv);
+                PatchLevel::new(
+                    surface.local_patch(k, l),
+                    [axes[0].local_params(k), axes[1].local_params(l)],
+                    &set,
+                )
+            })
+            .collect();
+        let mut level = Self {
             axes,
             partials,
             terms,
             patches,
-            grid,
-            scratch: Vec::new(),
+            grid: SampleGrid::new(dims, set, normals),
         };
-        s.full();
+        for idx in 0..level.patches.len() {
+            let values = level.patches[idx].samples().to_vec();
+            let all = level.local_dims(idx);
+            level.blend(idx, &values, [0..all[0], 0..all[1]], None);
+        }
+        level
+    }
+
+    fn nv(&self) -> usize {
+        self.axes[1].locals()
+    }
+
+    /// Local sub-grid size of patch idx: [local rows, local cols].
+    fn local_dims(&self, idx: usize) -> [usize; 2] {
+        let nv = self.nv();
+        [
+            self.axes[0].local_len(idx / nv),
+            self.axes[1].local_len(idx % nv),
+        ]
+    }
+
+    /// ∂^{ab}P += Σ C(a,a')C(b,b') Wu_k^(a−a') Wv_l^(b−b') Δs^(a'b') for the patch's local
+    /// samples `local` (rows × cols; `delta` covers exactly them), restricted to level rows
+    /// `only` if given. Returns the change of this level's samples, rectangle by rectangle.
+    fn blend(
+        &mut self,
+        idx: usize,
+        delta: &[DVec3],
+        local: [Range<usize>; 2],
+        only: Option<&[Range<usize>; 2]>,
+    ) -> Vec<Patch> {
+        let nv = self.nv();
+        let (k, l) = (idx / nv, idx % nv);
+        let stride = self.partials.len();
+        let width = local[1].len();
+        let mv = self.grid.dims[1];
+        let mut out = Vec::new();
+        let upieces: Vec<Piece> = self.axes[0].pieces(k).to_vec();
+        let vpieces: Vec<Piece> = self.axes[1].pieces(l).to_vec();
+        for pu in &upieces {
+            let Some(mut rows) = pu.level_range(&local[0]) else {
+                continue;
+            };
+            if let Some(o) = only {
+                rows = rows.start.max(o[0].start)..rows.end.min(o[0].end);
+            }
+            for pv in &vpieces {
+                let Some(mut cols) = pv.level_range(&local[1]) else {
+                    continue;
+                };
+                if let Some(o) = only {
+                    cols = cols.start.max(o[1].start)..cols.end.min(o[1].end);
+                }
+                if rows.is_empty() || cols.is_empty() {
+                    continue;
+                }
+                let rows = rows.clone();
+                let rows = rows.clone();
+                let mut values = Vec::with_capacity(rows.len() * cols.len() * stride);
+                let wv: Vec<&[f64]> = cols.clone().map(|j| self.axes[1].weights(j, l)).collect();
+                for i in rows.clone() {
+                    let wu = self.axes[0].weights(i, k);
+                    let li = i - pu.samples.start + pu.offset - local[0].start;
+                    for (j, wv) in cols.clone().zip(&wv) {
+                        let lj = j - pv.samples.start + pv.offset - local[1].start;
+                        let d = &delta[(li * width + lj) * stride..][..stride];
+                        let o = &mut self.grid.data[(i * mv + j) * stride..][..stride];
+                        for (slot, terms) in self.terms.iter().enumerate() {
+                            let mut acc = DVec3::ZERO;
+                            for &(c, ia, ib, s) in terms {
+                                acc += d[s] * (c * wu[ia] * wv[ib]);
+                            }
+                            o[slot] += acc;
+                            values.push(acc);
+                        }
+                    }
+                }
+                out.push(Patch { rows, cols, values });
+            }
+        }
+        out
+    }
+
+    fn transform_all(&mut self, a: &DMat4) -> Vec<DVec3> {
+        let stride = self.partials.len();
+        for p in &mut self.patches {
+            p.transform(a, stride);
+        }
+        transform_samples(&mut self.grid.data, a, stride)
+    }
+
+    /// Applies `op` to the patch at `path` and returns this level's change.
+    pub fn apply(&mut self, path: &[[usize; 2]], op: &PatchOp) -> Vec<Patch> {
+        let stride = self.partials.len();
+        let Some((&[k, l], rest)) = path.split_first() else {
+            return Vec::new();
+        };
+        let idx = k * self.nv() + l;
+        if !rest.is_empty() {
+            let PatchLevel::Erbs(child) = &mut self.patches[idx] else {
+                return Vec::new();
+            };
+            let changes = child.apply(rest, op);
+            return changes
+                .into_iter()
+                .flat_map(|c| self.blend(idx, &c.values, [c.rows, c.cols], None))
+                .collect();
+        }
+        let dims = self.local_dims(idx);
+        let all = [0..dims[0], 0..dims[1]];
+        match *op {
+            PatchOp::Transform(a) => {
+                let delta = self.patches[idx].transform(a, stride);
+                self.blend(idx, &delta, all, None)
+            }
+            PatchOp::MovePoint([qa, qb], d) => {
+                let PatchLevel::Spline {
+                    tables, samples, ..
+                } = &mut self.patches[idx]
+                else {
+                    return Vec::new();
+                };
+                let (rows, cols) = (tables[0].range(qa), tables[1].range(qb));
+                let width = dims[1];
+                let mut delta = Vec::with_capacity(rows.len() * cols.len() * stride);
+                for li in rows.clone() {
+                    for lj in cols.clone() {
+                        let base = (li * width + lj) * stride;
+                        for (slot, &(a, b)) in self.partials.iter().enumerate() {
+                            let c = coefficient(&tables[0], li, a, qa)
+                                * coefficient(&tables[1], lj, b, qb);
+                            samples[base + slot] += d * c;
+                            delta.push(d * c);
+                        }
+                    }
+                }
+                self.blend(idx, &delta, [rows, cols], None)
+            }
+            PatchOp::Replace(patch) => {
+                let nv = self.nv();
+                let params = [
+                    self.axes[0].local_params(idx / nv),
+                    self.axes[1].local_params(idx % nv),
+                ];
+                let fresh = PatchLevel::new(patch, params, &self.grid.partials);
+                let delta: Vec<DVec3> = fresh
+                    .samples()
+                    .iter()
+                    .zip(self.patches[idx].samples())
+                    .map(|(a, b)| *a - *b)
+                    .collect();
+                self.patches[idx] = fresh;
+                self.blend(idx, &delta, all, None)
+            }
+        }
+    }
+
+    /// After [`ErbsSurface::insert_knot`] in direction `dir` inside interval i: the restricted
+    /// patches and the new row or column are pre-evaluated, the others keep theirs, and the
+    /// samples of the refined strip are blended again. Returns the strip.
+    pub fn refine(
+        &mut self,
+        old: &ErbsSurface,
+        refined: &ErbsSurface,
+        dir: usize,
+        i: usize,
+    ) -> [Range<usize>; 2] {
+        let stride = self.partials.len();
+        let strip = self.axes[dir].touched_by_refinement(&old.knots()[dir], i, old.bfunction());
+        let (right, _) = old.knots()[dir].right(i);
+        self.axes[dir] = self.axes[dir].refined(&refined.knots()[dir], refined.bfunction(), i);
+        let new_right = if right == 0 { 0 } else { right + 1 };
+        let rebuilt = [i, i + 1, new_right];
+        let [nu, nv] = refined.count();
+        let old_nv = old.count()[1];
+        let mut old_patches: Vec<Option<PatchLevel>> = std::mem::take(&mut self.patches)
+            .into_iter()
+            .map(Some)
+            .collect();
+        let mut patches = Vec::with_capacity(nu * nv);
+        for k in 0..nu {
+            for l in 0..nv {
+                let (a, m) = if dir == 0 { (k, l) } else { (l, k) };
+                let kept = if rebuilt.contains(&a) {
+                    None
+                } else {
+                    let old_a = if a > i + 1 { a - 1 } else { a };
+                    let (ok, ol) = if dir == 0 { (old_a, m) } else { (m, old_a) };
+                    old_patches[ok * old_nv + ol].take()
+                };
+                patches.push(match kept {
+                    Some(p) => p,
+                    None => PatchLevel::new(
+                        refined.local_patch(k, l),
+                        [self.axes[0].local_params(k), self.axes[1].local_params(l)],
+                        &self.grid.partials,
+                    ),
+                });
+            }
+        }
+        self.patches = patches;
+        let [mu, mv] = self.grid.dims;
+        let region = if dir == 0 {
+            [strip.clone(), 0..mv]
+        } else {
+            [0..mu, strip.clone()]
+        };
+        for i in region[0].clone() {
+            self.grid.data[(i * mv + region[1].start) * stride..(i * mv + region[1].end) * stride]
+                .fill(DVec3::ZERO);
+        }
+        for idx in 0..self.patches.len() {
+            let dims = self.local_dims(idx);
+            let values = self.patches[idx].samples().to_vec();
+            self.blend(idx, &values, [0..dims[0], 0..dims[1]], Some(&region));
+        }
+        region
+    }
+}
+
+/// M[li][order][q] of a table, 0 when q is not active there or the order is above the degree.
+#[inline]
+fn coefficient(t: &HermiteTable, j: usize, order: usize, q: usize) -> f64 {
+    let first = t.first(j);
+    if q < first || q > first + t.degree() {
+        return 0.0;
+    }
+    t.row(j, order).map_or(0.0, |r| r[q - first])
+}
+
+/// A top-level ERBS surface: the level at uniform parameters over its domain (with unit normals
+/// when rendering).
+#[derive(Debug, Clone)]
+pub struct ErbsSurfaceSampler {
+    model: ErbsSurfaceModel,
+    level: SurfaceLevel,
+}
+
+impl ErbsSurfaceSampler {
+    pub fn new(model: ErbsSurfaceModel, set: PartialSet, normals: bool) -> Self {
+        let level = Self::level(&model, set, normals);
+        let mut s = Self { model, level };
+        let [mu, mv] = s.level.grid.dims;
+        s.update_normals(0..mu, 0..mv);
         s
     }
 
-    /// Exact sampling: every local patch from its control points (two passes on its sub-grid),
-    /// then the blend.
-    fn sample_all(&mut self) -> DirtyRegion {
-        self.grid.data.fill(DVec3::ZERO);
-        for idx in 0..self.patches.len() {
-            self.sample_patch(idx);
-            // The patch's samples are the whole delta; lent out instead of cloned.
-            let delta = std::mem::take(&mut self.patches[idx].samples);
-            self.blend_in(idx, &delta);
-            self.patches[idx].samples = delta;
-        }
-        let [mu, mv] = self.grid.dims;
-        self.update_normals(0..mu, 0..mv);
-        DirtyRegion::surface(0..mu, 0..mv)
+    fn level(model: &ErbsSurfaceModel, set: PartialSet, normals: bool) -> SurfaceLevel {
+        let [(u0, u1), (v0, v1)] = model.surface().domain();
+        let [mu, mv] = model.samples();
+        let params = [uniform_params(u0, u1, mu), uniform_params(v0, v1, mv)];
+        SurfaceLevel::new(model.surface(), params, set, normals)
     }
 
-    fn sample_patch(&mut self, idx: usize) {
-        let surface = self.model.surface();
-        let nv = surface.count()[1];
-        let patch = surface.local_patch(idx / nv, idx % nv);
-        let p = &mut self.patches[idx];
-        let [tu, tv] = &p.tables;
-        if self.grid.partials == PartialSet::Shading
-            && shading::surface_supported([tu.degree(), tv.degree()])
-        {
-            let out = ShadingGrid {
-                data: &mut p.samples,
-                normals: None,
-                width: p.cols.len(),
-            };
-            let (rows, cols) = (0..p.rows.len(), 0..p.cols.len());
-            let nv = patch.count()[1];
-            shading::sample_surface(tu, tv, patch.points(), nv, rows, cols, out, &mut Vec::new());
-            return;
+    fn finish(&mut self, changes: &[Patch]) -> DirtyRegion {
+        let mut region = DirtyRegion::NOTHING;
+        for c in changes {
+            self.update_normals(c.rows.clone(), c.cols.clone());
+            region = region.union(DirtyRegion::surface(c.rows.clone(), c.cols.clone()));
         }
-        let rect = Rect {
-            rows: p.rows.clone(),
-            cols: p.cols.clone(),
-            origin: (p.rows.start, p.cols.start),
-            width: p.cols.len(),
-            stride: self.partials.len(),
-        };
-        two_pass(
-            &p.tables[0],
-            &p.tables[1],
-            patch.points(),
-            patch.count()[1],
-            &self.partials,
-            &rect,
-            &mut p.samples,
-        );
-    }
-
-    /// Affine map of local patch (k, l): Δs = A·s − s on its pre-sampled partials (positions as
-    /// points, derivatives as vectors), blended into the parent.
-    fn transform_local(&mut self, idx: usize, a: &DMat4) -> DirtyRegion {
-        let stride = self.partials.len();
-        let p = &mut self.patches[idx];
-        let mut delta = std::mem::take(&mut self.scratch);
-        delta.resize(p.samples.len(), DVec3::ZERO);
-        let samples = p.samples.chunks_exact_mut(stride);
-        for (d, s) in delta.chunks_exact_mut(stride).zip(samples) {
-            for (q, (d, s)) in d.iter_mut().zip(s).enumerate() {
-                let moved = if q == 0 {
-                    a.transform_point3(*s)
-                } else {
-                    a.transform_vector3(*s)
-                };
-                *d = moved - *s;
-                *s = moved;
-            }
-        }
-        let region = self.finish(idx, &delta);
-        self.scratch = delta;
         region
-    }
-
-    /// Control point (qa, qb) of local patch `idx` moved by Δ: Δs^(ab) = Mu[a][qa] Mv[b][qb] Δ.
-    fn move_local_point(&mut self, idx: usize, qa: usize, qb: usize, delta: DVec3) -> DirtyRegion {
-        let stride = self.partials.len();
-        let p = &mut self.patches[idx];
-        let width = p.cols.len();
-        let mut d = std::mem::take(&mut self.scratch);
-        d.resize(p.samples.len(), DVec3::ZERO);
-        for li in 0..p.rows.len() {
-            for lj in 0..width {
-                let base = (li * width + lj) * stride;
-                for (slot, &(a, b)) in self.partials.iter().enumerate() {
-                    let c = p.tables[0].row(li, a).map_or(0.0, |r| r[qa])
-                        * p.tables[1].row(lj, b).map_or(0.0, |r| r[qb]);
-                    d[base + slot] = delta * c;
-                    p.samples[base + slot] += delta * c;
-                }
-            }
-        }
-        let region = self.finish(idx, &d);
-        self.scratch = d;
-        region
-    }
-
-    fn finish(&mut self, idx: usize, delta: &[DVec3]) -> DirtyRegion {
-        let region = self.blend_in(idx, delta);
-        let (rows, cols) = (
-            self.patches[idx].rows.clone(),
-            self.patches[idx].cols.clone(),
-        );
-        self.update_normals(rows, cols);
-        region
-    }
-
-    /// ∂^{ab}P += Σ C(a,a')C(b,b') Wu_k^(a−a') Wv_l^(b−b') Δs^(a'b') over the patch's support.
-    fn blend_in(&mut self, idx: usize, delta: &[DVec3]) -> DirtyRegion {
-        let nv = self.model.surface().count()[1];
-        let (k, l) = (idx / nv, idx % nv);
-        let p = &self.patches[idx];
-        let stride = self.partials.len();
-        let mv = self.grid.dims[1];
-        let width = p.cols.len();
-        if self.grid.partials == PartialSet::Shading {
-            // The Leibniz terms of S, Su, Sv written out (the generic loop below with its
-            // terms in the same order, up to the sign of an exact zero): no per-sample term
-            // lists and slices.
-            let wv: Vec<[f64; 2]> = p
-                .cols
-                .clone()
-                .map(|j| {
-                    let w = self.axes[1].weights(j, l);
-                    [w[0], w[1]]
-                })
-                .collect();
-            for (i, d) in p.rows.clone().zip(delta.chunks_exact(width * 3)) {
-                let wu = self.axes[0].weights(i, k);
-                let (wu0, wu1) = (wu[0], wu[1]);
-                let out =
-                    &mut self.grid.data[(i * mv + p.cols.start) * 3..(i * mv + p.cols.end) * 3];
-                let (out, d) = (out.as_chunks_mut::<3>().0, d.as_chunks::<3>().0);
-                for ((o, d), &[wv0, wv1]) in out.iter_mut().zip(d).zip(&wv) {
-                    let w00 = wu0 * wv0;
-                    o[0] += d[0] * w00;
-                    o[1] += d[0] * (wu1 * wv0) + d[1] * w00;
-                    o[2] += d[0] * (wu0 * wv1) + d[2] * w00;
-                }
-            }
-            return DirtyRegion::surface(p.rows.clone(), p.cols.clone());
-        }
-        for i in p.rows.clone() {
-            let wu = self.axes[0].weights(i, k);
-            for j in p.cols.clone() {
-                let wv = self.axes[1].weights(j, l);
-                let d =
-                    &delta[((i - p.rows.start) * width + (j - p.cols.start)) * stride..][..stride];
-                let out = &mut self.grid.data[(i * mv + j) * stride..][..stride];
-                for (slot, terms) in self.terms.iter().enumerate() {
-                    let mut acc = DVec3::ZERO;
-                    for &(c, ia, ib, s) in terms {
-                        acc += d[s] * (c * wu[ia] * wv[ib]);
-                    }
-                    out[slot] += acc;
-                }
-            }
-        }
-        DirtyRegion::surface(p.rows.clone(), p.cols.clone())
     }
 
     fn update_normals(&mut self, rows: Range<usize>, cols: Range<usize>) {
         let params = [
-            self.axes[0].params.as_slice(),
-            self.axes[1].params.as_slice(),
+            self.level.axes[0].params.as_slice(),
+            self.level.axes[1].params.as_slice(),
         ];
-        super::normals::update(&mut self.grid, rows, cols, params, self.model.surface());
+        super::normals::update(
+            &mut self.level.grid,
+            rows,
+            cols,
+            params,
+            self.model.surface(),
+        );
+    }
+
+    fn point(&self, path: &[[usize; 2]], [a, b]: [usize; 2]) -> DVec3 {
+        match self.model.surface().local_at(path) {
+            Some(LocalPatch::Spline { surface, .. }) => surface.point(a, b),
+            _ => DVec3::ZERO,
+        }
+    }
+
+    fn replace(&mut self, path: &[[usize; 2]]) -> Vec<Patch> {
+        match self.model.surface().local_at(path) {
+            Some(p) => self.level.apply(path, &PatchOp::Replace(p)),
+            None => Vec::new(),
+        }
     }
 }
 
@@ -302,44 +507,80 @@ impl Sampler for ErbsSurfaceSampler {
     }
 
     fn grid(&self) -> &SampleGrid {
-        &self.grid
+        &self.level.grid
     }
 
     fn params(&self) -> Vec<&[f64]> {
-        vec![&self.axes[0].params, &self.axes[1].params]
+        vec![&self.level.axes[0].params, &self.level.axes[1].params]
     }
 
     fn apply(&mut self, edit: &ErbsSurfaceEdit) -> DirtyRegion {
-        let ErbsSurfaceEdit::Local(e) = edit;
-        let [k, l] = e.local();
-        let nb = self.model.surface().local_patch(k, l).count()[1];
-        let idx = k * self.model.surface().count()[1] + l;
-        let before = self.model.surface().local_patch(k, l).points().to_vec();
-        edit.apply(&mut self.model);
-        match e {
-            LocalEdit::Transform { matrix, .. } => self.transform_local(idx, matrix),
-            // Samples move by the model's exact change of each point.
-            LocalEdit::MovePoint { .. } | LocalEdit::SetPoints { .. } => {
-                let after = self.model.surface().local_patch(k, l).points().to_vec();
-                let mut region = DirtyRegion::NOTHING;
-                for (q, (&new, &old)) in after.iter().zip(&before).enumerate() {
-                    if new != old {
-                        region =
-                            region.union(self.move_local_point(idx, q / nb, q % nb, new - old));
+        let changes = match edit {
+            ErbsEdit::Local(e) => {
+                let path = e.local();
+                match e {
+                    LocalEdit::Transform { matrix, .. } => {
+                        edit.apply(&mut self.model);
+                        self.level.apply(path.steps(), &PatchOp::Transform(matrix))
+                    }
+                    LocalEdit::MovePoint { point, .. } => {
+                        let before = self.point(path.steps(), *point);
+                        edit.apply(&mut self.model);
+                        let d = self.point(path.steps(), *point) - before;
+                        self.level
+                            .apply(path.steps(), &PatchOp::MovePoint(*point, d))
+                    }
+                    LocalEdit::SetPoints { .. } => {
+                        edit.apply(&mut self.model);
+                        self.replace(path.steps())
                     }
                 }
-                region
             }
-        }
+            ErbsEdit::InsertKnot {
+                local: None,
+                at: (dir, t),
+                ..
+            } => {
+                let old = self.model.surface().clone();
+                let i = old.knots()[*dir].locate(*t);
+                edit.apply(&mut self.model);
+                if self.model.surface() == &old {
+                    return DirtyRegion::NOTHING;
+                }
+                let [rows, cols] = self.level.refine(&old, self.model.surface(), *dir, i);
+                vec![Patch {
+                    rows,
+                    cols,
+                    values: Vec::new(),
+                }]
+            }
+            ErbsEdit::InsertKnot {
+                local: Some(path), ..
+            }
+            | ErbsEdit::ToErbs { local: path, .. }
+            | ErbsEdit::SetLocal { local: path, .. } => {
+                edit.apply(&mut self.model);
+                self.replace(path.steps())
+            }
+            ErbsEdit::Restore(_) => {
+                edit.apply(&mut self.model);
+                return self.full();
+            }
+        };
+        self.finish(&changes)
     }
 
     /// ERBS updates are local anyway: drift control re-samples everything.
     fn rebuild(&mut self, _region: DirtyRegion) -> DirtyRegion {
-        self.sample_all()
+        self.full()
     }
 
     fn full(&mut self) -> DirtyRegion {
-        self.sample_all()
+        let normals = self.level.grid.normals.is_some();
+        self.level = Self::level(&self.model, self.level.grid.partials.clone(), normals);
+        let [mu, mv] = self.level.grid.dims;
+        self.update_normals(0..mu, 0..mv);
+        DirtyRegion::surface(0..mu, 0..mv)
     }
 }
 

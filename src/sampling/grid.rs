@@ -1,5 +1,6 @@
 //! The canonical f64 sample grid.
 
+use crate::geom::point::{Point, nan_max};
 use glam::DVec3;
 
 /// Which derivatives a grid holds per sample. Curves: orders 0..=g. Surfaces: a downward-closed
@@ -113,33 +114,136 @@ impl SampleGrid {
         self.data[(i * self.dims[1] + j) * self.stride()]
     }
 
-    /// Largest |component| over every stored value of partial slot p (for relative tolerances).
+    /// Largest |component| over every stored value of partial slot p (its magnitude, for
+    /// relative tolerances); NaN when any of them is NaN.
     pub fn scale(&self, p: usize) -> f64 {
         self.data
             .iter()
             .skip(p)
             .step_by(self.stride())
-            .fold(0.0, |m, v| m.max(v.abs().max_element()))
+            .fold(0.0, |m, v| nan_max(m, v.max_abs()))
     }
 
-    /// Largest absolute difference to another grid of the same shape, per partial slot,
-    /// relative to max(1, that slot's scale).
-    pub fn max_relative_difference(&self, other: &SampleGrid) -> f64 {
+    /// Per partial slot, the largest absolute difference to another grid of the same shape
+    /// relative to that slot's own magnitude (the larger of the two grids' [`scale`]s, no
+    /// floor): each derivative order is held to its own size, however small the object. A
+    /// slot that is zero in both grids differs by 0. A NaN anywhere — in either grid, values or
+    /// normals — gives +∞, so that no comparison with a tolerance can pass it.
+    ///
+    /// [`scale`]: SampleGrid::scale
+    pub fn relative_differences(&self, other: &SampleGrid) -> Vec<f64> {
         assert_eq!(self.dims, other.dims);
         assert_eq!(self.partials, other.partials);
         let s = self.stride();
         (0..s)
             .map(|p| {
-                let scale = self.scale(p).max(other.scale(p)).max(1.0);
+                let scale = nan_max(self.scale(p), other.scale(p));
                 let diff = self
                     .data
                     .iter()
                     .zip(&other.data)
                     .skip(p)
                     .step_by(s)
-                    .fold(0.0f64, |m, (a, b)| m.max((*a - *b).abs().max_element()));
-                diff / scale
+                    .fold(0.0f64, |m, (a, b)| nan_max(m, (*a - *b).max_abs()));
+                relative(diff, scale)
             })
-            .fold(0.0, f64::max)
+            .collect()
+    }
+
+    /// The largest of [`relative_differences`](SampleGrid::relative_differences) (+∞ on NaN).
+    pub fn max_relative_difference(&self, other: &SampleGrid) -> f64 {
+        self.relative_differences(other)
+            .into_iter()
+            .fold(0.0, nan_max)
+    }
+
+    /// Largest distance between the unit normals of two grids (0 when neither keeps normals,
+    /// +∞ when only one does or on NaN).
+    pub fn max_normal_difference(&self, other: &SampleGrid) -> f64 {
+        match (&self.normals, &other.normals) {
+            (None, None) => 0.0,
+            (Some(a), Some(b)) if a.len() == b.len() => {
+                let d = a
+                    .iter()
+                    .zip(b)
+                    .fold(0.0, |m, (x, y)| nan_max(m, (*x - *y).length()));
+                if d.is_nan() { f64::INFINITY } else { d }
+            }
+            _ => f64::INFINITY,
+        }
+    }
+}
+
+/// `diff / scale`, +∞ for NaN and for any difference of something that is zero.
+fn relative(diff: f64, scale: f64) -> f64 {
+    if diff.is_nan() || scale.is_nan() {
+        f64::INFINITY
+    } else if diff == 0.0 {
+        0.0
+    } else {
+        diff / scale
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn curve(values: &[[f64; 3]]) -> SampleGrid {
+        let mut g = SampleGrid::new([values.len() / 2, 1], PartialSet::Curve(1), false);
+        for (d, v) in g.data.iter_mut().zip(values) {
+            *d = DVec3::from_array(*v);
+        }
+        g
+    }
+
+    #[test]
+    fn a_nan_is_never_within_tolerance() {
+        let a = curve(&[
+            [1.0, 2.0, 3.0],
+            [0.1, 0.0, 0.0],
+            [2.0, 1.0, 0.0],
+            [0.2, 0.0, 0.0],
+        ]);
+        let mut b = a.clone();
+        assert_eq!(a.max_relative_difference(&b), 0.0);
+        b.data[3].y = f64::NAN;
+        assert_eq!(a.max_relative_difference(&b), f64::INFINITY);
+        assert_eq!(b.max_relative_difference(&a), f64::INFINITY);
+        assert!(b.scale(1).is_nan());
+        // NaN in both at the same place is no better.
+        assert_eq!(b.max_relative_difference(&b.clone()), f64::INFINITY);
+    }
+
+    #[test]
+    fn each_derivative_order_is_relative_to_its_own_magnitude() {
+        // Positions of size 1000, first derivatives of size 1e-3: an error of 1e-9 in the
+        // derivative is 1e-6 of its magnitude, however large the positions are.
+        let a = curve(&[
+            [1000.0, 0.0, 0.0],
+            [1e-3, 0.0, 0.0],
+            [0.0, 1000.0, 0.0],
+            [0.0, 1e-3, 0.0],
+        ]);
+        let mut b = a.clone();
+        b.data[1].x += 1e-9;
+        let rel = a.relative_differences(&b);
+        assert_eq!(rel[0], 0.0);
+        assert!((rel[1] - 1e-6).abs() < 1e-11, "{rel:?}");
+        // A slot that is zero in one grid and not in the other differs relative to the other.
+        let zero = curve(&[[1.0, 0.0, 0.0], [0.0; 3], [2.0, 0.0, 0.0], [0.0; 3]]);
+        let mut nonzero = zero.clone();
+        nonzero.data[1].x = 1e-300;
+        assert_eq!(zero.relative_differences(&nonzero)[1], 1.0);
+        assert_eq!(zero.relative_differences(&zero.clone())[1], 0.0);
+    }
+
+    #[test]
+    fn normal_differences_catch_nan() {
+        let mut a = SampleGrid::new([2, 2], PartialSet::Shading, true);
+        let b = a.clone();
+        assert_eq!(a.max_normal_difference(&b), 0.0);
+        a.normals.as_mut().unwrap()[3] = DVec3::new(f64::NAN, 0.0, 1.0);
+        assert_eq!(a.max_normal_difference(&b), f64::INFINITY);
     }
 }

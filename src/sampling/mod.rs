@@ -6,6 +6,7 @@
 //! `geom` knows the curves; this module knows where they are sampled. Nothing here knows Vulkan.
 
 pub mod axis;
+pub mod budget;
 pub mod chain_curve;
 pub mod curvature;
 pub mod dirty;

@@ -6,7 +6,7 @@ use super::json::*;
 use super::{Scene, SceneError};
 use crate::model::{
     BezierSplineEdit, CatmullRomEdit, CurveEdit, Edit, EditError, ErbsCurveEdit, ErbsSurfaceEdit,
-    KindEdit, LocalEdit, Model, ModelRef, ObjectEdit, PointEdit, SurfaceEdit,
+    KindEdit, LocalEdit, LocalPath, Model, ModelRef, ObjectEdit, PointEdit, SurfaceEdit,
 };
 use glam::DMat4;
 use serde_json::{Map, Value};
@@ -73,6 +73,9 @@ fn parse_edit(
     if obj.contains_key("to_bspline") {
         return to_bspline(at, obj, model);
     }
+    if let ModelRef::ErbsCurve(_) | ModelRef::ErbsSurface(_) = model {
+        return erbs_edit(at, obj, model.is_surface());
+    }
     if obj.contains_key("insert_knot") || obj.contains_key("elevate_degree") {
         return structural(at, obj, model);
     }
@@ -97,13 +100,166 @@ fn parse_edit(
         ModelRef::Surface(_) => {
             SurfaceEdit::Point(point_edit(at, obj, |v| pair(at, "point", v))?).into_object()
         }
-        ModelRef::ErbsCurve(_) => {
-            ErbsCurveEdit::Local(local_edit(at, obj, |f, v| index(at, f, v))?).into_object()
-        }
-        ModelRef::ErbsSurface(_) => {
-            ErbsSurfaceEdit::Local(local_edit(at, obj, |f, v| pair(at, f, v))?).into_object()
-        }
+        ModelRef::ErbsCurve(_) | ModelRef::ErbsSurface(_) => unreachable!("handled above"),
     })
+}
+
+/// An ERBS edit: a local edit (`local` with `transform`, or `point` and `delta`), a refinement
+/// (`insert_knot`, optionally of the ERBS local at `local`, with an optional `degree`), or a
+/// local turned into an ERBS local of its own (`local` with `to_erbs`).
+fn erbs_edit(at: &At, obj: &Map<String, Value>, surface: bool) -> Result<ObjectEdit, SceneError> {
+    if obj.contains_key("elevate_degree") {
+        return Err(at.err(
+            "elevate_degree",
+            "ERBS objects are refined by inserting knots (insert_knot), not by degree elevation",
+        ));
+    }
+    if surface {
+        let path = |v: &Value| surface_path(at, v);
+        let point = |v: &Value| pair(at, "point", v);
+        if let Some(v) = obj.get("insert_knot") {
+            check_fields(at, obj, &["object", "local", "insert_knot", "degree"])?;
+            let local = obj.get("local").map(path).transpose()?;
+            let at_knot = direction_parameter(at, v)?;
+            let degree = obj
+                .get("degree")
+                .map(|d| super::parse::usize_pair(at, "degree", "[du, dv]", d))
+                .transpose()?;
+            return Ok(ErbsSurfaceEdit::InsertKnot {
+                local,
+                at: at_knot,
+                degree,
+            }
+            .into_object());
+        }
+        if let Some(v) = obj.get("to_erbs") {
+            check_fields(at, obj, &["object", "local", "to_erbs"])?;
+            let local = path(require(at, obj, "local")?)?;
+            let spec = as_object(at, "to_erbs", v)?;
+            let inner = At(format!("{}: field 'to_erbs'", at.0));
+            check_fields(&inner, spec, &["local_patches", "local_degree"])?;
+            let count = super::parse::usize_pair(
+                at,
+                "to_erbs",
+                "[nu, nv]",
+                require(&inner, spec, "local_patches")?,
+            )?;
+            let degree = super::parse::usize_pair(
+                at,
+                "to_erbs",
+                "[du, dv]",
+                require(&inner, spec, "local_degree")?,
+            )?;
+            return Ok(ErbsSurfaceEdit::ToErbs {
+                local,
+                count,
+                degree,
+            }
+            .into_object());
+        }
+        return Ok(ErbsSurfaceEdit::Local(local_edit(at, obj, path, point)?).into_object());
+    }
+    let path = |v: &Value| curve_path(at, v);
+    let point = |v: &Value| index(at, "point", v);
+    if let Some(v) = obj.get("insert_knot") {
+        check_fields(at, obj, &["object", "local", "insert_knot", "degree"])?;
+        let local = obj.get("local").map(path).transpose()?;
+        let t = as_f64(at, "insert_knot", "parameter", v)?;
+        let degree = obj
+            .get("degree")
+            .map(|d| as_usize(at, "degree", "degree", d))
+            .transpose()?;
+        return Ok(ErbsCurveEdit::InsertKnot {
+            local,
+            at: t,
+            degree,
+        }
+        .into_object());
+    }
+    if let Some(v) = obj.get("to_erbs") {
+        check_fields(at, obj, &["object", "local", "to_erbs"])?;
+        let local = path(require(at, obj, "local")?)?;
+        let spec = as_object(at, "to_erbs", v)?;
+        let inner = At(format!("{}: field 'to_erbs'", at.0));
+        check_fields(&inner, spec, &["local_curves", "local_degree"])?;
+        let count = as_usize(
+            at,
+            "to_erbs",
+            "local_curves",
+            require(&inner, spec, "local_curves")?,
+        )?;
+        let degree = as_usize(
+            at,
+            "to_erbs",
+            "local_degree",
+            require(&inner, spec, "local_degree")?,
+        )?;
+        return Ok(ErbsCurveEdit::ToErbs {
+            local,
+            count,
+            degree,
+        }
+        .into_object());
+    }
+    Ok(ErbsCurveEdit::Local(local_edit(at, obj, path, point)?).into_object())
+}
+
+/// A curve's local path: `l` or `[l, l2, …]` descending through ERBS locals.
+fn curve_path(at: &At, v: &Value) -> Result<LocalPath<usize>, SceneError> {
+    let steps = match v.as_array() {
+        Some(a) => a
+            .iter()
+            .map(|x| as_usize(at, "local", "index", x))
+            .collect::<Result<Vec<_>, _>>()?,
+        None => vec![as_usize(at, "local", "index", v)?],
+    };
+    LocalPath::new(&steps).ok_or_else(|| bad_path(at, steps.len()))
+}
+
+/// A surface's local path: `[k, l]` or `[[k, l], [k2, l2], …]`.
+fn surface_path(at: &At, v: &Value) -> Result<LocalPath<[usize; 2]>, SceneError> {
+    let nested = v
+        .as_array()
+        .is_some_and(|a| a.first().is_some_and(Value::is_array));
+    let steps = if nested {
+        as_array(at, "local", v)?
+            .iter()
+            .map(|x| pair(at, "local", x))
+            .collect::<Result<Vec<_>, _>>()?
+    } else {
+        vec![pair(at, "local", v)?]
+    };
+    LocalPath::new(&steps).ok_or_else(|| bad_path(at, steps.len()))
+}
+
+fn bad_path(at: &At, len: usize) -> SceneError {
+    at.err(
+        "local",
+        format!(
+            "a path of {len} steps: paths have 1 to {} steps",
+            crate::geom::erbs::MAX_NESTING
+        ),
+    )
+}
+
+/// `{"u": t}` or `{"v": t}`.
+fn direction_parameter(at: &At, v: &Value) -> Result<(usize, f64), SceneError> {
+    let one = |key: &str| {
+        v.as_object()
+            .filter(|d| d.len() == 1)
+            .and_then(|d| d.get(key))
+    };
+    let (dir, t) = match (one("u"), one("v")) {
+        (Some(t), _) => (0, t),
+        (_, Some(t)) => (1, t),
+        _ => {
+            return Err(at.err(
+                "insert_knot",
+                format!("a surface takes {{\"u\": t}} or {{\"v\": t}}, found {v}"),
+            ));
+        }
+    };
+    Ok((dir, as_f64(at, "insert_knot", "parameter", t)?))
 }
 
 /// `{"point": i, "delta": [..]}` or `{"point": i, "weight": w}`.
@@ -127,11 +283,12 @@ fn point_edit<I>(
 }
 
 /// `{"local": l, "transform": [[4×4]]}` or `{"local": l, "point": q, "delta": [..]}`.
-fn local_edit<I>(
+fn local_edit<I: Copy + Default>(
     at: &At,
     obj: &Map<String, Value>,
-    index: impl Fn(&'static str, &Value) -> Result<I, SceneError>,
-) -> Result<LocalEdit<I, I>, SceneError> {
+    path: impl Fn(&Value) -> Result<LocalPath<I>, SceneError>,
+    index: impl Fn(&Value) -> Result<I, SceneError>,
+) -> Result<LocalEdit<I>, SceneError> {
     let Some(l) = obj.get("local") else {
         let field = if obj.contains_key("transform") {
             "transform"
@@ -143,14 +300,14 @@ fn local_edit<I>(
             "an ERBS object is edited through its local curves: give \"local\" (with \"transform\", or \"point\" and \"delta\")",
         ));
     };
-    let local = index("local", l)?;
+    let local = path(l)?;
     if obj.contains_key("transform") {
         check_fields(at, obj, &["object", "local", "transform"])?;
         let matrix = affine(at, require(at, obj, "transform")?)?;
         return Ok(LocalEdit::Transform { local, matrix });
     }
     check_fields(at, obj, &["object", "local", "point", "delta"])?;
-    let point = index("point", require(at, obj, "point")?)?;
+    let point = index(require(at, obj, "point")?)?;
     let delta = as_point(at, "delta", "delta", require(at, obj, "delta")?)?;
     Ok(LocalEdit::MovePoint {
         local,
@@ -203,17 +360,6 @@ fn structural(
             format!("a {ty} keeps its own segment structure; convert it first ({{\"object\": …, \"to_bspline\": true}}) to refine it"),
         ));
     }
-    if let ModelRef::ErbsCurve(_) | ModelRef::ErbsSurface(_) = model {
-        let field = if obj.contains_key("insert_knot") {
-            "insert_knot"
-        } else {
-            "elevate_degree"
-        };
-        return Err(at.err(
-            field,
-            format!("an {ty} is refined by its own ERBS refinement, not by B-spline {field} (not supported yet)"),
-        ));
-    }
     let surface = model.is_surface();
     if let Some(v) = obj.get("insert_knot") {
         check_fields(at, obj, &["object", "insert_knot", "times"])?;
@@ -225,18 +371,7 @@ fn structural(
             let t = as_f64(at, "insert_knot", "parameter", v)?;
             return Ok(CurveEdit::InsertKnot { t, times }.into_object());
         }
-        let one = |key: &str| v.as_object().filter(|d| d.len() == 1).and_then(|d| d.get(key));
-        let (dir, t) = match (one("u"), one("v")) {
-            (Some(t), _) => (0, t),
-            (_, Some(t)) => (1, t),
-            _ => {
-                return Err(at.err(
-                    "insert_knot",
-                    format!("a surface takes {{\"u\": t}} or {{\"v\": t}}, found {v}"),
-                ));
-            }
-        };
-        let t = as_f64(at, "insert_knot", "parameter", t)?;
+        let (dir, t) = direction_parameter(at, v)?;
         return Ok(SurfaceEdit::InsertKnot { dir, t, times }.into_object());
     }
     check_fields(at, obj, &["object", "elevate_degree"])?;

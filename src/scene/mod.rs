@@ -6,6 +6,7 @@ pub mod edit;
 mod json;
 pub mod obj;
 mod parse;
+mod parse_erbs;
 mod write;
 
 pub use crate::model::{Index2, MAX_CURVE_SAMPLES, MAX_DEGREE, MAX_SURFACE_SAMPLES, Model};
@@ -43,13 +44,10 @@ impl Scene {
         parse_scene(&text)
     }
 
-    /// Writes the scene file atomically (temporary file + rename), so a failed save never
-    /// destroys the previous file.
+    /// Writes the scene file atomically and durably (see [`write_durably`]), so neither a
+    /// failed save nor a crash or power loss right after it destroys the previous file.
     pub fn save(&self, path: &Path) -> Result<(), SceneError> {
-        let text = scene_to_json(self);
-        let tmp = path.with_extension("json.tmp");
-        std::fs::write(&tmp, text)
-            .and_then(|()| std::fs::rename(&tmp, path))
+        write_durably(path, scene_to_json(self).as_bytes())
             .map_err(|e| SceneError(format!("cannot write {}: {e}", path.display())))
     }
 
@@ -68,4 +66,33 @@ impl Scene {
         }
         self
     }
+}
+
+/// Replaces `path` with `bytes` atomically and durably: the bytes go to a temporary file in the
+/// same directory, which is flushed to disk (fsync) before it is renamed over `path`, and the
+/// directory is flushed after the rename. Readers see the old file or the new one, never a
+/// part; after a crash the rename is not there without the data it points to.
+pub fn write_durably(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    use std::io::Write;
+    let name = path
+        .file_name()
+        .ok_or_else(|| std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a file path"))?;
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let tmp = dir.join(format!(
+        ".{}.tmp-{}",
+        name.to_string_lossy(),
+        std::process::id()
+    ));
+    let written = std::fs::File::create(&tmp).and_then(|mut f| {
+        f.write_all(bytes)?;
+        f.sync_all()
+    });
+    if let Err(e) = written.and_then(|()| std::fs::rename(&tmp, path)) {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(e);
+    }
+    std::fs::File::open(dir).and_then(|d| d.sync_all())
 }

@@ -3,8 +3,8 @@
 use super::json::*;
 use super::{MAX_CURVE_SAMPLES, MAX_DEGREE, MAX_SURFACE_SAMPLES, Scene, SceneError, SceneObject};
 use crate::geom::{
-    BFunctionKind, BSplineCurve, BezierCurve, BezierSpline, CatmullRom, ErbsCurve, ErbsSurface,
-    GeomError, JoinContinuity, KnotVector, Parametrization, TensorSurface,
+    BFunctionKind, BSplineCurve, BezierSpline, CatmullRom, GeomError, JoinContinuity, KnotVector,
+    Parametrization, TensorSurface,
 };
 use crate::model::{
     BezierSplineModel, CatmullRomModel, CurveModel, EditError, ErbsCurveModel, ErbsSurfaceModel,
@@ -40,7 +40,8 @@ pub fn parse_scene(text: &str) -> Result<Scene, SceneError> {
     Ok(Scene { objects })
 }
 
-const CURVE_FIELDS: [&str; 4] = ["name", "type", "samples", "color"];
+/// Fields every object has besides its geometry.
+const OBJECT_FIELDS: [&str; 4] = ["name", "type", "samples", "color"];
 
 fn parse_object(i: usize, v: &Value) -> Result<SceneObject, SceneError> {
     let at = At(format!("objects[{i}]"));
@@ -57,86 +58,30 @@ fn parse_object(i: usize, v: &Value) -> Result<SceneObject, SceneError> {
     let at = At(format!("object '{name}' (objects[{i}])"));
     let ty = as_str(&at, "type", require(&at, obj, "type")?)?;
     let model = match ty {
-        "bezier_curve" => {
-            check_fields(&at, obj, &fields(&["points", "weights"]))?;
-            let points = as_points(&at, "points", require(&at, obj, "points")?)?;
-            check_degree(&at, "points", points.len() - 1)?;
-            let weights = opt(obj, "weights")
-                .map(|w| as_f64_list(&at, "weights", "weight", w))
-                .transpose()?;
-            let knots = KnotVector::bezier(points.len() - 1, 0.0, 1.0).into_vec();
-            let c = BSplineCurve::new(points.len() - 1, knots, points, weights)
-                .map_err(|e| geom(&at, e))?;
-            curve(&at, SplineForm::Bezier, c, curve_samples(&at, obj)?)?
+        "bezier_curve" | "bspline_curve" => {
+            let (form, c) = spline_curve(&at, obj, ty, &OBJECT_FIELDS)?;
+            curve(&at, form, c, curve_samples(&at, obj)?)?
         }
-        "bspline_curve" => {
-            check_fields(&at, obj, &fields(&["degree", "knots", "points", "weights"]))?;
-            let degree = as_usize(&at, "degree", "degree", require(&at, obj, "degree")?)?;
-            check_degree(&at, "degree", degree)?;
-            let knots = as_f64_list(&at, "knots", "knot", require(&at, obj, "knots")?)?;
-            let points = as_points(&at, "points", require(&at, obj, "points")?)?;
-            let weights = opt(obj, "weights")
-                .map(|w| as_f64_list(&at, "weights", "weight", w))
-                .transpose()?;
-            let c = BSplineCurve::new(degree, knots, points, weights).map_err(|e| geom(&at, e))?;
-            curve(&at, SplineForm::BSpline, c, curve_samples(&at, obj)?)?
+        "bezier_surface" | "bspline_surface" => {
+            let (form, s) = spline_surface(&at, obj, ty, &OBJECT_FIELDS)?;
+            surface(&at, form, s, surface_samples(&at, obj)?)?
         }
         "erbs_curve" => {
-            check_fields(&at, obj, &fields(&["knots", "local", "bfunction"]))?;
-            let knots = as_f64_list(&at, "knots", "knot", require(&at, obj, "knots")?)?;
-            let local = as_array(&at, "local", require(&at, obj, "local")?)?;
-            let curves = local
-                .iter()
-                .enumerate()
-                .map(|(l, v)| local_curve(&at, &format!("local[{l}]"), v))
-                .collect::<Result<Vec<_>, _>>()?;
-            let bf = bfunction(&at, obj)?;
-            let c = ErbsCurve::new(knots, curves, bf).map_err(|e| geom(&at, e))?;
+            let c = super::parse_erbs::erbs_curve(&at, obj, &OBJECT_FIELDS)?;
             let m = ErbsCurveModel::new(c, curve_samples(&at, obj)?);
             Model::ErbsCurve(m.map_err(|e| edit(&at, e))?)
         }
-        "bezier_surface" => {
-            check_fields(&at, obj, &fields(&["points", "weights"]))?;
-            let (count, points) = point_grid(&at, "points", require(&at, obj, "points")?)?;
-            check_degree(&at, "points", count[0].max(count[1]) - 1)?;
-            let weights = weight_grid(&at, obj, count)?;
-            let s = TensorSurface::bezier(count, points, weights).map_err(|e| geom(&at, e))?;
-            surface(&at, SplineForm::Bezier, s, surface_samples(&at, obj)?)?
-        }
-        "bspline_surface" => {
-            check_fields(&at, obj, &fields(&["degree", "knots", "points", "weights"]))?;
-            let dv = as_array(&at, "degree", require(&at, obj, "degree")?)?;
-            if dv.len() != 2 {
-                return Err(at.err(
-                    "degree",
-                    format!("expected [du, dv], found {} entries", dv.len()),
-                ));
-            }
-            let degree = [
-                as_usize(&at, "degree", "degree[0]", &dv[0])?,
-                as_usize(&at, "degree", "degree[1]", &dv[1])?,
-            ];
-            check_degree(&at, "degree", degree[0].max(degree[1]))?;
-            let knots = knot_pair(&at, obj)?;
-            let (count, points) = point_grid(&at, "points", require(&at, obj, "points")?)?;
-            let weights = weight_grid(&at, obj, count)?;
-            let s = TensorSurface::bspline(degree, knots, count, points, weights)
-                .map_err(|e| geom(&at, e))?;
-            surface(&at, SplineForm::BSpline, s, surface_samples(&at, obj)?)?
-        }
         "erbs_surface" => {
-            check_fields(&at, obj, &fields(&["knots", "local", "bfunction"]))?;
-            let knots = knot_pair(&at, obj)?;
-            let (count, patches) = as_grid(&at, "local", require(&at, obj, "local")?, |idx, v| {
-                local_patch(&at, &format!("local{idx}"), v)
-            })?;
-            let bf = bfunction(&at, obj)?;
-            let s = ErbsSurface::new(knots, count, patches, bf).map_err(|e| geom(&at, e))?;
+            let s = super::parse_erbs::erbs_surface(&at, obj, &OBJECT_FIELDS)?;
             let m = ErbsSurfaceModel::new(s, surface_samples(&at, obj)?);
             Model::ErbsSurface(m.map_err(|e| edit(&at, e))?)
         }
         "catmull_rom" => {
-            check_fields(&at, obj, &fields(&["points", "parametrization", "closed"]))?;
+            check_fields(
+                &at,
+                obj,
+                &with(&OBJECT_FIELDS, &["points", "parametrization", "closed"]),
+            )?;
             let points = as_points(&at, "points", require(&at, obj, "points")?)?;
             let parametrization = match opt(obj, "parametrization") {
                 None => Parametrization::default(),
@@ -169,7 +114,7 @@ fn parse_object(i: usize, v: &Value) -> Result<SceneObject, SceneError> {
             check_fields(
                 &at,
                 obj,
-                &fields(&["degree", "knots", "points", "continuity"]),
+                &with(&OBJECT_FIELDS, &["degree", "knots", "points", "continuity"]),
             )?;
             let degree = as_usize(&at, "degree", "degree", require(&at, obj, "degree")?)?;
             check_degree(&at, "degree", degree)?;
@@ -204,6 +149,94 @@ fn parse_object(i: usize, v: &Value) -> Result<SceneObject, SceneError> {
     })
 }
 
+/// The geometry of a `bezier_curve` or `bspline_curve` body (an object, an ERBS `from`
+/// source, a local curve); `outer` lists the other fields the body may hold.
+pub(super) fn spline_curve(
+    at: &At,
+    obj: &Map<String, Value>,
+    ty: &str,
+    outer: &[&'static str],
+) -> Result<(SplineForm, BSplineCurve), SceneError> {
+    let weights = || {
+        opt(obj, "weights")
+            .map(|w| as_f64_list(at, "weights", "weight", w))
+            .transpose()
+    };
+    if ty == "bezier_curve" {
+        check_fields(at, obj, &with(outer, &["points", "weights"]))?;
+        let points = as_points(at, "points", require(at, obj, "points")?)?;
+        check_degree(at, "points", points.len() - 1)?;
+        let knots = KnotVector::bezier(points.len() - 1, 0.0, 1.0).into_vec();
+        let c = BSplineCurve::new(points.len() - 1, knots, points, weights()?)
+            .map_err(|e| geom(at, e))?;
+        return Ok((SplineForm::Bezier, c));
+    }
+    check_fields(
+        at,
+        obj,
+        &with(outer, &["degree", "knots", "points", "weights"]),
+    )?;
+    let degree = as_usize(at, "degree", "degree", require(at, obj, "degree")?)?;
+    check_degree(at, "degree", degree)?;
+    let knots = as_f64_list(at, "knots", "knot", require(at, obj, "knots")?)?;
+    let points = as_points(at, "points", require(at, obj, "points")?)?;
+    let c = BSplineCurve::new(degree, knots, points, weights()?).map_err(|e| geom(at, e))?;
+    Ok((SplineForm::BSpline, c))
+}
+
+/// The geometry of a `bezier_surface` or `bspline_surface` body.
+pub(super) fn spline_surface(
+    at: &At,
+    obj: &Map<String, Value>,
+    ty: &str,
+    outer: &[&'static str],
+) -> Result<(SplineForm, TensorSurface), SceneError> {
+    if ty == "bezier_surface" {
+        check_fields(at, obj, &with(outer, &["points", "weights"]))?;
+        let (count, points) = point_grid(at, "points", require(at, obj, "points")?)?;
+        check_degree(at, "points", count[0].max(count[1]) - 1)?;
+        let weights = weight_grid(at, obj, count)?;
+        let s = TensorSurface::bezier(count, points, weights).map_err(|e| geom(at, e))?;
+        return Ok((SplineForm::Bezier, s));
+    }
+    check_fields(
+        at,
+        obj,
+        &with(outer, &["degree", "knots", "points", "weights"]),
+    )?;
+    let degree = usize_pair(at, "degree", "[du, dv]", require(at, obj, "degree")?)?;
+    check_degree(at, "degree", degree[0].max(degree[1]))?;
+    let knots = knot_pair(at, obj)?;
+    let (count, points) = point_grid(at, "points", require(at, obj, "points")?)?;
+    let weights = weight_grid(at, obj, count)?;
+    let s =
+        TensorSurface::bspline(degree, knots, count, points, weights).map_err(|e| geom(at, e))?;
+    Ok((SplineForm::BSpline, s))
+}
+
+/// `[a, b]` of non-negative integers, one per direction (`form` shows it in messages, e.g.
+/// "[du, dv]").
+pub(super) fn usize_pair(
+    at: &At,
+    field: &str,
+    form: &str,
+    v: &Value,
+) -> Result<[usize; 2], SceneError> {
+    match v.as_array() {
+        Some(a) if a.len() == 2 => Ok([
+            as_usize(at, field, &format!("{field}[0]"), &a[0])?,
+            as_usize(at, field, &format!("{field}[1]"), &a[1])?,
+        ]),
+        Some(a) => Err(at.err(field, format!("expected {form}, found {} entries", a.len()))),
+        None => Err(at.err(field, format!("expected {form}, found {v}"))),
+    }
+}
+
+/// `outer` plus the body's own fields.
+pub(super) fn with(outer: &[&'static str], own: &[&'static str]) -> Vec<&'static str> {
+    outer.iter().chain(own).copied().collect()
+}
+
 fn curve(at: &At, form: SplineForm, c: BSplineCurve, m: usize) -> Result<Model, SceneError> {
     Ok(Model::Curve(
         CurveModel::new(form, c, m).map_err(|e| edit(at, e))?,
@@ -221,25 +254,20 @@ fn surface(
     ))
 }
 
-fn edit(at: &At, e: EditError) -> SceneError {
+pub(super) fn edit(at: &At, e: EditError) -> SceneError {
     at.err(e.field, e.message)
 }
 
-/// The common fields plus the type's own.
-fn fields(extra: &[&'static str]) -> Vec<&'static str> {
-    CURVE_FIELDS.iter().chain(extra).copied().collect()
-}
-
-fn opt<'a>(obj: &'a Map<String, Value>, field: &str) -> Option<&'a Value> {
+pub(super) fn opt<'a>(obj: &'a Map<String, Value>, field: &str) -> Option<&'a Value> {
     obj.get(field)
 }
 
-fn geom(at: &At, e: GeomError) -> SceneError {
+pub(super) fn geom(at: &At, e: GeomError) -> SceneError {
     at.err(e.field, e.message)
 }
 
 /// `[[u knots], [v knots]]` of a surface.
-fn knot_pair(at: &At, obj: &Map<String, Value>) -> Result<[Vec<f64>; 2], SceneError> {
+pub(super) fn knot_pair(at: &At, obj: &Map<String, Value>) -> Result<[Vec<f64>; 2], SceneError> {
     let kv = as_array(at, "knots", require(at, obj, "knots")?)?;
     if kv.len() != 2 {
         return Err(at.err(
@@ -256,7 +284,7 @@ fn knot_pair(at: &At, obj: &Map<String, Value>) -> Result<[Vec<f64>; 2], SceneEr
     ])
 }
 
-fn check_degree(at: &At, field: &str, degree: usize) -> Result<(), SceneError> {
+pub(super) fn check_degree(at: &At, field: &str, degree: usize) -> Result<(), SceneError> {
     if degree > MAX_DEGREE {
         return Err(at.err(
             field,
@@ -266,13 +294,13 @@ fn check_degree(at: &At, field: &str, degree: usize) -> Result<(), SceneError> {
     Ok(())
 }
 
-fn curve_samples(at: &At, obj: &Map<String, Value>) -> Result<usize, SceneError> {
+pub(super) fn curve_samples(at: &At, obj: &Map<String, Value>) -> Result<usize, SceneError> {
     let m = as_usize(at, "samples", "samples", require(at, obj, "samples")?)?;
     check_count(at, m, MAX_CURVE_SAMPLES)?;
     Ok(m)
 }
 
-fn surface_samples(at: &At, obj: &Map<String, Value>) -> Result<[usize; 2], SceneError> {
+pub(super) fn surface_samples(at: &At, obj: &Map<String, Value>) -> Result<[usize; 2], SceneError> {
     let v = require(at, obj, "samples")?;
     let a = v
         .as_array()
@@ -291,7 +319,7 @@ fn surface_samples(at: &At, obj: &Map<String, Value>) -> Result<[usize; 2], Scen
     Ok([mu, mv])
 }
 
-fn check_count(at: &At, m: usize, max: usize) -> Result<(), SceneError> {
+pub(super) fn check_count(at: &At, m: usize, max: usize) -> Result<(), SceneError> {
     if m < 2 {
         return Err(at.err(
             "samples",
@@ -304,7 +332,7 @@ fn check_count(at: &At, m: usize, max: usize) -> Result<(), SceneError> {
     Ok(())
 }
 
-fn bfunction(at: &At, obj: &Map<String, Value>) -> Result<BFunctionKind, SceneError> {
+pub(super) fn bfunction(at: &At, obj: &Map<String, Value>) -> Result<BFunctionKind, SceneError> {
     let Some(v) = obj.get("bfunction") else {
         return Ok(BFunctionKind::default());
     };
@@ -321,41 +349,17 @@ fn bfunction(at: &At, obj: &Map<String, Value>) -> Result<BFunctionKind, SceneEr
     })
 }
 
-fn local_curve(at: &At, which: &str, v: &Value) -> Result<BezierCurve, SceneError> {
-    let la = At(format!("{}: {which}", at.0));
-    let obj = as_object(at, "local", v).map_err(|_| {
-        at.err(
-            "local",
-            format!("{which}: expected {{\"points\": [...]}}, found {}", kind(v)),
-        )
-    })?;
-    check_fields(&la, obj, &["points"])?;
-    let points = as_points(&la, "points", require(&la, obj, "points")?)?;
-    check_degree(&la, "points", points.len() - 1)?;
-    BezierCurve::new(points).map_err(|e| geom(&la, e))
-}
-
-fn local_patch(at: &At, which: &str, v: &Value) -> Result<TensorSurface, SceneError> {
-    let la = At(format!("{}: {which}", at.0));
-    let obj = as_object(at, "local", v).map_err(|_| {
-        at.err(
-            "local",
-            format!("{which}: expected {{\"points\": [...]}}, found {}", kind(v)),
-        )
-    })?;
-    check_fields(&la, obj, &["points"])?;
-    let (count, points) = point_grid(&la, "points", require(&la, obj, "points")?)?;
-    check_degree(&la, "points", count[0].max(count[1]) - 1)?;
-    TensorSurface::bezier(count, points, None).map_err(|e| geom(&la, e))
-}
-
-fn point_grid(at: &At, field: &str, v: &Value) -> Result<([usize; 2], Vec<DVec3>), SceneError> {
+pub(super) fn point_grid(
+    at: &At,
+    field: &str,
+    v: &Value,
+) -> Result<([usize; 2], Vec<DVec3>), SceneError> {
     as_grid(at, field, v, |idx, p| {
         as_point(at, field, &format!("point {idx}"), p)
     })
 }
 
-fn weight_grid(
+pub(super) fn weight_grid(
     at: &At,
     obj: &Map<String, Value>,
     count: [usize; 2],
@@ -380,7 +384,7 @@ fn weight_grid(
 
 fn parse_color(at: &At, v: &Value) -> Result<[f64; 3], SceneError> {
     let p = as_point(at, "color", "color", v)?;
-    if p.min_element() < 0.0 || p.max_element() > 1.0 {
+    if !p.cmpge(glam::DVec3::ZERO).all() || !p.cmple(glam::DVec3::ONE).all() {
         return Err(at.err(
             "color",
             format!("components must lie in [0, 1], found {:?}", p.to_array()),

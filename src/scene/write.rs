@@ -2,6 +2,7 @@
 //! loading a saved scene reproduces every control value bit for bit.
 
 use super::{Scene, SceneObject};
+use crate::geom::erbs::{ErbsCurve, ErbsSurface, LocalCurve, LocalPatch};
 use crate::geom::{BFunctionKind, Parametrization, TensorSurface};
 use crate::model::{Model, SplineForm};
 use glam::DVec3;
@@ -47,17 +48,7 @@ fn write_object(s: &mut String, o: &SceneObject) {
                 field(s, "weights", &numbers(w));
             }
         }
-        Model::ErbsCurve(m) => {
-            let c = m.curve();
-            field(s, "knots", &numbers(c.knots()));
-            let local: Vec<String> = c
-                .local_curves()
-                .iter()
-                .map(|l| format!("{{\"points\": {}}}", points(l.points())))
-                .collect();
-            field(s, "local", &format!("[{}]", local.join(", ")));
-            bfunction(s, c.bfunction());
-        }
+        Model::ErbsCurve(m) => erbs_curve(s, m.curve()),
         Model::Surface(m) if m.form() == SplineForm::Bezier => {
             let p = m.surface();
             field(s, "points", &point_grid(p));
@@ -72,22 +63,7 @@ fn write_object(s: &mut String, o: &SceneObject) {
             field(s, "points", &point_grid(p));
             weights(s, p);
         }
-        Model::ErbsSurface(m) => {
-            let e = m.surface();
-            let [ku, kv] = e.knots();
-            field(s, "knots", &format!("[{}, {}]", numbers(ku), numbers(kv)));
-            let [nu, nv] = e.count();
-            let rows: Vec<String> = (0..nu)
-                .map(|k| {
-                    let row: Vec<String> = (0..nv)
-                        .map(|l| format!("{{\"points\": {}}}", point_grid(e.local_patch(k, l))))
-                        .collect();
-                    format!("[{}]", row.join(", "))
-                })
-                .collect();
-            field(s, "local", &format!("[{}]", rows.join(", ")));
-            bfunction(s, e.bfunction());
-        }
+        Model::ErbsSurface(m) => erbs_surface(s, m.surface()),
         Model::CatmullRom(m) => {
             let c = m.spline();
             field(s, "points", &points(c.points()));
@@ -118,6 +94,109 @@ fn write_object(s: &mut String, o: &SceneObject) {
         field(s, "color", &numbers(&c));
     }
     s.push('}');
+}
+
+/// The explicit form of an ERBS curve's fields: knots, `closed`, locals (typed where not the
+/// original Bézier form), a narrowed `domain` of a local ERBS, the B-function.
+fn erbs_curve(s: &mut String, c: &ErbsCurve) {
+    let k = c.knots();
+    field(s, "knots", &numbers(k.as_slice()));
+    if k.is_closed() {
+        field(s, "closed", "true");
+    }
+    if k.domain() != k.full_domain() {
+        let (a, b) = k.domain();
+        field(s, "domain", &numbers(&[a, b]));
+    }
+    let local: Vec<String> = c.local_curves().iter().map(local_curve).collect();
+    field(s, "local", &format!("[{}]", local.join(", ")));
+    bfunction(s, c.bfunction());
+}
+
+fn local_curve(l: &LocalCurve) -> String {
+    let mut s = String::from("{");
+    match l {
+        LocalCurve::Spline {
+            curve,
+            bezier: true,
+        } => {
+            let _ = write!(s, "\"points\": {}", points(curve.points()));
+        }
+        LocalCurve::Spline { curve, .. } => {
+            let _ = write!(
+                s,
+                "\"type\": \"bspline_curve\", \"degree\": {}, \"knots\": {}, \"points\": {}",
+                curve.degree(),
+                numbers(curve.knots()),
+                points(curve.points())
+            );
+        }
+        LocalCurve::Erbs(e) => {
+            s.push_str("\"type\": \"erbs_curve\"");
+            erbs_curve(&mut s, e);
+        }
+    }
+    s.push('}');
+    s
+}
+
+fn erbs_surface(s: &mut String, e: &ErbsSurface) {
+    let [ku, kv] = e.knots();
+    field(
+        s,
+        "knots",
+        &format!("[{}, {}]", numbers(ku.as_slice()), numbers(kv.as_slice())),
+    );
+    if e.closed() != [false, false] {
+        let [a, b] = e.closed();
+        field(s, "closed", &format!("[{a}, {b}]"));
+    }
+    if ku.domain() != ku.full_domain() || kv.domain() != kv.full_domain() {
+        let [(u0, u1), (v0, v1)] = e.domain();
+        field(
+            s,
+            "domain",
+            &format!("[{}, {}]", numbers(&[u0, u1]), numbers(&[v0, v1])),
+        );
+    }
+    let [nu, nv] = e.count();
+    let rows: Vec<String> = (0..nu)
+        .map(|k| {
+            let row: Vec<String> = (0..nv).map(|l| local_patch(e.local_patch(k, l))).collect();
+            format!("[{}]", row.join(", "))
+        })
+        .collect();
+    field(s, "local", &format!("[{}]", rows.join(", ")));
+    bfunction(s, e.bfunction());
+}
+
+fn local_patch(p: &LocalPatch) -> String {
+    let mut s = String::from("{");
+    match p {
+        LocalPatch::Spline {
+            surface,
+            bezier: true,
+        } => {
+            let _ = write!(s, "\"points\": {}", point_grid(surface));
+        }
+        LocalPatch::Spline { surface, .. } => {
+            let [du, dv] = surface.degree();
+            let [ku, kv] = surface.knots();
+            let _ = write!(
+                s,
+                "\"type\": \"bspline_surface\", \"degree\": [{du}, {dv}], \"knots\": [{}, {}], \"points\": {}",
+                numbers(ku),
+                numbers(kv),
+                point_grid(surface)
+            );
+        }
+        LocalPatch::Erbs(e) => {
+            s.push_str("\"type\": \"erbs_surface\"");
+            erbs_surface(&mut s, e);
+        }
+    }
+    s.push('}');
+    s
 }
 
 fn field(s: &mut String, name: &str, value: &str) {

@@ -1,6 +1,7 @@
 //! The winit 0.30 application: window, swapchain (resize, minimise, out-of-date), input
 //! translation, the frame loop, scripted input and screenshots.
 
+use super::autosave::Autosave;
 use super::input::{InputEvent, Key, Modifiers, MouseButton};
 use super::scenario::{Scenario, ScenarioDriver};
 use super::script::ScriptPlayer;
@@ -40,6 +41,8 @@ pub struct ViewArgs {
     pub max_frames: Option<usize>,
     /// Re-sample and upload edited objects in full (`--naive`).
     pub naive: bool,
+    /// Where unsaved edits are kept (`None`: nowhere, as in benchmarks).
+    pub autosave: Option<Autosave>,
 }
 
 /// What a viewer run measured.
@@ -71,6 +74,8 @@ struct App {
     /// as this frame's input phase.
     rec: Recorder,
     device: String,
+    /// The wake-up this app asked for on the autosave's behalf (so it clears only its own).
+    autosave_wakeup: Option<Instant>,
 }
 
 /// Whether an X11 display is reachable (this build's winit backend is X11; Wayland sessions
@@ -101,10 +106,21 @@ pub fn run(args: ViewArgs) -> Result<ViewRun, String> {
         error: None,
         rec,
         device: String::new(),
+        autosave_wakeup: None,
     };
-    event_loop
-        .run_app(&mut app)
-        .map_err(|e| format!("event loop failed: {e}"))?;
+    // A panic anywhere in the loop must not lose unsaved edits: write the autosave, then let
+    // the panic go on.
+    let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        event_loop.run_app(&mut app)
+    }));
+    let outcome = match outcome {
+        Ok(outcome) => outcome,
+        Err(panic) => {
+            app.keep_unsaved_edits();
+            std::panic::resume_unwind(panic)
+        }
+    };
+    outcome.map_err(|e| format!("event loop failed: {e}"))?;
     if let Some(errors) = app
         .sink
         .as_ref()
@@ -157,13 +173,14 @@ impl App {
                 },
             )
             .map_err(|e| e.to_string())?;
-        let session = Session::new(
+        let mut session = Session::new(
             &mut renderer,
             &self.args.scene,
             self.args.save_path.clone(),
             [size.width, size.height],
         )
         .map_err(|e| e.to_string())?;
+        session.set_autosave(self.args.autosave.clone());
         window.request_redraw();
         self.running = Some(Running {
             session,
@@ -174,7 +191,19 @@ impl App {
         Ok(())
     }
 
+    /// Every way out: the unsaved edits go to the autosave first (CPU only), and its path is
+    /// printed.
+    fn keep_unsaved_edits(&mut self) {
+        if let Some(path) = self.running.as_mut().and_then(|r| r.session.on_exit()) {
+            eprintln!(
+                "unsaved edits kept in {} (`prespline view SCENE --recover` opens them)",
+                path.display()
+            );
+        }
+    }
+
     fn shutdown(&mut self, event_loop: &ActiveEventLoop) {
+        self.keep_unsaved_edits();
         if let Some(r) = self.running.take() {
             let Running {
                 session,
@@ -276,6 +305,30 @@ impl App {
             rec.phase_start(Phase::Input);
         }
         Ok(())
+    }
+}
+
+impl App {
+    /// Writes the autosave when due, and keeps a loop that sleeps until input (redraw on
+    /// demand) waking up for the next deadline. A polling loop wakes up anyway.
+    fn schedule_autosave(&mut self, event_loop: &ActiveEventLoop) {
+        let Some(r) = self.running.as_mut() else {
+            return;
+        };
+        let now = Instant::now();
+        let next = r.session.tick(now);
+        let mine = std::mem::replace(&mut self.autosave_wakeup, next);
+        let flow = match (event_loop.control_flow(), next) {
+            (ControlFlow::Poll, _) => return,
+            // Another timer of the loop's that is still ahead and comes first stays.
+            (ControlFlow::WaitUntil(t), Some(d)) if t > now && Some(t) != mine => t.min(d),
+            (_, Some(d)) => d,
+            (ControlFlow::WaitUntil(t), None) if Some(t) == mine => {
+                return event_loop.set_control_flow(ControlFlow::Wait);
+            }
+            (_, None) => return,
+        };
+        event_loop.set_control_flow(ControlFlow::WaitUntil(flow));
     }
 }
 
@@ -390,7 +443,8 @@ impl ApplicationHandler for App {
         }
     }
 
-    fn about_to_wait(&mut self, _event_loop: &ActiveEventLoop) {
+    fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
+        self.schedule_autosave(event_loop);
         // Continuous redraw: the frame-time graph and profiling want a steady stream of frames;
         // FIFO presentation paces it to the display.
         if let Some(r) = self.running.as_ref() {

@@ -3,6 +3,7 @@
 //! tests, and the HUD.
 
 pub mod app;
+pub mod autosave;
 pub mod hud;
 pub mod input;
 pub mod picking;

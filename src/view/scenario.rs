@@ -4,7 +4,7 @@
 use super::input::{InputEvent, Key, MouseButton};
 use super::script::Action;
 use super::session::Session;
-use crate::model::{Index2, ModelRef};
+use crate::model::{Index2, LocalPath, ModelRef};
 use crate::render::Handle;
 use std::f64::consts::TAU;
 
@@ -220,20 +220,20 @@ fn erbs_target(session: &Session) -> Option<Handle> {
                 let s = s.surface();
                 let [nu, nv] = s.count();
                 let (k, l) = (nu / 2, nv / 2);
-                let [a, b] = s.local_patch(k, l).count();
+                let ([a, b], _) = s.local_patch(k, l).net()?;
                 return Some(Handle::LocalPoint {
                     object,
-                    local: Index2::Two(k, l),
+                    local: LocalPath::top(Index2::Two(k, l)),
                     point: Index2::Two(a / 2, b / 2),
                 });
             }
             ModelRef::ErbsCurve(c) => {
                 let c = c.curve();
                 let l = c.local_curves().len() / 2;
-                let q = c.local_curves()[l].points().len() / 2;
+                let q = c.local_curves()[l].points()?.len() / 2;
                 return Some(Handle::LocalPoint {
                     object,
-                    local: Index2::One(l),
+                    local: LocalPath::top(Index2::One(l)),
                     point: Index2::One(q),
                 });
             }

@@ -20,7 +20,7 @@
 //! keep working when the window size or framing changes.
 
 use super::input::{InputEvent, Key, Modifiers, MouseButton};
-use crate::model::Index2;
+use crate::model::{Index2, LocalPath};
 use crate::render::{Document, Handle};
 use serde_json::Value;
 use std::path::PathBuf;
@@ -184,10 +184,11 @@ fn handle(v: &Value, doc: &Document) -> Result<Handle, String> {
         }
     };
     let point = index("point")?.ok_or("'move_to' needs \"point\"")?;
-    let h = match index("local")? {
-        Some(local) => Handle::LocalPoint {
+    let h = match v.get("local") {
+        Some(l) => Handle::LocalPoint {
             object,
-            local,
+            local: local_path(l, doc.objects[object].sampled.model().is_surface())
+                .ok_or("bad 'local': an index, [k, l], or a path of them")?,
             point,
         },
         None => Handle::Point { object, point },
@@ -230,4 +231,26 @@ impl ScriptPlayer {
     pub fn finished(&self) -> bool {
         self.next >= self.events.len()
     }
+}
+
+/// An ERBS local: `l` or a path `[l, l2, …]` (curves); `[k, l]` or a path
+/// `[[k, l], [k2, l2], …]` (surfaces).
+fn local_path(v: &Value, surface: bool) -> Option<LocalPath<Index2>> {
+    let one = |x: &Value| x.as_u64().map(|u| u as usize);
+    let pair = |x: &Value| {
+        let a = x.as_array().filter(|a| a.len() == 2)?;
+        Some(Index2::Two(one(&a[0])?, one(&a[1])?))
+    };
+    let steps: Vec<Index2> = match (v, surface) {
+        (Value::Array(a), true) if a.first().is_some_and(Value::is_array) => {
+            a.iter().map(pair).collect::<Option<_>>()?
+        }
+        (_, true) => vec![pair(v)?],
+        (Value::Array(a), false) => a
+            .iter()
+            .map(|x| one(x).map(Index2::One))
+            .collect::<Option<_>>()?,
+        (_, false) => vec![Index2::One(one(v)?)],
+    };
+    LocalPath::new(&steps)
 }

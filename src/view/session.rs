@@ -3,6 +3,7 @@
 //! delta path, copy dirty rows, record draws and the overlay). The winit viewer, `--script`
 //! replays and `prespline bench` all drive this same type.
 
+use super::autosave::Autosave;
 use super::hud::Hud;
 use super::input::{InputEvent, Key, Modifiers, MouseButton};
 use super::picking::{PICK_RADIUS, Projected, pick, project_all};
@@ -11,13 +12,17 @@ use super::script::Action;
 use super::tools::{Axis, Drag, Transform, TransformKind, View};
 use super::undo::UndoStack;
 use crate::gpu::{Frame, GpuResult, Renderer};
-use crate::model::{CurveEdit, Edit, Index2, KindEdit, ModelRef, SurfaceEdit, merge_edits};
+use crate::model::{
+    CurveEdit, Edit, Index2, KindEdit, LocalPath, Model, ModelRef, SurfaceEdit, merge_edits,
+};
 use crate::render::analysis::{
     CurveEval, Osculating, badge_overlay, osculating_lines, osculating_overlay,
 };
 use crate::render::maps::{SurfaceMap, legend};
 use crate::render::overlays::overlay_lines;
-use crate::sampling::DirtyRegion;
+use crate::cli::render::DRAW_USES;
+use crate::sampling::budget::{MemoryBudget, check_scene};
+use crate::sampling::{DirtyRegion, SampleMode};
 use crate::render::{
     Bounds, Document, GpuScene, Handle, Highlight, NetMode, OrbitCamera, Palette, UploadStats,
     ViewOptions, Wire,
@@ -31,7 +36,7 @@ use std::time::Instant;
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Target {
     Point(Handle),
-    Local(usize, Index2),
+    Local(usize, LocalPath<Index2>),
 }
 
 #[derive(Debug, Clone)]
@@ -82,7 +87,7 @@ pub struct Session {
     hovered: Option<Projected>,
     hovered_object: Option<usize>,
     selected: Option<Handle>,
-    selected_local: Option<(usize, Index2)>,
+    selected_local: Option<(usize, LocalPath<Index2>)>,
     mode: Mode,
     pending: Vec<Edit>,
     undo: UndoStack,
@@ -99,6 +104,10 @@ pub struct Session {
     /// What tools without pre-evaluation do on an edit: re-sample every edited object from
     /// scratch and upload all of it (`prespline bench --naive`).
     pub naive: bool,
+    /// Unsaved edits kept beside the scene file (`None`: not kept, as in benchmarks).
+    autosave: Option<Autosave>,
+    /// The transformed object's model when the gesture began.
+    transform_origin: Option<Model>,
     /// Osculating circle, curvature and torsion of the curve under the cursor (O).
     pub osculating: bool,
     /// Half range of the analysis map's colour scale (refitted when a map is chosen and after
@@ -151,9 +160,61 @@ impl Session {
             projected: None,
             merge: true,
             naive: false,
+            autosave: None,
+            transform_origin: None,
             osculating: false,
             map_range: 1.0,
         })
+    }
+
+    /// Keeps unsaved edits in an autosave file (see [`super::autosave`]).
+    pub fn set_autosave(&mut self, autosave: Option<Autosave>) {
+        self.autosave = autosave;
+    }
+
+    pub fn autosave(&self) -> Option<&Autosave> {
+        self.autosave.as_ref()
+    }
+
+    /// Writes the autosave when it is due at `now`; returns when it is due next, for an event
+    /// loop that otherwise sleeps until input arrives.
+    pub fn tick(&mut self, now: Instant) -> Option<Instant> {
+        let due = self.autosave.as_ref()?.deadline()?;
+        if due > now {
+            return Some(due);
+        }
+        self.write_autosave();
+        self.autosave.as_ref()?.deadline()
+    }
+
+    /// Every way out (window close, Ctrl+Q, a script's quit, an error): writes the autosave if
+    /// edits are unsaved, and returns its path while it holds edits the scene file lacks.
+    pub fn on_exit(&mut self) -> Option<PathBuf> {
+        self.write_autosave();
+        let a = self.autosave.as_ref()?;
+        a.exists().then(|| a.path().to_path_buf())
+    }
+
+    /// The device was lost or the viewer is about to fail: write the autosave now, before
+    /// anything else can go wrong (CPU only; touches no GPU object). Returns its path as
+    /// [`Session::on_exit`] does.
+    pub fn on_fatal_exit(&mut self) -> Option<PathBuf> {
+        self.on_exit()
+    }
+
+    /// Brings the autosave up to date with every queued edit (no-op when nothing is unsaved).
+    fn write_autosave(&mut self) {
+        if self.autosave.is_none() {
+            return;
+        }
+        self.apply_pending();
+        let scene = self.doc.to_scene();
+        if let Some(a) = self.autosave.as_mut()
+            && let Err(e) = a.write(&scene)
+        {
+            eprintln!("autosave failed: {e}");
+            self.set_status(format!("autosave failed: {e}"));
+        }
     }
 
     /// Gives the GPU resources back.
@@ -184,7 +245,7 @@ impl Session {
         self.selected
     }
 
-    pub fn selected_local(&self) -> Option<(usize, Index2)> {
+    pub fn selected_local(&self) -> Option<(usize, LocalPath<Index2>)> {
         self.selected_local
     }
 
@@ -270,6 +331,9 @@ impl Session {
             samples += region.samples();
             self.gpu.note_samples(i, &region);
             self.gpu.note_controls(&self.doc, i);
+        }
+        if let Some(a) = self.autosave.as_mut() {
+            a.edited(start);
         }
         let micros = start.elapsed().as_secs_f64() * 1e6;
         self.projected = None;
@@ -633,7 +697,7 @@ impl Session {
             Handle::LocalPoint { local, point, .. } => {
                 format!(
                     "{name}: local {} point {} (G/R/S transform the local)",
-                    index_text(local),
+                    path_text(local),
                     index_text(point)
                 )
             }
@@ -890,6 +954,8 @@ impl Session {
     }
 
     fn start_transform(&mut self, kind: TransformKind) {
+        // The pivot and the starting points come from the model with every queued edit in.
+        self.apply_pending();
         let target = match (self.selected_local, self.selected) {
             (Some((o, l)), _) => Target::Local(o, l),
             (None, Some(h)) if kind == TransformKind::Grab => Target::Point(h),
@@ -911,6 +977,10 @@ impl Session {
                 .map(|p| p.iter().sum::<DVec3>() / p.len() as f64),
         };
         let Some(pivot) = pivot else { return };
+        self.transform_origin = match target {
+            Target::Local(o, _) => Some(self.doc.objects[o].sampled.model().to_model()),
+            Target::Point(_) => None,
+        };
         let t = Box::new(Transform::new(kind, pivot, &self.view(), self.cursor));
         self.undo.begin(kind.name());
         self.mode = Mode::Transform { target, t };
@@ -928,12 +998,21 @@ impl Session {
             return;
         };
         let total = t.total(&view);
-        let inc = total * t.applied.inverse();
-        if inc == DMat4::IDENTITY {
+        if total == t.applied {
             return;
         }
+        // A singular transform (a typed scale passes through 0 on the way to "0.5") has no
+        // inverse to take the next increment from: the local's points are then set exactly
+        // from where they were when the gesture began.
+        let singular = |m: &DMat4| !(m.determinant().abs() > 0.0 && m.inverse().is_finite());
+        let exact = singular(&total) || singular(&t.applied);
+        let inc = total * t.applied.inverse();
         t.applied = total;
         let edit = match *target {
+            Target::Local(object, local) if exact => self
+                .transform_origin
+                .as_ref()
+                .and_then(|origin| Document::set_local_transformed(object, local, origin, &total)),
             Target::Local(object, local) => self.doc.transform_local(object, local, inc),
             // A point only translates: the increment's translation part.
             Target::Point(h) => self.doc.move_handle(h, inc.w_axis.truncate()),
@@ -987,7 +1066,12 @@ impl Session {
         self.apply_pending();
         let scene = self.doc.to_scene();
         match crate::scene::obj::save_scene_file(&scene, &self.save_path) {
-            Ok(()) => self.set_status(format!("saved {}", self.save_path.display())),
+            Ok(()) => {
+                if let Some(a) = self.autosave.as_mut() {
+                    a.saved();
+                }
+                self.set_status(format!("saved {}", self.save_path.display()))
+            }
             Err(e) => self.set_status(format!("save failed: {e}")),
         }
     }
@@ -1025,6 +1109,17 @@ impl Session {
     /// Shows `map` (or none) on every surface.
     pub fn set_map(&mut self, map: Option<SurfaceMap>) {
         self.apply_pending();
+        if map.is_some_and(|m| m.needs_curvature())
+            && self.options.analysis.is_none_or(|m| !m.needs_curvature())
+            && let Err(e) = check_scene(
+                &self.doc.to_scene(),
+                SampleMode::Analysis,
+                DRAW_USES,
+                &MemoryBudget::machine_default(),
+            )
+        {
+            return self.set_status(format!("no curvature map: {e}"));
+        }
         self.options.analysis = map;
         for i in self.doc.set_analysis(map) {
             let [rows, cols] = self.doc.objects[i].sampled.grid().dims;
@@ -1124,7 +1219,7 @@ impl Session {
             Handle::Point { point, .. } => format!("{name} point {}", index_text(point)),
             Handle::LocalPoint { local, point, .. } => format!(
                 "{name} local {} point {}",
-                index_text(local),
+                path_text(local),
                 index_text(point)
             ),
         }
@@ -1188,6 +1283,11 @@ fn default_nets(doc: &Document) -> NetMode {
     } else {
         NetMode::Focused
     }
+}
+
+fn path_text(path: LocalPath<Index2>) -> String {
+    let steps: Vec<String> = path.steps().iter().map(|&i| index_text(i)).collect();
+    steps.join(" → ")
 }
 
 fn index_text(i: Index2) -> String {

@@ -2,9 +2,13 @@
 //!
 //! Error measure: for every number x (product) and y (oracle) of an object's samples,
 //!   |x − y| ≤ rel_tol · scale,
-//! where scale = max(1, max |value| over that object's oracle samples of the same derivative
-//! order) — per r for curves, per (a, b) for surfaces. The oracle is evaluated at the product's
-//! own parameters; those must equal the contract's formula to within 4 ulp of the domain size.
+//! where scale = max |value| over that object's oracle samples of the same derivative order —
+//! per r for curves, per (a, b) for surfaces — with no floor, so a small object is held to its
+//! own size. Where a derivative order vanishes identically (above a polynomial's degree) its
+//! scale is the object's position magnitude instead, so rounding noise there is measured
+//! against the object's size rather than against zero. NaN never passes: a NaN on either side
+//! is a mismatch and makes the maximum error NaN. The oracle is evaluated at the product's own
+//! parameters; those must equal the contract's formula to within 4 ulp of the domain size.
 
 use serde_json::Value;
 
@@ -33,8 +37,27 @@ pub struct Report {
     pub mismatch_count: usize,
     /// Numbers compared.
     pub compared: usize,
-    /// max |x − y| / scale over everything compared.
+    /// max |x − y| / scale over everything compared (NaN when anything compared was NaN).
     pub max_relative_error: f64,
+}
+
+/// The larger of two numbers, NaN when either is NaN (`f64::max` returns the other one).
+pub fn nan_max(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.max(b)
+    }
+}
+
+/// Per-order scales from per-order maxima of |value|: an order that vanishes identically is
+/// measured against the position magnitude (order 0) instead.
+fn scales_or_position(maxima: &mut [f64], position: f64) {
+    for m in maxima.iter_mut() {
+        if *m == 0.0 {
+            *m = position;
+        }
+    }
 }
 
 const MAX_LISTED: usize = 8;
@@ -190,7 +213,8 @@ fn compare_object(object: &Object, n: usize, entry: &Value, rel_tol: f64, report
                 let y = ours[k];
                 let err = (x - y).abs();
                 report.compared += 1;
-                report.max_relative_error = report.max_relative_error.max(err / scale);
+                let relative = if err == 0.0 { 0.0 } else { err / scale };
+                report.max_relative_error = nan_max(report.max_relative_error, relative);
                 if err.is_nan() || err > rel_tol * scale {
                     report.mismatch_count += 1;
                     if listed < MAX_LISTED {
@@ -209,16 +233,20 @@ fn compare_object(object: &Object, n: usize, entry: &Value, rel_tol: f64, report
     let shape_error = |what: &str| format!("samples: wrong shape at {what}");
     if object.is_surface() {
         let ours = object.surface_grid(&params[0], &params[1], n);
-        let mut scales = vec![vec![1.0f64; n + 1]; n + 1];
+        let mut scales = vec![vec![0.0f64; n + 1]; n + 1];
         for p in ours.iter().flatten() {
             for (a, row) in p.iter().enumerate() {
                 for (b, v) in row.iter().enumerate() {
                     for x in v {
-                        scales[a][b] = scales[a][b].max(x.abs());
+                        scales[a][b] = nan_max(scales[a][b], x.abs());
                     }
                 }
             }
         }
+        let position = scales[0][0];
+        scales
+            .iter_mut()
+            .for_each(|row| scales_or_position(row, position));
         let Some(rows) = samples.as_array().filter(|r| r.len() == ours.len()) else {
             return problem(report, shape_error("[i]"));
         };
@@ -249,14 +277,16 @@ fn compare_object(object: &Object, n: usize, entry: &Value, rel_tol: f64, report
             .iter()
             .map(|&t| object.curve_derivatives(t, n))
             .collect();
-        let mut scales = vec![1.0f64; n + 1];
+        let mut scales = vec![0.0f64; n + 1];
         for p in &ours {
             for (r, v) in p.iter().enumerate() {
                 for x in v {
-                    scales[r] = scales[r].max(x.abs());
+                    scales[r] = nan_max(scales[r], x.abs());
                 }
             }
         }
+        let position = scales[0];
+        scales_or_position(&mut scales, position);
         let Some(rows) = samples.as_array().filter(|r| r.len() == ours.len()) else {
             return problem(report, shape_error("[j]"));
         };

@@ -11,7 +11,7 @@
 
 use crate::geom::point::binomial;
 use crate::geom::{
-    BFunctionKind, BSplineCurve, BezierCurve, ErbsCurve, ErbsSurface, TensorSurface,
+    BFunctionKind, BSplineCurve, ErbsCurve, ErbsSurface, LocalCurve, LocalPatch, TensorSurface,
 };
 use crate::scene::MAX_DEGREE;
 use glam::{DVec3, DVec4};
@@ -57,22 +57,33 @@ impl Blend {
     }
 }
 
+fn exact_form_only() -> String {
+    "cannot be written to OBJ: the exact B-spline form covers open ERBS objects whose locals are Bézier curves or patches (not closed ones, nor B-spline or ERBS locals); keep it in JSON".into()
+}
+
 /// The exact B-spline (NURBS for the rational B-function) form of an ERBS curve.
 pub fn curve_to_bspline(c: &ErbsCurve) -> Result<BSplineCurve, String> {
     let blend = Blend::of(c.bfunction())?;
-    let local = c.local_curves();
-    if local.iter().any(BezierCurve::is_rational) {
-        return Err(
-            "cannot be written to OBJ: the exact export handles polynomial local curves only"
-                .into(),
-        );
+    let k = c.knots();
+    if k.is_closed() || k.domain() != k.full_domain() {
+        return Err(exact_form_only());
     }
-    let d = local.iter().map(BezierCurve::degree).max().unwrap_or(0);
+    let local = c
+        .local_curves()
+        .iter()
+        .map(|l| match l {
+            LocalCurve::Spline {
+                curve,
+                bezier: true,
+            } => Ok(curve.points()),
+            _ => Err(exact_form_only()),
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let d = local.iter().map(|p| p.len() - 1).max().unwrap_or(0);
     let p = degree(d, &blend)?;
-    let t = c.knots();
+    let t = k.as_slice();
     let n = local.len();
-    let hom =
-        |l: usize| -> Vec<DVec4> { local[l].points().iter().map(|q| q.extend(1.0)).collect() };
+    let hom = |l: usize| -> Vec<DVec4> { local[l].iter().map(|q| q.extend(1.0)).collect() };
     let mut points: Vec<DVec4> = Vec::with_capacity((n - 1) * p + 1);
     for i in 1..n {
         let mut piece = vec![DVec4::ZERO; p + 1];
@@ -94,14 +105,23 @@ pub fn curve_to_bspline(c: &ErbsCurve) -> Result<BSplineCurve, String> {
 pub fn surface_to_bspline(s: &ErbsSurface) -> Result<TensorSurface, String> {
     let blend = Blend::of(s.bfunction())?;
     let [cu, cv] = s.count();
+    if s.closed() != [false, false] || s.knots().iter().any(|k| k.domain() != k.full_domain()) {
+        return Err(exact_form_only());
+    }
+    let patches = s
+        .local_patches()
+        .iter()
+        .map(|p| match p {
+            LocalPatch::Spline {
+                surface,
+                bezier: true,
+            } => Ok(surface),
+            _ => Err(exact_form_only()),
+        })
+        .collect::<Result<Vec<_>, _>>()?;
     let [ku, kv] = s.knots();
-    let [du, dv] = [0, 1].map(|d| {
-        s.local_patches()
-            .iter()
-            .map(|q| q.degree()[d])
-            .max()
-            .unwrap_or(0)
-    });
+    let (ku, kv) = (ku.as_slice(), kv.as_slice());
+    let [du, dv] = [0, 1].map(|d| patches.iter().map(|q| q.degree()[d]).max().unwrap_or(0));
     let (pu, pv) = (degree(du, &blend)?, degree(dv, &blend)?);
     let (nu, nv) = ((cu - 1) * pu + 1, (cv - 1) * pv + 1);
     let mut net = vec![DVec4::ZERO; nu * nv];
@@ -114,7 +134,7 @@ pub fn surface_to_bspline(s: &ErbsSurface) -> Result<TensorSurface, String> {
                     let (k, l) = (i - 1 + a, j - 1 + b);
                     let (u0, u1) = sub_interval(ku, k, i);
                     let (v0, v1) = sub_interval(kv, l, j);
-                    let g = Grid::of(s.local_patch(k, l))
+                    let g = Grid::of(patches[k * cv + l])
                         .map_columns(|col| product(&elevate(&part(col, u0, u1), du), bu))
                         .map_rows(|row| product(&elevate(&part(row, v0, v1), dv), bv));
                     cell.add(&g);

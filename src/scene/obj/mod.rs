@@ -151,9 +151,7 @@ pub fn save_scene_file(scene: &Scene, path: &Path) -> Result<(), SceneError> {
         return scene.save(path);
     }
     let text = scene_to_obj(scene)?;
-    let tmp = path.with_extension("obj.tmp");
-    std::fs::write(&tmp, text)
-        .and_then(|()| std::fs::rename(&tmp, path))
+    super::write_durably(path, text.as_bytes())
         .map_err(|e| SceneError(format!("cannot write {}: {e}", path.display())))
 }
 

@@ -1,0 +1,571 @@
+//! Memory budget for pre-evaluation: how many bytes an object's Hermite tables, sample grids and
+//! GPU mirrors will take, estimated from its shape and sample counts *before* anything is
+//! allocated, so that a request too large for the machine is refused with one line naming the
+//! object instead of aborting in the allocator.
+//!
+//! [`estimate`] is a pure function of an object's [`Extent`] (degrees, sample counts, rational
+//! or not, ERBS local counts), the [`SampleMode`] and what the command does with the samples
+//! ([`Uses`]). [`check_scene`] applies it to every object of a scene against a
+//! [`MemoryBudget`] (by default half of physical memory; `--memory-limit` overrides).
+
+use super::object::SampleMode;
+use crate::model::Model;
+use crate::scene::Scene;
+use std::fmt::Write;
+
+/// Bytes of one f64 / `DVec3` / `DVec4` / f32.
+const F64: u128 = 8;
+const VEC3: u128 = 24;
+const VEC4: u128 = 32;
+const F32: u128 = 4;
+/// Frames in flight, each with its own mirror (see `gpu::FRAMES_IN_FLIGHT`; `sampling` does not
+/// depend on `gpu`).
+const MIRROR_SLOTS: u128 = 2;
+/// Budget when physical memory cannot be read.
+pub const FALLBACK_BUDGET: u64 = 4 << 30;
+
+/// What the estimate needs to know about one object, independent of the scene model's types.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Extent {
+    /// Samples per direction: one entry for curves, two for surfaces.
+    pub samples: Vec<usize>,
+    /// Polynomial degree per direction; for ERBS objects the highest local degree.
+    pub degree: Vec<usize>,
+    /// Rational objects keep homogeneous samples besides the projected ones.
+    pub rational: bool,
+    /// ERBS objects: local curves (patches) per direction; `None` for Bézier/B-spline/NURBS.
+    pub erbs_locals: Option<Vec<usize>>,
+}
+
+impl Extent {
+    /// The extent of an object's model.
+    #[must_use]
+    pub fn of(model: &Model) -> Self {
+        let samples = match model.sample_dims() {
+            [m, 1] if !model.is_surface() => vec![m],
+            dims => dims.to_vec(),
+        };
+        match model {
+            Model::Curve(m) => Extent {
+                samples,
+                degree: vec![m.curve().degree()],
+                rational: m.curve().is_rational(),
+                erbs_locals: None,
+            },
+            Model::CatmullRom(_) => Extent {
+                samples,
+                degree: vec![3],
+                rational: false,
+                erbs_locals: None,
+            },
+            Model::BezierSpline(m) => Extent {
+                samples,
+                degree: vec![m.spline().degree()],
+                rational: false,
+                erbs_locals: None,
+            },
+            Model::Surface(m) => Extent {
+                samples,
+                degree: m.surface().degree().to_vec(),
+                rational: m.surface().is_rational(),
+                erbs_locals: None,
+            },
+            Model::ErbsCurve(m) => {
+                let c = m.curve();
+                Extent {
+                    samples,
+                    degree: vec![
+                        c.local_curves()
+                            .iter()
+                            .map(|l| l.degree())
+                            .max()
+                            .unwrap_or(0),
+                    ],
+                    rational: false,
+                    erbs_locals: Some(vec![c.local_curves().len()]),
+                }
+            }
+            Model::ErbsSurface(m) => {
+                let s = m.surface();
+                let degree = s.local_patches().iter().fold(vec![0, 0], |d, p| {
+                    let [a, b] = p.degree();
+                    vec![d[0].max(a), d[1].max(b)]
+                });
+                Extent {
+                    samples,
+                    degree,
+                    rational: false,
+                    erbs_locals: Some(s.count().to_vec()),
+                }
+            }
+        }
+    }
+
+    fn is_surface(&self) -> bool {
+        self.samples.len() == 2
+    }
+
+    /// Samples in the grid (product over the directions).
+    fn sample_count(&self) -> u128 {
+        self.samples.iter().map(|&m| m as u128).product()
+    }
+}
+
+/// What a command does with the samples besides keeping them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Uses {
+    /// Per-frame GPU mirrors, upload scratch and index buffers (`render`, `view`, `bench`).
+    pub gpu: bool,
+    /// The whole `prespline sample` JSON text, built in memory so a failure prints nothing.
+    pub json_text: bool,
+}
+
+/// One kind of allocation and its size.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Part {
+    /// What it is ("Hermite tables", "samples", …).
+    pub what: &'static str,
+    pub bytes: u64,
+    /// How it is computed, e.g. "5000000 samples × 21 derivative orders × 61 basis functions".
+    pub formula: String,
+}
+
+/// Estimated memory of one object.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct Estimate {
+    /// The parts, largest first.
+    pub parts: Vec<Part>,
+}
+
+impl Estimate {
+    /// Total bytes.
+    #[must_use]
+    pub fn bytes(&self) -> u64 {
+        self.parts
+            .iter()
+            .fold(0u64, |s, p| s.saturating_add(p.bytes))
+    }
+
+    /// The two largest parts with their formulas, for the refusal message.
+    #[must_use]
+    pub fn describe(&self) -> String {
+        let mut s = String::new();
+        for (i, p) in self.parts.iter().take(2).enumerate() {
+            if i > 0 {
+                s.push_str("; ");
+            }
+            let _ = write!(s, "{} {}: {}", p.what, format_bytes(p.bytes), p.formula);
+        }
+        if self.parts.len() > 2 {
+            let rest = self.parts[2..]
+                .iter()
+                .fold(0u64, |s, p| s.saturating_add(p.bytes));
+            let _ = write!(s, "; other {}", format_bytes(rest));
+        }
+        s
+    }
+
+    fn add(&mut self, what: &'static str, bytes: u128, formula: String) {
+        if bytes > 0 {
+            self.parts.push(Part {
+                what,
+                bytes: u64::try_from(bytes).unwrap_or(u64::MAX),
+                formula,
+            });
+        }
+    }
+}
+
+/// Estimates the bytes pre-evaluating one object takes: per direction the Hermite tables
+/// (samples × derivative rows kept × (degree + 1) f64), the canonical grid (samples × partials
+/// × 24 B), homogeneous copies of rational objects, unit normals, ERBS blend weights and local
+/// sample buffers, and with `uses` the GPU mirrors and the JSON text.
+#[must_use]
+pub fn estimate(extent: &Extent, mode: SampleMode, uses: Uses) -> Estimate {
+    let mut e = Estimate::default();
+    let surface = extent.is_surface();
+    // Highest derivative order per direction and vectors stored per sample.
+    let (g, stride) = match (mode, surface) {
+        (SampleMode::Derivatives(g), false) => (g, g + 1),
+        (SampleMode::Derivatives(g), true) => (g, (g + 1) * (g + 1)),
+        (SampleMode::Render, false) => (1, 2),
+        (SampleMode::Render, true) => (1, 3),
+        (SampleMode::Analysis, false) => (1, 2),
+        (SampleMode::Analysis, true) => (2, 6),
+    };
+    let (g, stride) = (g as u128, stride as u128);
+    let n = extent.sample_count();
+    let vectors = n * stride;
+    let orders = if surface {
+        format!("{stride} partials")
+    } else {
+        format!("{stride} derivative orders")
+    };
+    let samples_text = samples_text(&extent.samples);
+
+    // Hermite tables: per direction m × rows × (d+1) f64; an ERBS local's table covers its
+    // support, and every sample lies in the supports of two locals per direction.
+    let mut table_bytes = 0u128;
+    let mut table_formula = Vec::new();
+    for (dir, (&m, &d)) in extent.samples.iter().zip(&extent.degree).enumerate() {
+        let (m, d) = (m as u128, d as u128);
+        let rows = g.min(d) + 1;
+        let copies = match &extent.erbs_locals {
+            // A surface's local patch (k, l) has its own u table over its support rows: each
+            // u support is repeated for every l.
+            Some(locals) if surface => 2 * locals[1 - dir] as u128,
+            Some(_) => 2,
+            None => 1,
+        };
+        table_bytes += copies * m * rows * (d + 1) * F64;
+        table_formula.push(format!(
+            "{}{m} samples × {rows} derivative orders × {} basis functions",
+            if copies > 1 {
+                format!("{copies} × ")
+            } else {
+                String::new()
+            },
+            d + 1
+        ));
+    }
+    e.add("Hermite tables", table_bytes, table_formula.join(" + "));
+    e.add(
+        "samples",
+        vectors * VEC3,
+        format!("{samples_text} × {orders} × 24 B"),
+    );
+    if extent.rational {
+        e.add(
+            "homogeneous samples",
+            vectors * VEC4,
+            format!("{samples_text} × {orders} × 32 B"),
+        );
+    }
+    if surface && matches!(mode, SampleMode::Render | SampleMode::Analysis) {
+        e.add("normals", n * VEC3, format!("{samples_text} × 24 B"));
+    }
+    if surface && mode == SampleMode::Analysis {
+        e.add(
+            "curvatures",
+            n * 2 * F64,
+            format!("{samples_text} × [K, H] × 16 B"),
+        );
+    }
+    if let Some(locals) = &extent.erbs_locals {
+        // Blend weights: per direction m × 2 × (g+1) f64. Local samples: every parent sample
+        // lies in two supports per direction, so 2 (curves) or 4 (surfaces) local copies.
+        let blend: u128 = extent
+            .samples
+            .iter()
+            .map(|&m| m as u128 * 2 * (g + 1) * F64)
+            .sum();
+        e.add(
+            "ERBS blend weights",
+            blend,
+            format!("{samples_text} × 2 × {} orders × 8 B", g + 1),
+        );
+        let copies: u128 = if surface { 4 } else { 2 };
+        e.add(
+            "ERBS local samples",
+            copies * vectors * VEC3,
+            format!(
+                "{copies} × {samples_text} × {orders} × 24 B over {} locals",
+                locals.iter().map(|&l| l as u128).product::<u128>()
+            ),
+        );
+    }
+    if uses.gpu {
+        // Per frame in flight a mirror of f32 vertices (surfaces: position + normal), plus the
+        // CPU scratch that fills it; surfaces also get triangle and wireframe index buffers
+        // (u32, 6 + 4 per sample) and their staging copies.
+        let floats: u128 = if surface { 6 } else { 3 };
+        e.add(
+            "GPU mirrors",
+            (MIRROR_SLOTS + 1) * n * floats * F32,
+            format!("{} × {samples_text} × {} B", MIRROR_SLOTS + 1, floats * F32),
+        );
+        if surface {
+            e.add(
+                "GPU index buffers",
+                2 * n * 10 * F32,
+                format!("2 × {samples_text} × 40 B"),
+            );
+        }
+    }
+    if uses.json_text {
+        // "[x, y, z]" with up to 24 characters a number.
+        e.add(
+            "output text",
+            vectors * 80,
+            format!("{samples_text} × {orders} × ~80 characters"),
+        );
+    }
+    e.parts.sort_by_key(|p| std::cmp::Reverse(p.bytes));
+    e
+}
+
+fn samples_text(samples: &[usize]) -> String {
+    match samples {
+        [m] => format!("{m} samples"),
+        [mu, mv] => format!("{mu}×{mv} samples"),
+        _ => format!("{samples:?} samples"),
+    }
+}
+
+/// Where a budget came from (said in the refusal so the user knows what to change).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BudgetSource {
+    /// Half of the machine's physical memory (or of the cgroup limit when lower).
+    HalfOfPhysical,
+    /// Physical memory could not be read: [`FALLBACK_BUDGET`].
+    Fallback,
+    /// `--memory-limit`.
+    Flag,
+}
+
+/// The bytes pre-evaluation may take.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct MemoryBudget {
+    pub bytes: u64,
+    pub source: BudgetSource,
+}
+
+impl MemoryBudget {
+    /// `--memory-limit` when given, else half of physical memory.
+    #[must_use]
+    pub fn from_flag(limit: Option<u64>) -> Self {
+        match limit {
+            Some(bytes) => MemoryBudget {
+                bytes,
+                source: BudgetSource::Flag,
+            },
+            None => Self::machine_default(),
+        }
+    }
+
+    /// Half of physical memory (`MemTotal` in /proc/meminfo, lowered to a cgroup v2 limit when
+    /// there is one), or [`FALLBACK_BUDGET`] where neither can be read.
+    #[must_use]
+    pub fn machine_default() -> Self {
+        let physical = std::fs::read_to_string("/proc/meminfo")
+            .ok()
+            .and_then(|t| mem_total(&t));
+        let cgroup = std::fs::read_to_string("/sys/fs/cgroup/memory.max")
+            .ok()
+            .and_then(|t| t.trim().parse::<u64>().ok());
+        match (physical, cgroup) {
+            (None, None) => MemoryBudget {
+                bytes: FALLBACK_BUDGET,
+                source: BudgetSource::Fallback,
+            },
+            (p, c) => MemoryBudget {
+                bytes: p.unwrap_or(u64::MAX).min(c.unwrap_or(u64::MAX)) / 2,
+                source: BudgetSource::HalfOfPhysical,
+            },
+        }
+    }
+
+    fn describe(&self) -> String {
+        let why = match self.source {
+            BudgetSource::HalfOfPhysical => "half of physical memory; --memory-limit overrides",
+            BudgetSource::Fallback => {
+                "physical memory unknown, fixed default; --memory-limit overrides"
+            }
+            BudgetSource::Flag => "--memory-limit",
+        };
+        format!("{} ({why})", format_bytes(self.bytes))
+    }
+}
+
+/// `MemTotal` in bytes from /proc/meminfo text.
+fn mem_total(meminfo: &str) -> Option<u64> {
+    let line = meminfo.lines().find(|l| l.starts_with("MemTotal:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    kib.checked_mul(1024)
+}
+
+/// Refuses, as one line naming the object, a scene whose objects do not fit `budget`
+/// together; returns the estimated total otherwise.
+pub fn check_scene(
+    scene: &Scene,
+    mode: SampleMode,
+    uses: Uses,
+    budget: &MemoryBudget,
+) -> Result<u64, String> {
+    let mut total = 0u64;
+    let mut largest: Option<(usize, u64)> = None;
+    for (i, o) in scene.objects.iter().enumerate() {
+        let e = estimate(&Extent::of(&o.model), mode, uses);
+        let bytes = e.bytes();
+        if bytes > budget.bytes {
+            return Err(format!(
+                "object '{}' (objects[{i}]): needs about {} to pre-evaluate ({}), over the memory budget of {}",
+                o.name,
+                format_bytes(bytes),
+                e.describe(),
+                budget.describe()
+            ));
+        }
+        total = total.saturating_add(bytes);
+        if largest.is_none_or(|(_, b)| bytes > b) {
+            largest = Some((i, bytes));
+        }
+    }
+    match largest {
+        Some((i, bytes)) if total > budget.bytes => Err(format!(
+            "{} objects need about {} together to pre-evaluate (the largest, object '{}' (objects[{i}]), about {}), over the memory budget of {}",
+            scene.objects.len(),
+            format_bytes(total),
+            scene.objects[i].name,
+            format_bytes(bytes),
+            budget.describe()
+        )),
+        _ => Ok(total),
+    }
+}
+
+/// Bytes in binary units with one decimal: "512 B", "1.5 KiB", "47.7 GiB".
+#[must_use]
+pub fn format_bytes(bytes: u64) -> String {
+    const UNITS: [&str; 6] = ["KiB", "MiB", "GiB", "TiB", "PiB", "EiB"];
+    if bytes < 1024 {
+        return format!("{bytes} B");
+    }
+    let mut v = bytes as f64 / 1024.0;
+    let mut unit = 0;
+    while v >= 1024.0 && unit + 1 < UNITS.len() {
+        v /= 1024.0;
+        unit += 1;
+    }
+    format!("{v:.1} {}", UNITS[unit])
+}
+
+/// Parses a `--memory-limit` value: a number of bytes with an optional binary suffix
+/// (K, M, G, T, optionally followed by "iB" or "B"), e.g. `512M`, `4G`, `1.5GiB`, `1000000`.
+pub fn parse_size(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let split = t
+        .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .unwrap_or(t.len());
+    let (number, unit) = t.split_at(split);
+    let unit = unit.trim();
+    let shift = match unit.to_ascii_uppercase().as_str() {
+        "" | "B" => 0,
+        "K" | "KB" | "KIB" => 10,
+        "M" | "MB" | "MIB" => 20,
+        "G" | "GB" | "GIB" => 30,
+        "T" | "TB" | "TIB" => 40,
+        _ => {
+            return Err(format!(
+                "'{s}': unknown unit '{unit}' (use a byte count or K, M, G, T, e.g. 512M, 4G)"
+            ));
+        }
+    };
+    let value: f64 = number
+        .parse()
+        .map_err(|_| format!("'{s}' is not a size (e.g. 512M, 4G)"))?;
+    let bytes = value * (1u64 << shift) as f64;
+    if !bytes.is_finite() || bytes < 1.0 || bytes >= u64::MAX as f64 {
+        return Err(format!("'{s}': the limit must be at least 1 byte"));
+    }
+    Ok(bytes as u64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn curve(degree: usize, samples: usize) -> Extent {
+        Extent {
+            samples: vec![samples],
+            degree: vec![degree],
+            rational: false,
+            erbs_locals: None,
+        }
+    }
+
+    #[test]
+    fn issue_example_is_dominated_by_the_hermite_tables() {
+        // Degree 60, 5 000 000 samples, 20 derivatives: 5e6 × 21 × 61 f64 = 51.24e9 B of
+        // tables plus 5e6 × 21 × 24 B of samples.
+        let e = estimate(
+            &curve(60, 5_000_000),
+            SampleMode::Derivatives(20),
+            Uses::default(),
+        );
+        assert_eq!(e.parts[0].what, "Hermite tables");
+        assert_eq!(e.parts[0].bytes, 5_000_000 * 21 * 61 * 8);
+        assert_eq!(e.parts[1].bytes, 5_000_000 * 21 * 24);
+        assert_eq!(e.bytes(), 5_000_000 * 21 * 61 * 8 + 5_000_000 * 21 * 24);
+        assert!(
+            e.describe()
+                .contains("5000000 samples × 21 derivative orders × 61 basis functions"),
+            "{}",
+            e.describe()
+        );
+    }
+
+    #[test]
+    fn derivative_rows_above_the_degree_are_not_kept() {
+        let e = estimate(
+            &curve(3, 1000),
+            SampleMode::Derivatives(20),
+            Uses::default(),
+        );
+        let tables = e.parts.iter().find(|p| p.what == "Hermite tables").unwrap();
+        assert_eq!(tables.bytes, 1000 * 4 * 4 * 8);
+    }
+
+    #[test]
+    fn render_mode_surfaces_count_normals_and_gpu_mirrors() {
+        let s = Extent {
+            samples: vec![512, 512],
+            degree: vec![3, 3],
+            rational: true,
+            erbs_locals: None,
+        };
+        let e = estimate(
+            &s,
+            SampleMode::Render,
+            Uses {
+                gpu: true,
+                json_text: false,
+            },
+        );
+        let part = |w: &str| e.parts.iter().find(|p| p.what == w).unwrap().bytes;
+        let n = 512 * 512;
+        assert_eq!(part("samples"), n * 3 * 24);
+        assert_eq!(part("homogeneous samples"), n * 3 * 32);
+        assert_eq!(part("normals"), n * 24);
+        assert_eq!(part("GPU mirrors"), 3 * n * 24);
+    }
+
+    #[test]
+    fn sizes_parse_with_binary_units() {
+        assert_eq!(parse_size("512M"), Ok(512 << 20));
+        assert_eq!(parse_size("4G"), Ok(4 << 30));
+        assert_eq!(parse_size("4GiB"), Ok(4 << 30));
+        assert_eq!(parse_size("1.5k"), Ok(1536));
+        assert_eq!(parse_size("1000"), Ok(1000));
+        assert!(parse_size("4X").is_err());
+        assert!(parse_size("G").is_err());
+        assert!(parse_size("0").is_err());
+        assert!(parse_size("-1G").is_err());
+    }
+
+    #[test]
+    fn physical_memory_is_read_from_meminfo() {
+        assert_eq!(
+            mem_total("MemTotal:       24683656 kB\nMemFree: 1 kB\n"),
+            Some(24683656 * 1024)
+        );
+        assert_eq!(mem_total("nothing"), None);
+    }
+
+    #[test]
+    fn bytes_are_printed_in_binary_units() {
+        assert_eq!(format_bytes(512), "512 B");
+        assert_eq!(format_bytes(1536), "1.5 KiB");
+        assert_eq!(format_bytes(12 << 30), "12.0 GiB");
+    }
+}
