@@ -1,5 +1,7 @@
 #version 460
-// Control points as screen-space squares, pulled from a float buffer like polyline.vert.
+// Control points as screen-space squares, one draw, pulled from a float buffer like
+// polyline.vert: point primitives of gl_PointSize pixels (quads = 0, needs largePoints) or
+// quads of 6 vertices per point (quads = 1).
 // The hovered and the selected point (indices relative to the run, -1 for none) are larger
 // and have their own colours.
 #extension GL_EXT_buffer_reference : require
@@ -20,14 +22,16 @@ layout(push_constant) uniform Push {
     uint color;           // packed linear RGBA8
     uint hovered_color;
     uint selected_color;
+    uint quads;           // 1: vertices 6i..6i+5 draw point i; 0: vertex i is point i
 } pc;
 
 layout(location = 0) flat out vec4 v_color;
 layout(location = 1) out vec2 v_uv;
 layout(location = 2) flat out float v_size;
+layout(location = 3) flat out float v_sprite;   // 1: a point primitive (uv from gl_PointCoord)
 
 void main() {
-    int index = gl_InstanceIndex;
+    int index = pc.quads != 0u ? gl_VertexIndex / 6 : gl_VertexIndex;
     uint o = pc.first + uint(index) * pc.stride;
     vec3 p = vec3(pc.points.v[o], pc.points.v[o + 1], pc.points.v[o + 2]);
     vec4 c = pc.view_proj * vec4(p, 1.0);
@@ -43,12 +47,14 @@ void main() {
     }
     const vec2 CORNER[6] = vec2[6](vec2(-1, -1), vec2(1, -1), vec2(1, 1),
                                    vec2(-1, -1), vec2(1, 1), vec2(-1, 1));
-    vec2 uv = CORNER[gl_VertexIndex];
+    vec2 uv = pc.quads != 0u ? CORNER[gl_VertexIndex % 6] : vec2(0.0);
     if (c.z < 0.0 || c.w <= 0.0) {
         gl_Position = vec4(2.0, 2.0, 2.0, 1.0);
     } else {
         gl_Position = vec4(c.xy + uv * (size / pc.viewport) * c.w, c.z, c.w);
     }
+    gl_PointSize = size;
+    v_sprite = pc.quads != 0u ? 0.0 : 1.0;
     v_color = unpackUnorm4x8(packed);
     v_uv = uv;
     v_size = size;

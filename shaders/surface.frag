@@ -14,6 +14,25 @@ layout(push_constant) uniform Push {
 
 layout(location = 0) out vec4 out_color;
 
+// x^e: by repeated squaring for whole exponents up to 255 (the usual Blinn-Phong exponents),
+// which software rasterisers evaluate far faster than pow's exp2(e * log2(x)).
+float specular_power(float x, float e) {
+    if (e != floor(e) || e < 1.0 || e > 255.0) {
+        return pow(x, e);
+    }
+    uint n = uint(e);
+    float result = 1.0;
+    float base = x;
+    for (int bit = 0; bit < 8; ++bit) {
+        if ((n & 1u) != 0u) {
+            result *= base;
+        }
+        base *= base;
+        n >>= 1u;
+    }
+    return result;
+}
+
 void main() {
     vec3 V = normalize(pc.eye.xyz - v_pos);
     // Sampling can produce a zero normal (degenerate point); shade it as facing the viewer.
@@ -25,7 +44,7 @@ void main() {
     vec3 L = dot(pc.light.xyz, pc.light.xyz) > 0.0 ? normalize(pc.light.xyz) : V;
     vec3 H = normalize(L + V);
     float diffuse = max(dot(N, L), 0.0);
-    float specular = diffuse > 0.0 ? pow(max(dot(N, H), 0.0), pc.eye.w) : 0.0;
+    float specular = diffuse > 0.0 ? specular_power(max(dot(N, H), 0.0), pc.eye.w) : 0.0;
     vec4 base = back_side ? pc.back : pc.front;
     float ambient = pc.light.w;
     vec3 rgb = base.rgb * (ambient + (1.0 - ambient) * diffuse) + vec3(0.3) * specular;

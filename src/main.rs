@@ -98,11 +98,15 @@ enum Command {
         /// Output directory for the reports.
         #[arg(long, default_value = "bench-out", value_name = "DIR")]
         out: PathBuf,
-        /// MSAA samples (1, 2, 4, 8); 0 picks 4 where supported.
+        /// MSAA samples (1, 2, 4, 8); 0 picks the device's default: 1 on CPU rasterisers such
+        /// as lavapipe, 4 on GPUs (see README "Interactive frames").
         #[arg(long, default_value_t = 0)]
         msaa: u32,
         #[command(flatten)]
         memory: MemoryArgs,
+        /// Draw every sample of every surface (no display level of detail), for comparison.
+        #[arg(long)]
+        no_lod: bool,
     },
     /// Render a scene headless (no display needed) into a PNG image.
     Render {
@@ -121,8 +125,9 @@ enum Command {
         /// Edits (JSON list) applied before rendering.
         #[arg(long, value_name = "EDITS.json")]
         edits: Option<PathBuf>,
-        /// MSAA samples (1, 2, 4, 8); 0 picks 4 where supported.
-        #[arg(long, default_value_t = 0)]
+        /// MSAA samples (1, 2, 4, 8); a still image is worth 4; 0 picks the device's interactive
+        /// default (1 on CPU rasterisers, 4 on GPUs).
+        #[arg(long, default_value_t = 4)]
         msaa: u32,
         /// Draw the osculating circle of curve NAME at parameter T, labelled with its
         /// curvature, radius and torsion.
@@ -208,6 +213,9 @@ struct DisplayArgs {
     /// (principal curvatures) or zebra (reflection lines).
     #[arg(long, value_name = "MAP", value_parser = SurfaceMap::parse)]
     analysis: Option<SurfaceMap>,
+    /// Draw every sample of every surface (no display level of detail).
+    #[arg(long)]
+    no_lod: bool,
 }
 
 impl DisplayArgs {
@@ -225,6 +233,7 @@ impl DisplayArgs {
             curvature_comb: self.comb,
             badges: self.badges,
             analysis: self.analysis,
+            lod: !self.no_lod,
             ..ViewOptions::default()
         }
     }
@@ -281,6 +290,7 @@ fn main() -> ExitCode {
             out,
             msaa,
             memory,
+            no_lod,
         } => {
             let args = cli::bench::BenchArgs {
                 scene,
@@ -293,6 +303,7 @@ fn main() -> ExitCode {
                 out,
                 msaa,
                 memory: memory.budget(),
+                lod: !no_lod,
             };
             cli::bench::run(&args).map(|line| eprintln!("{line}"))
         }

@@ -29,6 +29,7 @@ fn overlay_colours_round_trip_through_srgb() {
     let mut frame = r.begin_offscreen(&mut target).expect("begin");
     frame.set_clear_color([0.0, 0.0, 0.0, 1.0]);
     frame.draw_overlay(&quads).expect("overlay");
+    frame.capture();
     frame.finish().expect("finish");
     let px = r.read_pixels(&target).expect("read");
     for (x, want) in [(5, [200, 100, 30, 255]), (40, [10, 128, 250, 255])] {
@@ -60,6 +61,7 @@ fn viewport_restricts_drawing_and_late_clear_clears_it() {
         frame.set_viewport(40, 0, 32, 32),
         Err(GpuError::InvalidArgument(_))
     ));
+    frame.capture();
     frame.finish().expect("finish");
     let px = r.read_pixels(&target).expect("read");
     assert_eq!(px.get(10, 10), [255, 255, 255, 255]);
@@ -110,6 +112,7 @@ fn strided_packed_and_immediate_polylines_agree() {
             _ => frame.draw_polyline_immediate(&column, &style),
         }
         .expect("polyline");
+        frame.capture();
         frame.finish().expect("finish");
         images.push(r.read_pixels(&target).expect("read"));
     }
@@ -234,6 +237,7 @@ fn transient_growth_timestamps_and_teardown() {
         frame.draw_lines3d(&lines[..1000]).expect("small lines");
         frame.draw_lines3d(&lines).expect("big lines");
         frame.draw_overlay(&hud).expect("hud");
+        frame.capture();
         frame.finish().expect("finish");
     }
     let px = r.read_pixels(&target).expect("read");

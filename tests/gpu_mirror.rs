@@ -71,6 +71,7 @@ fn render(
             },
         )
         .expect("points");
+    frame.capture();
     frame.finish().expect("finish");
 }
 

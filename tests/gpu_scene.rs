@@ -131,6 +131,7 @@ fn synthetic_scene_matches_golden() {
         .expect("points");
     frame.draw_lines3d(&normals).expect("normals");
     frame.draw_overlay(&hud).expect("hud");
+    frame.capture();
     frame.finish().expect("finish");
 
     let pixels = r.read_pixels(&target).expect("read");

@@ -1,6 +1,7 @@
 //! Swapchain smoke test: a real winit window (X11, e.g. under Xvfb), a few presented frames,
-//! a resize, a switch away from vsync, and a leak-free teardown. Skipped without `DISPLAY`,
-//! except under `make test` and CI, where that fails.
+//! a resize, a switch away from vsync, a frame whose submission fails after its image was
+//! acquired (the next frames must still present, validation-clean), and a leak-free teardown.
+//! Skipped without `DISPLAY`, except under `make test` and CI, where that fails.
 //! winit allows one event loop per process, so this binary holds exactly one windowed test
 //! (the other only runs it again in child processes).
 //!
@@ -13,8 +14,8 @@ use std::time::Duration;
 use glam::Vec3;
 use prespline::gpu::font::{push_rect, push_text};
 use prespline::gpu::{
-    GridShape, LAVAPIPE_ICD, Mirror, PolylineStyle, Renderer, RendererDesc, SurfaceGrid,
-    SurfaceStyle, Swapchain, SwapchainDesc, ValidationMode, ValidationSink, force_driver_files, vk,
+    Fault, GpuError, GridShape, Mirror, PolylineStyle, Renderer, RendererDesc, SurfaceGrid,
+    SurfaceStyle, Swapchain, SwapchainDesc, ValidationMode, ValidationSink, vk,
 };
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
@@ -32,8 +33,8 @@ struct Gpu {
     swapchain: Swapchain,
     mirror: Mirror,
     grid: SurfaceGrid,
-    // Declared last: the swapchain and renderer must go before the window.
-    window: Window,
+    // The swapchain keeps its own reference to the window.
+    window: std::sync::Arc<Window>,
 }
 
 #[derive(Default)]
@@ -47,6 +48,8 @@ struct App {
     last_extent: [u32; 2],
     minimised_once: bool,
     last_mode: Option<vk::PresentModeKHR>,
+    /// Whether the injected submit failure was reported as the device-lost error.
+    failed_submit_reported: bool,
     error: Option<String>,
     done: bool,
 }
@@ -75,7 +78,8 @@ impl App {
         let attrs = Window::default_attributes()
             .with_title("prespline gpu test")
             .with_inner_size(PhysicalSize::new(320, 240));
-        let window = event_loop.create_window(attrs).map_err(|e| e.to_string())?;
+        let window =
+            std::sync::Arc::new(event_loop.create_window(attrs).map_err(|e| e.to_string())?);
         let display = window.display_handle().map_err(|e| e.to_string())?.as_raw();
         let mut renderer = Renderer::new(&RendererDesc {
             app_name: "prespline-window-test".into(),
@@ -83,13 +87,17 @@ impl App {
             sync_validation: false,
             display: Some(display),
             always_flush: false,
+            device: Some("llvmpipe".into()),
         })
         .map_err(|e| e.to_string())?;
+        if renderer.caps().device_type != vk::PhysicalDeviceType::CPU {
+            return Err(format!("not lavapipe: {}", renderer.caps().name));
+        }
         self.sink = renderer.validation_sink();
         let size = window.inner_size();
         let swapchain = renderer
             .create_swapchain(
-                &window,
+                std::sync::Arc::clone(&window),
                 &SwapchainDesc {
                     width: size.width,
                     height: size.height,
@@ -150,6 +158,11 @@ impl App {
             let size = gpu.window.inner_size();
             gpu.swapchain.resize(size.width, size.height);
         }
+        let inject = self.presented == 10 && !self.failed_submit_reported;
+        if inject {
+            gpu.renderer
+                .inject_fault(Fault::Submit(vk::Result::ERROR_DEVICE_LOST));
+        }
         let Some(mut frame) = gpu
             .renderer
             .begin_swapchain(&mut gpu.swapchain)
@@ -184,6 +197,19 @@ impl App {
             [255, 255, 255, 255],
         );
         frame.draw_overlay(&hud).map_err(|e| e.to_string())?;
+        if inject {
+            // The image is acquired and its semaphore signalled; the submission fails. The
+            // error must come back (no hang), and the slot must acquire again next frame
+            // without a validation error about the semaphore.
+            return match frame.finish() {
+                Err(GpuError::DeviceLost { .. }) => {
+                    self.failed_submit_reported = true;
+                    self.skipped += 1;
+                    Ok(())
+                }
+                other => Err(format!("injected submit failure gave {other:?}")),
+            };
+        }
         frame.finish().map_err(|e| e.to_string())?;
         self.presented += 1;
         self.last_extent = [w, h];
@@ -236,7 +262,6 @@ fn swapchain_presents_resizes_and_tears_down() {
     if !common::display() {
         return;
     }
-    force_driver_files(LAVAPIPE_ICD);
     // A hung window system must fail the test, not the CI job's time limit.
     std::thread::spawn(|| {
         std::thread::sleep(Duration::from_secs(120));
@@ -260,6 +285,10 @@ fn swapchain_presents_resizes_and_tears_down() {
     assert!(
         app.minimised_once && app.skipped >= 1,
         "zero-size path not taken"
+    );
+    assert!(
+        app.failed_submit_reported,
+        "the injected submit failure was not reported"
     );
     let sink = app.sink.expect("validation sink");
     let errors = sink.errors();

@@ -8,7 +8,7 @@ use glam::{DMat4, DVec3};
 use prespline::gpu::{OffscreenDesc, OffscreenTarget, Pixels, Renderer};
 use prespline::model::{CurveEdit, Edit, KindEdit, ModelRef, ObjectEdit, PointEdit, SurfaceEdit};
 use prespline::render::offscreen::{Shot, shot_camera};
-use prespline::render::{Document, GpuScene, Highlight, NetMode, ViewOptions, Wire};
+use prespline::render::{Document, GpuScene, Highlight, Lod, NetMode, ViewOptions, Wire};
 use prespline::scene::Scene;
 use prespline::scene::demo::demo_scene;
 
@@ -123,11 +123,19 @@ fn draw_frame(
     shot: &Shot,
 ) -> usize {
     let camera = shot_camera(doc, shot);
+    let aspect = shot.width as f64 / shot.height as f64;
     let mut frame = renderer.begin_offscreen(target).unwrap();
     let stats = gs.upload(&mut frame, doc).unwrap();
-    frame.set_camera(camera.gpu(shot.width as f64 / shot.height as f64, &doc.bounds()));
-    gs.draw(&mut frame, doc, &shot.options, &Highlight::default())
+    frame.set_camera(camera.gpu(aspect, &doc.bounds()));
+    let viewport = [shot.width as f64, shot.height as f64];
+    let lod = Lod::new(
+        camera.view_proj(aspect, &doc.bounds()),
+        viewport,
+        frame.samples(),
+    );
+    gs.draw(&mut frame, doc, &shot.options, &Highlight::default(), &lod)
         .unwrap();
+    frame.capture();
     frame.finish().unwrap();
     stats.bytes
 }

@@ -30,6 +30,8 @@ pub struct BenchArgs {
     pub msaa: u32,
     /// What pre-evaluation and the GPU mirrors may take.
     pub memory: MemoryBudget,
+    /// Display level of detail (off: every sample of every surface is drawn).
+    pub lod: bool,
 }
 
 /// Runs the benchmark, writes the reports and returns the closing line.
@@ -136,6 +138,7 @@ fn run_headless(
     let mut session =
         Session::new(&mut renderer, scene, dir.join("scene.json"), [w, h]).map_err(gpu)?;
     session.naive = naive;
+    session.options.lod = args.lod;
     let total = args.warmup + args.frames;
     let result = (|| -> Result<Recorder, CliError> {
         let mut driver = ScenarioDriver::new(args.scenario, &session, args.warmup, args.frames)
@@ -162,12 +165,17 @@ fn run_headless(
             rec.add_bytes(stats.bytes as u64);
             rec.phase_start(Phase::Record);
             session.record(&mut frame, true).map_err(gpu)?;
+            if k + 1 == total {
+                // Only the last image is written (final.png); no other frame is read back.
+                frame.capture();
+            }
             rec.phase_start(Phase::Submit);
             frame.finish().map_err(gpu)?;
             rec.end_frame();
             session
                 .hud
                 .push_frame(rec.frames().last().map_or(0.0, |f| f.frame_ms));
+            session.hud.gpu_ms = renderer.last_gpu_time_ms();
             progress.update(k + 1);
         }
         progress.finish(total);
@@ -214,6 +222,8 @@ fn run_window(
         max_frames: Some(args.warmup + args.frames),
         naive,
         autosave: None,
+        msaa: args.msaa,
+        lod: args.lod,
     })
     .map_err(CliError)?;
     Ok((run.frames, run.device))

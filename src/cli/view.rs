@@ -102,6 +102,8 @@ pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
         max_frames: None,
         naive: false,
         autosave: Some(autosave),
+        msaa: 0,
+        lod: true,
     };
     let title = args.title.clone();
     let run = app::run(args).map_err(CliError)?;

@@ -28,6 +28,10 @@ pub struct DeviceCaps {
     pub sample_counts: vk::SampleCountFlags,
     /// Whether `fillModeNonSolid` was enabled (debug wireframe of arbitrary meshes).
     pub fill_mode_non_solid: bool,
+    /// Whether `VK_EXT_multi_draw` is enabled: batches of surfaces cost one draw call.
+    pub multi_draw: bool,
+    /// Whether `largePoints` is enabled: control points are drawn as point primitives.
+    pub large_points: bool,
 }
 
 impl DeviceCaps {
@@ -53,8 +57,16 @@ pub struct Device {
     pub(crate) queue_family: u32,
     pub(crate) caps: DeviceCaps,
     pub(crate) swapchain_fn: Option<ash::khr::swapchain::Device>,
+    pub(crate) multi_draw: Option<MultiDraw>,
     /// `Option` so it can be dropped (freeing its memory blocks) before `vkDestroyDevice`.
     allocator: Mutex<Option<Allocator>>,
+}
+
+/// `VK_EXT_multi_draw`: many draws of one index buffer in one command.
+pub(crate) struct MultiDraw {
+    pub fns: ash::ext::multi_draw::Device,
+    /// `maxMultiDrawCount`: draws per command at most (≥ 1).
+    pub max_count: u32,
 }
 
 /// How desirable a device type is; higher wins.
@@ -108,6 +120,10 @@ struct Candidate {
     timestamp_valid_bits: u32,
     swapchain: bool,
     fill_mode_non_solid: bool,
+    /// `largePoints`, and a point size range reaching 16 pixels.
+    large_points: bool,
+    /// `maxMultiDrawCount` when `VK_EXT_multi_draw` and its feature are available.
+    multi_draw: Option<u32>,
 }
 
 fn inspect(
@@ -129,6 +145,8 @@ fn inspect(
     // SAFETY: the chain only holds structs known to Vulkan 1.3, which the device supports.
     unsafe { raw.get_physical_device_features2(physical, &mut f2) };
     let fill_mode_non_solid = f2.features.fill_mode_non_solid == vk::TRUE;
+    let large_points =
+        f2.features.large_points == vk::TRUE && props.limits.point_size_range[1] >= 16.0;
     if f13.dynamic_rendering != vk::TRUE
         || f13.synchronization2 != vk::TRUE
         || f12.buffer_device_address != vk::TRUE
@@ -154,6 +172,13 @@ fn inspect(
     if want_swapchain && !swapchain {
         return Ok(None);
     }
+    let has_multi_draw = exts.iter().any(|e| {
+        e.extension_name_as_c_str()
+            .is_ok_and(|n| n == ash::ext::multi_draw::NAME)
+    });
+    let multi_draw = has_multi_draw
+        .then(|| multi_draw_limit(instance, physical))
+        .flatten();
     let name = props
         .device_name_as_c_str()
         .map(|c| c.to_string_lossy().into_owned())
@@ -166,13 +191,33 @@ fn inspect(
         timestamp_valid_bits: fam.timestamp_valid_bits,
         swapchain: want_swapchain,
         fill_mode_non_solid,
+        large_points,
+        multi_draw,
     }))
 }
 
+/// `maxMultiDrawCount` when the device reports the `multiDraw` feature (it has the extension).
+fn multi_draw_limit(instance: &Instance, physical: vk::PhysicalDevice) -> Option<u32> {
+    let raw = &instance.raw;
+    let mut features = vk::PhysicalDeviceMultiDrawFeaturesEXT::default();
+    let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut features);
+    // SAFETY: the device supports VK_EXT_multi_draw, so its feature struct may be chained.
+    unsafe { raw.get_physical_device_features2(physical, &mut f2) };
+    if features.multi_draw != vk::TRUE {
+        return None;
+    }
+    let mut props = vk::PhysicalDeviceMultiDrawPropertiesEXT::default();
+    let mut p2 = vk::PhysicalDeviceProperties2::default().push_next(&mut props);
+    // SAFETY: as above, for the properties struct.
+    unsafe { raw.get_physical_device_properties2(physical, &mut p2) };
+    (props.max_multi_draw_count > 0).then_some(props.max_multi_draw_count)
+}
+
 impl Device {
-    /// Chooses a physical device (see [`GPU_ENV`]) and creates the logical device. When the
-    /// instance was created for a display, `VK_KHR_swapchain` is required and enabled.
-    pub fn new(instance: &Instance) -> GpuResult<Self> {
+    /// Chooses a physical device (`preference`: a name substring, else [`GPU_ENV`]) and creates
+    /// the logical device. When the instance was created for a display, `VK_KHR_swapchain` is
+    /// required and enabled.
+    pub fn new(instance: &Instance, preference: Option<&str>) -> GpuResult<Self> {
         let want_swapchain = instance.surface_fn.is_some();
         // SAFETY: valid instance.
         let physicals = unsafe { instance.raw.enumerate_physical_devices() }
@@ -186,7 +231,9 @@ impl Device {
                 candidates.push(c);
             }
         }
-        let preference = std::env::var(GPU_ENV).ok();
+        let preference = preference
+            .map(str::to_owned)
+            .or_else(|| std::env::var(GPU_ENV).ok());
         let listing: Vec<_> = candidates
             .iter()
             .map(|c| (c.name.clone(), c.props.device_type))
@@ -206,18 +253,30 @@ impl Device {
         if c.swapchain {
             extensions.push(ash::khr::swapchain::NAME.as_ptr());
         }
-        let features =
-            vk::PhysicalDeviceFeatures::default().fill_mode_non_solid(c.fill_mode_non_solid);
+        if c.multi_draw.is_some() {
+            extensions.push(ash::ext::multi_draw::NAME.as_ptr());
+        }
+        let mut multi_draw_features =
+            vk::PhysicalDeviceMultiDrawFeaturesEXT::default().multi_draw(true);
+        let features = vk::PhysicalDeviceFeatures::default()
+            .fill_mode_non_solid(c.fill_mode_non_solid)
+            .large_points(c.large_points);
         let mut f12 = vk::PhysicalDeviceVulkan12Features::default().buffer_device_address(true);
+        // Demotion is how SPIR-V 1.6 spells `discard` (the HUD's glyph lookup); Vulkan 1.3
+        // requires every device to support it.
         let mut f13 = vk::PhysicalDeviceVulkan13Features::default()
             .dynamic_rendering(true)
-            .synchronization2(true);
-        let info = vk::DeviceCreateInfo::default()
+            .synchronization2(true)
+            .shader_demote_to_helper_invocation(true);
+        let mut info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_infos)
             .enabled_extension_names(&extensions)
             .enabled_features(&features)
             .push_next(&mut f12)
             .push_next(&mut f13);
+        if c.multi_draw.is_some() {
+            info = info.push_next(&mut multi_draw_features);
+        }
         // SAFETY: features and extensions were checked in `inspect`; pointers outlive the call.
         let raw =
             unsafe { raw_instance.create_device(c.physical, &info, None) }.vk("vkCreateDevice")?;
@@ -238,6 +297,8 @@ impl Device {
             sample_counts: limits.framebuffer_color_sample_counts
                 & limits.framebuffer_depth_sample_counts,
             fill_mode_non_solid: c.fill_mode_non_solid,
+            multi_draw: c.multi_draw.is_some(),
+            large_points: c.large_points,
         };
 
         let allocator = Allocator::new(&AllocatorCreateDesc {
@@ -259,6 +320,10 @@ impl Device {
         let swapchain_fn = c
             .swapchain
             .then(|| ash::khr::swapchain::Device::new(raw_instance, &raw));
+        let multi_draw = c.multi_draw.map(|max_count| MultiDraw {
+            fns: ash::ext::multi_draw::Device::new(raw_instance, &raw),
+            max_count,
+        });
         Ok(Self {
             raw,
             physical: c.physical,
@@ -266,6 +331,7 @@ impl Device {
             queue_family: c.queue_family,
             caps,
             swapchain_fn,
+            multi_draw,
             allocator: Mutex::new(Some(allocator)),
         })
     }
@@ -319,9 +385,12 @@ impl Device {
         unsafe { self.raw.device_wait_idle() }.vk("vkDeviceWaitIdle")
     }
 
-    /// Frees the allocator's memory blocks and destroys the device. Every resource created
-    /// from it must already be destroyed.
-    pub fn destroy(self) {
+    /// Frees the allocator's memory blocks and destroys the device.
+    ///
+    /// # Safety
+    /// Every object created from the device must already be destroyed and the GPU idle (or
+    /// the device lost).
+    pub(crate) unsafe fn destroy(self) {
         drop(
             self.allocator
                 .lock()

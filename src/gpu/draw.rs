@@ -8,7 +8,7 @@ use glam::{Mat4, Vec3};
 
 use super::error::{GpuError, GpuResult};
 use super::frame::Frame;
-use super::grid::GridShape;
+use super::grid::{GridShape, GridStride};
 use super::mirror::Mirror;
 use super::pipeline::{
     Lines3dPush, OverlayPush, PUSH_STAGES, PointsPush, PolylinePush, SurfacePush, WirePush,
@@ -83,6 +83,22 @@ impl SurfaceGrid {
     pub fn floats(&self) -> usize {
         self.shape.vertices() as usize * Self::FLOATS_PER_VERTEX
     }
+}
+
+/// Surfaces of one grid shape, each at its own float offset in one mirror, drawn with one
+/// stride in one call: many small patches (a teapot's 32, a scene's thousands) cost one
+/// multi-draw (`VK_EXT_multi_draw`) instead of a draw each, and surfaces stored back to back
+/// (each offset the previous one's end) are a single range of a repeated index buffer
+/// within it. Offsets must be congruent modulo [`SurfaceGrid::FLOATS_PER_VERTEX`] (vertices
+/// of one mirror bound once).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SurfaceBatch<'a> {
+    /// Shape shared by every surface.
+    pub shape: GridShape,
+    /// Rows and columns drawn (display level of detail).
+    pub stride: GridStride,
+    /// Float offset of each surface's vertex (0, 0).
+    pub offsets: &'a [usize],
 }
 
 /// A run of points inside a float buffer: point `i` is `xyz` at floats
@@ -219,8 +235,8 @@ pub struct LineVertex {
     pub color: [u8; 4],
 }
 
-/// Vertex of [`Frame::draw_overlay`]: pixel position (origin top-left, y down) and
-/// sRGB-encoded RGBA8 colour (alpha-blended).
+/// Vertex of [`Frame::draw_overlay`]: pixel position (origin top-left, y down), sRGB-encoded
+/// RGBA8 colour (alpha-blended) and where in the built-in font the quad samples.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OverlayVertex {
@@ -228,16 +244,26 @@ pub struct OverlayVertex {
     pub pos: [f32; 2],
     /// sRGB-encoded colour, straight alpha.
     pub color: [u8; 4],
+    /// Font coordinates: `x = 8 · glyph + column`, `y = row`, in font pixels of the glyph
+    /// table of [`super::font`] (glyph = character code − 32). The fragment shader keeps the
+    /// fragment where that font pixel is lit. [`OverlayVertex::SOLID`] (negative) fills the
+    /// whole triangle.
+    pub glyph: [f32; 2],
+}
+
+impl OverlayVertex {
+    /// `glyph` value of untextured (solid) triangles.
+    pub const SOLID: [f32; 2] = [-1.0, -1.0];
 }
 
 // SAFETY: repr(C), 12 + 4 bytes, no padding, every bit pattern valid.
 unsafe impl Pod for LineVertex {}
-// SAFETY: repr(C), 8 + 4 bytes, no padding, every bit pattern valid.
+// SAFETY: repr(C), 8 + 4 + 8 bytes, no padding, every bit pattern valid.
 unsafe impl Pod for OverlayVertex {}
 
 const _: () = {
     assert!(size_of::<LineVertex>() == 16);
-    assert!(size_of::<OverlayVertex>() == 12);
+    assert!(size_of::<OverlayVertex>() == 20);
 };
 
 /// Packs a linear colour into RGBA8 (for `unpackUnorm4x8` in shaders).
@@ -246,16 +272,80 @@ fn pack_unorm(c: [f32; 4]) -> u32 {
     b(c[0]) | (b(c[1]) << 8) | (b(c[2]) << 16) | (b(c[3]) << 24)
 }
 
+/// What a frame recorded so far: draws and state changes (state already bound is not bound
+/// again).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct DrawStats {
+    /// Draw calls recorded.
+    pub draws: u32,
+    /// Pipeline binds recorded.
+    pub pipeline_binds: u32,
+    /// Triangles submitted by surface draws (after level of detail).
+    pub surface_triangles: u64,
+}
+
 impl Frame<'_> {
     fn bind_and_push<T: Pod>(&mut self, pipeline: vk::Pipeline, push: &T) {
         self.ensure_rendering();
         let layout = self.renderer.pipelines.layout;
-        // SAFETY: recording inside a rendering scope; the push struct fits the layout range.
-        unsafe {
-            let raw = &self.renderer.device.raw;
-            raw.cmd_bind_pipeline(self.cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
-            raw.cmd_push_constants(self.cmd, layout, PUSH_STAGES, 0, bytes_of(push));
+        let raw = &self.renderer.device.raw;
+        if self.bound.pipeline != pipeline {
+            // SAFETY: recording inside a rendering scope; the pipeline matches the target.
+            unsafe { raw.cmd_bind_pipeline(self.cmd, vk::PipelineBindPoint::GRAPHICS, pipeline) };
+            self.bound.pipeline = pipeline;
+            // Dynamic depth-test state is reset per pipeline in our bookkeeping: a pipeline
+            // without the dynamic state overrides it.
+            self.bound.depth_test = None;
+            self.stats.pipeline_binds += 1;
         }
+        // SAFETY: recording inside a rendering scope; the push struct fits the layout range.
+        unsafe { raw.cmd_push_constants(self.cmd, layout, PUSH_STAGES, 0, bytes_of(push)) };
+    }
+
+    fn set_depth_test(&mut self, enable: bool) {
+        if self.bound.depth_test != Some(enable) {
+            // SAFETY: recording; the bound pipeline has DEPTH_TEST_ENABLE as dynamic state.
+            unsafe {
+                self.renderer
+                    .device
+                    .raw
+                    .cmd_set_depth_test_enable(self.cmd, enable)
+            };
+            self.bound.depth_test = Some(enable);
+        }
+    }
+
+    fn bind_vertices(&mut self, buffer: vk::Buffer, offset: u64) {
+        if self.bound.vertices != Some((buffer, offset)) {
+            // SAFETY: recording; the buffer has VERTEX_BUFFER usage and outlives the frame.
+            unsafe {
+                self.renderer
+                    .device
+                    .raw
+                    .cmd_bind_vertex_buffers(self.cmd, 0, &[buffer], &[offset])
+            };
+            self.bound.vertices = Some((buffer, offset));
+        }
+    }
+
+    fn bind_indices(&mut self, buffer: vk::Buffer) {
+        if self.bound.indices != buffer {
+            // SAFETY: recording; cached index buffers live as long as the renderer.
+            unsafe {
+                self.renderer.device.raw.cmd_bind_index_buffer(
+                    self.cmd,
+                    buffer,
+                    0,
+                    vk::IndexType::UINT32,
+                )
+            };
+            self.bound.indices = buffer;
+        }
+    }
+
+    /// Draws and binds recorded so far in this frame.
+    pub fn stats(&self) -> DrawStats {
+        self.stats
     }
 
     fn view_proj(&self) -> [f32; 16] {
@@ -269,20 +359,45 @@ impl Frame<'_> {
         ]
     }
 
-    fn check_grid(mirror: &Mirror, grid: &SurfaceGrid) -> GpuResult<()> {
-        grid.shape.validate()?;
-        if grid
-            .offset
-            .checked_add(grid.floats())
-            .is_none_or(|end| end > mirror.len())
-        {
-            return Err(GpuError::InvalidArgument(format!(
-                "surface grid {grid:?} needs {} floats after its offset, mirror has {}",
-                grid.floats(),
-                mirror.len()
-            )));
+    /// Checks the batch against `mirror`; returns the byte offset to bind the vertices at and
+    /// the batch's runs: (vertex offset from there, number of surfaces stored back to back).
+    fn batch_runs(mirror: &Mirror, batch: &SurfaceBatch) -> GpuResult<(u64, Vec<(i32, u32)>)> {
+        batch.shape.validate()?;
+        let per = SurfaceGrid::FLOATS_PER_VERTEX;
+        let floats = SurfaceGrid {
+            offset: 0,
+            shape: batch.shape,
         }
-        Ok(())
+        .floats();
+        let residue = batch.offsets.first().map_or(0, |o| o % per);
+        let mut runs: Vec<(i32, u32)> = Vec::with_capacity(batch.offsets.len());
+        let mut next = None;
+        for &offset in batch.offsets {
+            let fits = offset
+                .checked_add(floats)
+                .is_some_and(|end| end <= mirror.len());
+            let vertex = i32::try_from((offset - offset % per) / per).ok();
+            match vertex {
+                Some(v) if fits && offset % per == residue => {
+                    match runs.last_mut() {
+                        // Right after the previous surface: the same run.
+                        Some(run) if next == Some(offset) => run.1 += 1,
+                        _ => runs.push((v, 1)),
+                    }
+                    next = Some(offset + floats);
+                }
+                _ => {
+                    return Err(GpuError::InvalidArgument(format!(
+                        "surface grid {}x{} at float {offset} does not fit a mirror of {} \
+                         floats (or its offset is not {residue} modulo {per})",
+                        batch.shape.rows,
+                        batch.shape.cols,
+                        mirror.len()
+                    )));
+                }
+            }
+        }
+        Ok((residue as u64 * 4, runs))
     }
 
     /// Draws a shaded grid surface from this frame's slot of `mirror`.
@@ -292,9 +407,32 @@ impl Frame<'_> {
         grid: SurfaceGrid,
         style: &SurfaceStyle,
     ) -> GpuResult<()> {
-        Self::check_grid(mirror, &grid)?;
+        let batch = SurfaceBatch {
+            shape: grid.shape,
+            stride: GridStride::FULL,
+            offsets: &[grid.offset],
+        };
+        self.draw_surface_batch(mirror, &batch, style)
+    }
+
+    /// Draws a batch of shaded grid surfaces at the batch's stride (display level of detail,
+    /// see [`GridStride`]): the same vertices, fewer triangles, one call.
+    pub fn draw_surface_batch(
+        &mut self,
+        mirror: &Mirror,
+        batch: &SurfaceBatch,
+        style: &SurfaceStyle,
+    ) -> GpuResult<()> {
+        let (base, runs) = Self::batch_runs(mirror, batch)?;
+        let Some(longest) = runs.iter().map(|r| r.1).max() else {
+            return Ok(());
+        };
         let r = &mut *self.renderer;
-        let ib = r.grids.triangles(&r.device, &mut r.uploader, grid.shape)?;
+        let release = &mut r.frames[self.slot].release;
+        let key = (batch.shape, batch.stride, longest);
+        let ib = r
+            .grids
+            .triangles(&r.device, &mut r.uploader, key, release)?;
         let (index_buffer, count) = (ib.buffer.raw, ib.count);
         let eye = self.camera.eye;
         let push = SurfacePush {
@@ -309,8 +447,9 @@ impl Frame<'_> {
             front: style.front,
             back: style.back,
         };
+        self.stats.surface_triangles += u64::from(count / 3) * batch.offsets.len() as u64;
         self.bind_and_push(self.pipelines.surface, &push);
-        self.draw_indexed(mirror, grid.offset, index_buffer, count);
+        self.draw_indexed(mirror, base, index_buffer, count, &runs);
         Ok(())
     }
 
@@ -323,29 +462,101 @@ impl Frame<'_> {
         every: u32,
         color: [f32; 4],
     ) -> GpuResult<()> {
-        Self::check_grid(mirror, &grid)?;
+        let batch = SurfaceBatch {
+            shape: grid.shape,
+            stride: GridStride::FULL,
+            offsets: &[grid.offset],
+        };
+        self.draw_wire_batch(mirror, &batch, every, color)
+    }
+
+    /// Isolines over every surface of a batch, on the strided mesh
+    /// [`Frame::draw_surface_batch`] draws for it: they lie on its edges (`every` rounds up
+    /// to a multiple of the stride).
+    pub fn draw_wire_batch(
+        &mut self,
+        mirror: &Mirror,
+        batch: &SurfaceBatch,
+        every: u32,
+        color: [f32; 4],
+    ) -> GpuResult<()> {
+        let (base, runs) = Self::batch_runs(mirror, batch)?;
+        let Some(longest) = runs.iter().map(|r| r.1).max() else {
+            return Ok(());
+        };
         let r = &mut *self.renderer;
-        let ib = r
-            .grids
-            .lines(&r.device, &mut r.uploader, grid.shape, every)?;
+        let release = &mut r.frames[self.slot].release;
+        let key = (batch.shape, every, batch.stride, longest);
+        let ib = r.grids.lines(&r.device, &mut r.uploader, key, release)?;
         let (index_buffer, count) = (ib.buffer.raw, ib.count);
         let push = WirePush {
             view_proj: self.view_proj(),
             color,
         };
         self.bind_and_push(self.pipelines.wire, &push);
-        self.draw_indexed(mirror, grid.offset, index_buffer, count);
+        self.draw_indexed(mirror, base, index_buffer, count, &runs);
         Ok(())
     }
 
-    fn draw_indexed(&self, mirror: &Mirror, offset: usize, index_buffer: vk::Buffer, count: u32) {
-        let vb = mirror.slot(self.slot).raw();
-        // SAFETY: recording inside a rendering scope; offsets/ranges checked by the caller.
-        unsafe {
-            let raw = &self.renderer.device.raw;
-            raw.cmd_bind_vertex_buffers(self.cmd, 0, &[vb], &[offset as u64 * 4]);
-            raw.cmd_bind_index_buffer(self.cmd, index_buffer, 0, vk::IndexType::UINT32);
-            raw.cmd_draw_indexed(self.cmd, count, 1, 0, 0, 0);
+    /// For each run (vertex offset, surfaces), the first `surfaces · count` indices of
+    /// `index_buffer` (copies of one grid's `count`): one `vkCmdDrawMultiIndexedEXT` (per
+    /// `maxMultiDrawCount` runs) where supported, else one draw per run.
+    fn draw_indexed(
+        &mut self,
+        mirror: &Mirror,
+        base: u64,
+        index_buffer: vk::Buffer,
+        count: u32,
+        runs: &[(i32, u32)],
+    ) {
+        self.bind_vertices(mirror.slot(self.slot).raw(), base);
+        self.bind_indices(index_buffer);
+        let device = &*self.renderer.device;
+        match &device.multi_draw {
+            Some(multi) => {
+                for chunk in runs.chunks(multi.max_count as usize) {
+                    let infos: Vec<vk::MultiDrawIndexedInfoEXT> = chunk
+                        .iter()
+                        .map(|&(vertex_offset, surfaces)| vk::MultiDrawIndexedInfoEXT {
+                            first_index: 0,
+                            index_count: count * surfaces,
+                            vertex_offset,
+                        })
+                        .collect();
+                    // SAFETY: recording inside a rendering scope; the extension and its
+                    // multiDraw feature are enabled; `infos` holds `chunk.len()` tightly packed
+                    // structs (stride = their size) whose index and vertex ranges the caller
+                    // checked against the bound buffers.
+                    unsafe {
+                        (multi.fns.fp().cmd_draw_multi_indexed_ext)(
+                            self.cmd,
+                            infos.len() as u32,
+                            infos.as_ptr(),
+                            1,
+                            0,
+                            size_of::<vk::MultiDrawIndexedInfoEXT>() as u32,
+                            std::ptr::null(),
+                        )
+                    };
+                    self.stats.draws += 1;
+                }
+            }
+            None => {
+                for &(vertex_offset, surfaces) in runs {
+                    // SAFETY: recording inside a rendering scope; ranges checked by the caller.
+                    unsafe {
+                        device.raw.cmd_draw_indexed(
+                            self.cmd,
+                            count * surfaces,
+                            1,
+                            0,
+                            vertex_offset,
+                            0,
+                        )
+                    };
+                    self.stats.draws += 1;
+                }
+            }
         }
     }
 
@@ -358,7 +569,32 @@ impl Frame<'_> {
     ) -> GpuResult<()> {
         run.check(mirror.len(), 2)?;
         let address = mirror.slot(self.slot).address();
-        self.polyline_at(address, run, style);
+        self.polyline_at(address, run, 0, style);
+        Ok(())
+    }
+
+    /// Draws every row and every column of a `rows × cols` grid of points as wide lines, in
+    /// one draw: a control net. Point `(r, c)` is point `r · cols + c` of `run`, whose count
+    /// must be `rows · cols`.
+    pub fn draw_net(
+        &mut self,
+        mirror: &Mirror,
+        run: PointRun,
+        cols: usize,
+        style: &PolylineStyle,
+    ) -> GpuResult<()> {
+        run.check(mirror.len(), 1)?;
+        if cols == 0 || !run.count.is_multiple_of(cols) || u32::try_from(cols).is_err() {
+            return Err(GpuError::InvalidArgument(format!(
+                "net of {} points is not a whole number of rows of {cols}",
+                run.count
+            )));
+        }
+        if net_segments(run.count, cols) == 0 {
+            return Ok(());
+        }
+        let address = mirror.slot(self.slot).address();
+        self.polyline_at(address, run, cols as u32, style);
         Ok(())
     }
 
@@ -371,11 +607,26 @@ impl Frame<'_> {
         let run = PointRun::packed(0, points.len());
         run.check(points.len() * 3, 2)?;
         let alloc = self.push_transient(points)?;
-        self.polyline_at(alloc.address, run, style);
+        self.polyline_at(alloc.address, run, 0, style);
         Ok(())
     }
 
-    fn polyline_at(&mut self, address: vk::DeviceAddress, run: PointRun, style: &PolylineStyle) {
+    /// One draw of 6 vertices per segment (a quad each). Instancing would say the same more
+    /// briefly, but Mesa's draw module runs every instance as a separate draw.
+    fn polyline_at(
+        &mut self,
+        address: vk::DeviceAddress,
+        run: PointRun,
+        grid_cols: u32,
+        style: &PolylineStyle,
+    ) {
+        let segments = if grid_cols == 0 {
+            run.count - 1
+        } else {
+            net_segments(run.count, grid_cols as usize)
+        };
+        // One-pixel lines rasterise natively: 2 vertices per segment instead of a quad's 6.
+        let thin = style.width <= 1.0;
         let push = PolylinePush {
             view_proj: self.view_proj(),
             color: style.color,
@@ -385,14 +636,24 @@ impl Frame<'_> {
             stride: run.stride as u32,
             count: run.count as u32,
             width: style.width,
+            grid_cols,
+            thin: u32::from(thin),
         };
-        self.bind_and_push(self.pipelines.polyline, &push);
-        // SAFETY: recording inside a rendering scope; the run was bounds-checked.
-        unsafe {
-            let raw = &self.renderer.device.raw;
-            raw.cmd_set_depth_test_enable(self.cmd, style.depth_test);
-            raw.cmd_draw(self.cmd, 6, run.count as u32 - 1, 0, 0);
-        }
+        let (pipeline, per_segment) = if thin {
+            (self.pipelines.thin_lines, 2)
+        } else {
+            (self.pipelines.polyline, 6)
+        };
+        self.bind_and_push(pipeline, &push);
+        self.set_depth_test(style.depth_test);
+        self.draw_vertices(vertex_count(segments, per_segment));
+    }
+
+    fn draw_vertices(&mut self, count: u32) {
+        // SAFETY: recording inside a rendering scope; vertex data is pulled through device
+        // addresses whose ranges the callers checked.
+        unsafe { self.renderer.device.raw.cmd_draw(self.cmd, count, 1, 0, 0) };
+        self.stats.draws += 1;
     }
 
     /// Draws the points of `run` as screen-space squares, highlighting hovered/selected.
@@ -403,6 +664,7 @@ impl Frame<'_> {
         style: &PointStyle,
     ) -> GpuResult<()> {
         run.check(mirror.len(), 1)?;
+        let large_points = self.renderer.device.caps.large_points;
         let index = |i: Option<u32>| i.and_then(|i| i32::try_from(i).ok()).unwrap_or(-1);
         let push = PointsPush {
             view_proj: self.view_proj(),
@@ -416,14 +678,12 @@ impl Frame<'_> {
             color: pack_unorm(style.color),
             hovered_color: pack_unorm(style.hovered_color),
             selected_color: pack_unorm(style.selected_color),
+            quads: u32::from(!large_points),
+            _pad: 0,
         };
         self.bind_and_push(self.pipelines.points, &push);
-        // SAFETY: recording inside a rendering scope; the run was bounds-checked.
-        unsafe {
-            let raw = &self.renderer.device.raw;
-            raw.cmd_set_depth_test_enable(self.cmd, style.depth_test);
-            raw.cmd_draw(self.cmd, 6, run.count as u32, 0, 0);
-        }
+        self.set_depth_test(style.depth_test);
+        self.draw_vertices(vertex_count(run.count, if large_points { 1 } else { 6 }));
         Ok(())
     }
 
@@ -457,18 +717,31 @@ impl Frame<'_> {
         let alloc = self.push_transient(&vertices[..count])?;
         let push = OverlayPush {
             viewport: self.viewport_size(),
+            font: self.renderer.font.as_ref().map_or(0, |f| f.address()),
         };
         self.bind_and_push(self.pipelines.overlay, &push);
         self.draw_transient(alloc, count as u32);
         Ok(())
     }
 
-    fn draw_transient(&self, alloc: TransientAlloc, count: u32) {
+    fn draw_transient(&mut self, alloc: TransientAlloc, count: u32) {
+        self.bind_vertices(alloc.buffer, alloc.offset);
         // SAFETY: recording inside a rendering scope; the data was just written this frame.
-        unsafe {
-            let raw = &self.renderer.device.raw;
-            raw.cmd_bind_vertex_buffers(self.cmd, 0, &[alloc.buffer], &[alloc.offset]);
-            raw.cmd_draw(self.cmd, count, 1, 0, 0);
-        }
+        unsafe { self.renderer.device.raw.cmd_draw(self.cmd, count, 1, 0, 0) };
+        self.stats.draws += 1;
     }
+}
+
+/// Segments of a `count`-point net with `cols` points per row: rows·(cols−1) along the rows,
+/// cols·(rows−1) along the columns.
+fn net_segments(count: usize, cols: usize) -> usize {
+    let rows = count / cols;
+    rows * (cols - 1) + cols * rows.saturating_sub(1)
+}
+
+/// Vertices of `n` primitives of `per` vertices each. Point runs are bounds-checked to fewer
+/// than 2³² floats of at least 3 each, so this fits a `u32` for every checked run up to
+/// 715 827 882 quads; larger counts are clamped to whole primitives.
+fn vertex_count(n: usize, per: u32) -> u32 {
+    u32::try_from(n.saturating_mul(per as usize)).unwrap_or(u32::MAX / per * per)
 }

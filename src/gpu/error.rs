@@ -27,6 +27,23 @@ pub enum GpuError {
          (apt-get install vulkan-validationlayers)"
     )]
     NoValidationLayer,
+    /// The device was lost (driver reset, crash, or hang recovery): nothing submitted since
+    /// completes, and the renderer cannot continue.
+    #[error(
+        "the GPU device was lost during {call} (driver reset or crash); rendering cannot continue"
+    )]
+    DeviceLost {
+        /// The Vulkan entry point that reported it.
+        call: &'static str,
+    },
+    /// The GPU did not finish work within the renderer's wait limit ([`super::WAIT_LIMIT`]).
+    #[error("the GPU did not finish within {seconds} s ({call}); it may be hung")]
+    Timeout {
+        /// The Vulkan entry point that waited.
+        call: &'static str,
+        /// The limit in seconds.
+        seconds: u64,
+    },
     /// A Vulkan call returned an error code.
     #[error("{call} failed: {result}")]
     Vk {
@@ -60,6 +77,13 @@ pub enum GpuError {
     },
 }
 
+impl GpuError {
+    /// Whether the error means the device is gone (every later call fails too).
+    pub fn is_device_lost(&self) -> bool {
+        matches!(self, GpuError::DeviceLost { .. })
+    }
+}
+
 /// Shorthand for `Result<T, GpuError>`.
 pub type GpuResult<T> = Result<T, GpuError>;
 
@@ -70,6 +94,18 @@ pub(crate) trait VkResultExt<T> {
 
 impl<T> VkResultExt<T> for Result<T, vk::Result> {
     fn vk(self, call: &'static str) -> GpuResult<T> {
-        self.map_err(|result| GpuError::Vk { call, result })
+        self.map_err(|result| vk_error(call, result))
+    }
+}
+
+/// The error for `result` returned by `call`: device loss and timeouts get their own variants.
+pub(crate) fn vk_error(call: &'static str, result: vk::Result) -> GpuError {
+    match result {
+        vk::Result::ERROR_DEVICE_LOST => GpuError::DeviceLost { call },
+        vk::Result::TIMEOUT => GpuError::Timeout {
+            call,
+            seconds: super::WAIT_LIMIT.as_secs(),
+        },
+        result => GpuError::Vk { call, result },
     }
 }

@@ -3,6 +3,10 @@
 //! Glyphs cover printable ASCII (32..=126); anything else renders as `?`. Each glyph is
 //! 7 rows of 5 bits, bit 4 being the leftmost column. Text is laid out on a 6×9 cell
 //! (one column and two rows of spacing) scaled by an integer-ish `scale` in pixels.
+//!
+//! Each character is one quad; the overlay fragment shader looks its font pixels up in the
+//! glyph table (uploaded once by the renderer), so a line of text costs two triangles per
+//! character rather than one quad per lit run of font pixels.
 
 use super::draw::OverlayVertex;
 
@@ -17,13 +21,22 @@ pub const LINE_HEIGHT: u32 = 9;
 
 /// Rows of the glyph for `c` (printable ASCII, else `?`).
 pub fn glyph(c: char) -> &'static [u8; 7] {
+    &FONT[glyph_index(c) as usize]
+}
+
+/// The glyph table as the overlay shader reads it: row `r` of glyph `g` at `7 g + r`.
+pub(crate) fn glyph_rows() -> Vec<u32> {
+    FONT.iter().flatten().map(|&r| u32::from(r)).collect()
+}
+
+/// Index of `c` in the glyph table (printable ASCII, else `?`).
+fn glyph_index(c: char) -> u32 {
     let code = c as u32;
-    let index = if (32..=126).contains(&code) {
+    if (32..=126).contains(&code) {
         code - 32
     } else {
         u32::from(b'?') - 32
-    };
-    &FONT[index as usize]
+    }
 }
 
 /// Size in pixels of `text` (which may contain `\n`) at `scale` pixels per font pixel.
@@ -44,25 +57,39 @@ pub fn text_size(text: &str, scale: f32) -> [f32; 2] {
     [w as f32 * scale, h as f32 * scale]
 }
 
-/// Appends an axis-aligned rectangle (two triangles) in pixel coordinates.
-pub fn push_rect(out: &mut Vec<OverlayVertex>, x: f32, y: f32, w: f32, h: f32, color: [u8; 4]) {
-    let v = |px: f32, py: f32| OverlayVertex {
+/// Appends a quad (two triangles) from `(x, y)` to `(x + w, y + h)` in pixels whose corners
+/// carry font coordinates `g0` and `g1` (see [`OverlayVertex::glyph`]).
+fn push_quad(
+    out: &mut Vec<OverlayVertex>,
+    [x, y, w, h]: [f32; 4],
+    color: [u8; 4],
+    g0: [f32; 2],
+    g1: [f32; 2],
+) {
+    let v = |px: f32, py: f32, gx: f32, gy: f32| OverlayVertex {
         pos: [px, py],
         color,
+        glyph: [gx, gy],
     };
     out.extend_from_slice(&[
-        v(x, y),
-        v(x + w, y),
-        v(x + w, y + h),
-        v(x, y),
-        v(x + w, y + h),
-        v(x, y + h),
+        v(x, y, g0[0], g0[1]),
+        v(x + w, y, g1[0], g0[1]),
+        v(x + w, y + h, g1[0], g1[1]),
+        v(x, y, g0[0], g0[1]),
+        v(x + w, y + h, g1[0], g1[1]),
+        v(x, y + h, g0[0], g1[1]),
     ]);
 }
 
-/// Appends quads drawing `text` with its top-left corner at `(x, y)` (pixels, y down),
-/// `scale` pixels per font pixel, in sRGB colour `color`. Horizontal runs of lit font pixels
-/// become one quad each. Returns the advance width in pixels of the longest line.
+/// Appends an axis-aligned rectangle (two triangles) in pixel coordinates.
+pub fn push_rect(out: &mut Vec<OverlayVertex>, x: f32, y: f32, w: f32, h: f32, color: [u8; 4]) {
+    let solid = OverlayVertex::SOLID;
+    push_quad(out, [x, y, w, h], color, solid, solid);
+}
+
+/// Appends one quad per visible character drawing `text` with its top-left corner at
+/// `(x, y)` (pixels, y down), `scale` pixels per font pixel, in sRGB colour `color`. Returns
+/// the advance width in pixels of the longest line.
 pub fn push_text(
     out: &mut Vec<OverlayVertex>,
     text: &str,
@@ -76,26 +103,16 @@ pub fn push_text(
         let top = y + (line_no as u32 * LINE_HEIGHT) as f32 * scale;
         let mut left = x;
         for c in line.chars() {
-            for (row, bits) in glyph(c).iter().enumerate() {
-                let mut col = 0;
-                while col < GLYPH_WIDTH {
-                    if bits & (0x10 >> col) == 0 {
-                        col += 1;
-                        continue;
-                    }
-                    let start = col;
-                    while col < GLYPH_WIDTH && bits & (0x10 >> col) != 0 {
-                        col += 1;
-                    }
-                    push_rect(
-                        out,
-                        left + start as f32 * scale,
-                        top + row as f32 * scale,
-                        (col - start) as f32 * scale,
-                        scale,
-                        color,
-                    );
-                }
+            if glyph(c).iter().any(|&row| row != 0) {
+                let g = (glyph_index(c) * 8) as f32;
+                let (w, h) = (GLYPH_WIDTH as f32, GLYPH_HEIGHT as f32);
+                push_quad(
+                    out,
+                    [left, top, w * scale, h * scale],
+                    color,
+                    [g, 0.0],
+                    [g + w, h],
+                );
             }
             left += ADVANCE as f32 * scale;
         }
@@ -216,13 +233,33 @@ mod tests {
     }
 
     #[test]
-    fn text_runs_become_quads() {
+    fn one_quad_per_visible_character() {
         let mut v = Vec::new();
-        // 'I' = .###. then 5 × ..#.. then .###. : 7 runs.
-        let w = push_text(&mut v, "I", 10.0, 20.0, 2.0, [255; 4]);
-        assert_eq!(v.len(), 7 * 6);
-        assert_eq!(w, 12.0);
-        assert_eq!(v[0].pos, [12.0, 20.0]);
+        let w = push_text(&mut v, "I I", 10.0, 20.0, 2.0, [255; 4]);
+        // Two glyph quads; the space advances without a quad.
+        assert_eq!(v.len(), 2 * 6);
+        assert_eq!(w, 36.0);
+        assert_eq!(v[0].pos, [10.0, 20.0]);
+        assert_eq!(v[2].pos, [20.0, 34.0]);
+        let g = (u32::from(b'I') - 32) as f32 * 8.0;
+        assert_eq!(v[0].glyph, [g, 0.0]);
+        assert_eq!(v[2].glyph, [g + 5.0, 7.0]);
+        assert_eq!(v[6].pos, [34.0, 20.0]);
         assert_eq!(text_size("ab\ncde", 1.0), [17.0, 16.0]);
+        let mut r = Vec::new();
+        push_rect(&mut r, 0.0, 0.0, 1.0, 1.0, [0; 4]);
+        assert!(r.iter().all(|v| v.glyph == OverlayVertex::SOLID));
+    }
+
+    #[test]
+    fn glyph_table_matches_the_font() {
+        let rows = glyph_rows();
+        assert_eq!(rows.len(), 95 * 7);
+        let a = glyph_index('A') as usize;
+        assert_eq!(
+            &rows[a * 7..a * 7 + 7],
+            glyph('A').map(u32::from).as_slice()
+        );
+        assert_eq!(glyph_index('\u{e9}'), glyph_index('?'));
     }
 }

@@ -5,7 +5,7 @@
 use ash::vk;
 
 use super::device::Device;
-use super::draw::Camera;
+use super::draw::{Camera, DrawStats};
 use super::error::{GpuError, GpuResult, VkResultExt};
 use super::memory::Buffer;
 use super::mirror::{Mirror, MirrorWriter};
@@ -30,6 +30,10 @@ pub(crate) struct FrameSlot {
     pub transient: TransientBuffer,
     /// GPU time of the previous use of this slot.
     pub gpu_ms: Option<f64>,
+    /// Whether a submission signalling `fence` is pending. Only such a fence is waited for:
+    /// the fence is reset just before submitting, so after a failed submission it would
+    /// never signal, and waiting for it would hang the slot forever.
+    pub in_flight: bool,
 }
 
 impl FrameSlot {
@@ -44,6 +48,7 @@ impl FrameSlot {
             release: Vec::new(),
             transient: TransientBuffer::new(always_flush),
             gpu_ms: None,
+            in_flight: false,
         };
         let result = (|| {
             let info = vk::CommandPoolCreateInfo::default()
@@ -74,22 +79,27 @@ impl FrameSlot {
         match result {
             Ok(()) => Ok(slot),
             Err(e) => {
-                slot.destroy(device);
+                // SAFETY: created just above and never used by the GPU.
+                unsafe { slot.destroy(device) };
                 Err(e)
             }
         }
     }
 
-    /// Waits for the slot's previous submission, then recycles what it used.
+    /// Waits for the slot's previous submission (if it was submitted), then recycles what it
+    /// used. A failed wait leaves everything in place, so a later call may try again.
     pub(crate) fn wait_and_recycle(&mut self, device: &Device) -> GpuResult<()> {
-        // SAFETY: the fence belongs to this device.
-        unsafe { device.raw.wait_for_fences(&[self.fence], true, u64::MAX) }
-            .vk("vkWaitForFences")?;
-        if let Some(t) = self.timer.as_mut() {
-            self.gpu_ms = t.read(device).or(self.gpu_ms);
+        if self.in_flight {
+            device.wait_fence(self.fence)?;
+            self.in_flight = false;
+            if let Some(t) = self.timer.as_mut() {
+                self.gpu_ms = t.read(device).or(self.gpu_ms);
+            }
         }
         for b in self.release.drain(..) {
-            device.destroy_buffer(b);
+            // SAFETY: released buffers were last used by this slot's previous submission,
+            // whose fence was just waited for (or which never happened).
+            unsafe { device.destroy_buffer(b) };
         }
         self.transient.reset();
         Ok(())
@@ -116,15 +126,22 @@ impl FrameSlot {
         Ok(())
     }
 
-    /// Destroys everything; the caller waited for the device to be idle.
-    pub(crate) fn destroy(mut self, device: &Device) {
-        for b in self.release.drain(..) {
-            device.destroy_buffer(b);
+    /// Destroys everything.
+    ///
+    /// # Safety
+    /// No submitted GPU work that uses these objects may still be pending (the device is idle
+    /// or lost, or they were never used).
+    pub(crate) unsafe fn destroy(mut self, device: &Device) {
+        // SAFETY: the caller guarantees nothing pending uses them (this function's contract).
+        unsafe {
+            for b in self.release.drain(..) {
+                device.destroy_buffer(b);
+            }
+            if let Some(t) = self.timer.take() {
+                t.destroy(device);
+            }
+            self.transient.destroy(device);
         }
-        if let Some(t) = self.timer.take() {
-            t.destroy(device);
-        }
-        self.transient.destroy(device);
         // SAFETY: idle device; null handles (from a failed `new`) are ignored by Vulkan.
         unsafe {
             device.raw.destroy_semaphore(self.acquire, None);
@@ -144,6 +161,16 @@ pub(crate) struct TargetView {
     pub extent: vk::Extent2D,
     pub format: vk::Format,
     pub samples: vk::SampleCountFlags,
+}
+
+/// State bound in the frame's command buffer, so draws skip binding it again.
+#[derive(Clone, Copy, Default)]
+pub(crate) struct Bound {
+    pub pipeline: vk::Pipeline,
+    pub vertices: Option<(vk::Buffer, u64)>,
+    pub indices: vk::Buffer,
+    /// `None` until set after the last pipeline bind.
+    pub depth_test: Option<bool>,
 }
 
 pub(crate) enum FrameTarget<'a> {
@@ -175,6 +202,10 @@ pub struct Frame<'a> {
     pub(crate) viewport: vk::Rect2D,
     pub(crate) flushes: Vec<vk::MappedMemoryRange<'static>>,
     pub(crate) finished: bool,
+    pub(crate) bound: Bound,
+    pub(crate) stats: DrawStats,
+    /// Offscreen only: copy the image into the readback buffer at the end of the frame.
+    pub(crate) capture: bool,
 }
 
 impl<'a> Frame<'a> {
@@ -187,6 +218,11 @@ impl<'a> Frame<'a> {
     /// Sequential frame number (0 for the renderer's first frame).
     pub fn number(&self) -> u64 {
         self.number
+    }
+
+    /// MSAA samples per pixel of the target.
+    pub fn samples(&self) -> u32 {
+        self.view.samples.as_raw()
     }
 
     /// Target size in pixels.
@@ -234,6 +270,13 @@ impl<'a> Frame<'a> {
         let old = std::mem::replace(mirror, fresh);
         self.renderer.destroy_mirror(old);
         Ok(())
+    }
+
+    /// Offscreen frames: also copy the finished image into the target's readback buffer, for
+    /// [`Renderer::read_pixels`]. Frames that are not captured copy nothing (an image read
+    /// back every frame costs a full-image copy nobody looks at). No effect on swapchains.
+    pub fn capture(&mut self) {
+        self.capture = true;
     }
 
     /// Sets the camera used by subsequent 3D draws.

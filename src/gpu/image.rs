@@ -101,21 +101,27 @@ impl Image {
                 .bind_image_memory(raw, image.allocation.memory(), image.allocation.offset())
         };
         if let Err(e) = bound.vk("vkBindImageMemory") {
-            image.destroy(device);
+            // SAFETY: created just above and never used by the GPU.
+            unsafe { image.destroy(device) };
             return Err(e);
         }
         match create_view(device, raw, desc.format) {
             Ok(view) => image.view = view,
             Err(e) => {
-                image.destroy(device);
+                // SAFETY: created just above and never used by the GPU.
+                unsafe { image.destroy(device) };
                 return Err(e);
             }
         }
         Ok(image)
     }
 
-    /// Destroys view, image and memory. The GPU must be done with them.
-    pub(crate) fn destroy(self, device: &Device) {
+    /// Destroys view, image and memory.
+    ///
+    /// # Safety
+    /// No submitted GPU work that uses these objects may still be pending (the device is idle
+    /// or lost, or they were never used).
+    pub(crate) unsafe fn destroy(self, device: &Device) {
         if self.view != vk::ImageView::null() {
             // SAFETY: no pending GPU use (caller's guarantee); destroyed once.
             unsafe { device.raw.destroy_image_view(self.view, None) };
@@ -178,17 +184,26 @@ impl Attachments {
             }),
             Err(e) => {
                 if let Some(m) = msaa {
-                    m.destroy(device);
+                    // SAFETY: created just above and never used by the GPU.
+                    unsafe { m.destroy(device) };
                 }
                 Err(e)
             }
         }
     }
 
-    pub(crate) fn destroy(self, device: &Device) {
-        if let Some(m) = self.msaa {
-            m.destroy(device);
+    /// Destroys the depth and MSAA attachments.
+    ///
+    /// # Safety
+    /// No submitted GPU work that uses these objects may still be pending (the device is idle
+    /// or lost, or they were never used).
+    pub(crate) unsafe fn destroy(self, device: &Device) {
+        // SAFETY: the caller guarantees nothing pending uses them (this function's contract).
+        unsafe {
+            if let Some(m) = self.msaa {
+                m.destroy(device);
+            }
+            self.depth.destroy(device);
         }
-        self.depth.destroy(device);
     }
 }

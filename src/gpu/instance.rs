@@ -47,17 +47,23 @@ pub struct Instance {
 }
 
 /// Points the Vulkan loader at specific ICD manifest(s) (`VK_DRIVER_FILES`, plus the older
-/// `VK_ICD_FILENAMES`) unless the user already set `VK_DRIVER_FILES`. Tests use it to force
-/// lavapipe. Only the first call in a process has an effect.
-pub fn force_driver_files(path: &str) {
+/// `VK_ICD_FILENAMES`) unless the user already set `VK_DRIVER_FILES`. Only the first call in a
+/// process has an effect. To pick a device among installed drivers without touching the
+/// environment, use [`super::RendererDesc::device`] instead.
+///
+/// # Safety
+/// Mutates the process environment: no other thread may read or write the environment
+/// while this runs (including C code such as a Vulkan loader in another thread), and it must
+/// run before any Vulkan object of this process is created. Call it first thing in `main`,
+/// before spawning threads.
+pub unsafe fn force_driver_files(path: &str) {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
         if std::env::var_os("VK_DRIVER_FILES").is_some() {
             return;
         }
-        // SAFETY: runs once, before this process creates any Vulkan object (every creation
-        // path goes through here first in tests), so no other thread is inside the loader
-        // reading the environment; concurrent callers block on the Once until we return.
+        // SAFETY: the caller guarantees no other thread touches the environment now;
+        // concurrent callers of this function block on the Once until we return.
         unsafe {
             std::env::set_var("VK_DRIVER_FILES", path);
             std::env::set_var("VK_ICD_FILENAMES", path);
@@ -212,8 +218,11 @@ impl Instance {
         self.debug.is_some()
     }
 
-    /// Destroys the messenger and the instance. Every object created from it must be gone.
-    pub fn destroy(self) {
+    /// Destroys the messenger and the instance.
+    ///
+    /// # Safety
+    /// Every object created from the instance (device, surfaces) must already be destroyed.
+    pub(crate) unsafe fn destroy(self) {
         if let Some((loader, messenger)) = self.debug {
             // SAFETY: the messenger belongs to this instance and is destroyed once.
             unsafe { loader.destroy_debug_utils_messenger(messenger, None) };

@@ -134,7 +134,7 @@ fn is_host_visible(location: MemoryLocation) -> bool {
 
 impl Device {
     /// Creates a buffer and binds fresh memory from the allocator.
-    pub fn create_buffer(&self, desc: &BufferDesc<'_>) -> GpuResult<Buffer> {
+    pub(crate) fn create_buffer(&self, desc: &BufferDesc<'_>) -> GpuResult<Buffer> {
         if desc.size == 0 {
             return Err(GpuError::InvalidArgument(format!(
                 "buffer {:?} has size 0",
@@ -178,7 +178,8 @@ impl Device {
                 .bind_buffer_memory(raw, buffer.allocation.memory(), buffer.allocation.offset())
         };
         if let Err(e) = bound.vk("vkBindBufferMemory") {
-            self.destroy_buffer(buffer);
+            // SAFETY: created just above and never used by the GPU.
+            unsafe { self.destroy_buffer(buffer) };
             return Err(e);
         }
         if desc
@@ -193,7 +194,8 @@ impl Device {
             };
         }
         if is_host_visible(desc.location) && buffer.mapped.is_none() {
-            self.destroy_buffer(buffer);
+            // SAFETY: created just above and never used by the GPU.
+            unsafe { self.destroy_buffer(buffer) };
             return Err(GpuError::Internal(format!(
                 "buffer {:?}: host-visible memory is not mapped",
                 desc.name
@@ -202,14 +204,25 @@ impl Device {
         Ok(buffer)
     }
 
-    /// Destroys a buffer and returns its memory. The GPU must be done with it.
-    pub fn destroy_buffer(&self, buffer: Buffer) {
+    /// Destroys a buffer and returns its memory.
+    ///
+    /// # Safety
+    /// No submitted GPU work that uses the buffer may still be pending (its fence signalled,
+    /// the device is idle, or it was never used).
+    pub(crate) unsafe fn destroy_buffer(&self, buffer: Buffer) {
         // SAFETY: the caller guarantees no pending GPU use; the buffer is destroyed once.
         unsafe { self.raw.destroy_buffer(buffer.raw, None) };
         if let Some(a) = self.allocator().as_mut() {
             // A free only fails for a foreign allocation, which cannot happen here.
             let _ = a.free(buffer.allocation);
         }
+    }
+
+    /// Waits for `fence` at most [`super::WAIT_LIMIT`] (then [`GpuError::Timeout`]).
+    pub(crate) fn wait_fence(&self, fence: vk::Fence) -> GpuResult<()> {
+        let limit = u64::try_from(super::WAIT_LIMIT.as_nanos()).unwrap_or(u64::MAX);
+        // SAFETY: the fence belongs to this device.
+        unsafe { self.raw.wait_for_fences(&[fence], true, limit) }.vk("vkWaitForFences")
     }
 
     /// Flushes host writes so the device sees them (no-op call list when empty).

@@ -49,7 +49,8 @@ impl MirrorBuffer {
         match ptr {
             Some(ptr) => Ok(Self { buffer, ptr, len }),
             None => {
-                device.destroy_buffer(buffer);
+                // SAFETY: created just above and never used by the GPU.
+                unsafe { device.destroy_buffer(buffer) };
                 Err(GpuError::Internal(format!(
                     "mirror {name:?}: mapping is missing or misaligned"
                 )))
@@ -97,7 +98,8 @@ impl Mirror {
                 Ok(b) => slots.push(b),
                 Err(e) => {
                     for b in slots {
-                        device.destroy_buffer(b.buffer);
+                        // SAFETY: created just above and never used by the GPU.
+                        unsafe { device.destroy_buffer(b.buffer) };
                     }
                     return Err(e);
                 }

@@ -25,6 +25,7 @@
 //! frame.set_camera(Camera::default());
 //! frame.draw_surface(&mirror, grid, &SurfaceStyle::default())?;
 //! frame.draw_wire(&mirror, grid, 8, [0.0, 0.0, 0.0, 1.0])?;
+//! frame.capture(); // copy the image out for read_pixels (frames copy nothing by default)
 //! frame.finish()?;
 //! let pixels = renderer.read_pixels(&target)?;
 //! # renderer.destroy_mirror(mirror);
@@ -39,7 +40,8 @@
 //!   every change made since *it* was last written (keep per-slot dirty ranges).
 //! * Draw calls record into the frame; rendering begins lazily with the clear.
 //! * [`Frame::finish`] ends recording, flushes non-coherent host writes (aligned to
-//!   `nonCoherentAtomSize`), submits with `vkQueueSubmit2`, presents for swapchains.
+//!   `nonCoherentAtomSize`), submits with `vkQueueSubmit2`, presents for swapchains. If it
+//!   fails, the slot stays usable (see the README's "Errors and failure injection").
 //!
 //! Mapped memory is never read: mirrors expose only writes (it may be write-combined).
 //!
@@ -83,21 +85,27 @@ mod validation;
 /// Frames the CPU may record ahead of the GPU; also the number of slots of every mirror.
 pub const FRAMES_IN_FLIGHT: usize = 2;
 
+/// The longest the renderer waits for the GPU (a fence) before reporting
+/// [`GpuError::Timeout`] instead of hanging: far beyond any frame, even in software.
+pub const WAIT_LIMIT: std::time::Duration = std::time::Duration::from_secs(30);
+
 pub use ash::vk;
 pub use device::{Device, DeviceCaps, GPU_ENV};
 pub use draw::{
-    Camera, LineVertex, OverlayVertex, PointRun, PointStyle, PolylineStyle, SurfaceGrid,
-    SurfaceStyle,
+    Camera, DrawStats, LineVertex, OverlayVertex, PointRun, PointStyle, PolylineStyle,
+    SurfaceBatch, SurfaceGrid, SurfaceStyle,
 };
 pub use error::{GpuError, GpuResult};
 pub use frame::Frame;
-pub use grid::{GridShape, grid_lines, grid_triangles};
+pub use grid::{
+    GridShape, GridStride, grid_lines, grid_lines_strided, grid_triangles, grid_triangles_strided,
+};
 pub use instance::{ValidationMode, force_driver_files};
 pub use memory::{Buffer, BufferDesc};
 pub use mirror::{Mirror, MirrorBuffer, MirrorWriter};
 pub use offscreen::{OFFSCREEN_FORMAT, OffscreenDesc, OffscreenTarget, Pixels};
 pub use pipeline::DEPTH_FORMAT;
-pub use renderer::{Renderer, RendererDesc};
+pub use renderer::{Fault, Renderer, RendererDesc};
 pub use swapchain::{Swapchain, SwapchainDesc};
 pub use validation::{Severity, ValidationMessage, ValidationSink};
 

@@ -54,6 +54,10 @@ pub(crate) struct PolylinePush {
     pub stride: u32,
     pub count: u32,
     pub width: f32,
+    /// 0: one polyline through the run; n > 0: a control net of rows of n points.
+    pub grid_cols: u32,
+    /// 1: one-pixel lines (line list, 2 vertices per segment); 0: wide quads (6 per segment).
+    pub thin: u32,
 }
 
 /// Push constants of `points.vert`.
@@ -71,6 +75,9 @@ pub(crate) struct PointsPush {
     pub color: u32,
     pub hovered_color: u32,
     pub selected_color: u32,
+    /// 1: one quad (6 vertices) per point; 0: one point primitive per point (`largePoints`).
+    pub quads: u32,
+    pub _pad: u32,
 }
 
 /// Push constants of `lines3d.vert`.
@@ -80,11 +87,13 @@ pub(crate) struct Lines3dPush {
     pub view_proj: [f32; 16],
 }
 
-/// Push constants of `overlay.vert`.
+/// Push constants of `overlay.vert` + `overlay.frag`.
 #[repr(C)]
 #[derive(Clone, Copy)]
 pub(crate) struct OverlayPush {
     pub viewport: [f32; 2],
+    /// Device address of the font table (one u32 of 5 bits per glyph row).
+    pub font: u64,
 }
 
 // SAFETY: all push structs are repr(C) with fields laid out without padding (the size and
@@ -104,10 +113,14 @@ unsafe impl Pod for OverlayPush {}
 const _: () = {
     assert!(size_of::<SurfacePush>() == 128);
     assert!(size_of::<WirePush>() == 80);
-    assert!(size_of::<PolylinePush>() == 112);
-    assert!(size_of::<PointsPush>() == 112);
+    assert!(size_of::<PolylinePush>() == 120);
+    assert!(size_of::<PointsPush>() == 120);
+    assert!(offset_of!(PointsPush, quads) == 112);
+    assert!(offset_of!(PolylinePush, thin) == 116);
     assert!(size_of::<Lines3dPush>() == 64);
-    assert!(size_of::<OverlayPush>() == 8);
+    assert!(size_of::<OverlayPush>() == 16);
+    assert!(offset_of!(OverlayPush, font) == 8);
+    assert!(offset_of!(PolylinePush, grid_cols) == 112);
     // std430 offsets of the blocks in surface.*, polyline.vert and points.vert.
     assert!(offset_of!(SurfacePush, eye) == 64);
     assert!(offset_of!(SurfacePush, back) == 112);
@@ -134,6 +147,8 @@ pub(crate) struct PipelineSet {
     pub surface: vk::Pipeline,
     pub wire: vk::Pipeline,
     pub polyline: vk::Pipeline,
+    /// `polyline.vert` as a line list: one-pixel lines and nets, 2 vertices per segment.
+    pub thin_lines: vk::Pipeline,
     pub points: vk::Pipeline,
     pub lines3d: vk::Pipeline,
     pub overlay: vk::Pipeline,
@@ -218,12 +233,18 @@ impl Pipelines {
         })
     }
 
-    pub(crate) fn destroy(self, device: &Device) {
+    /// Destroys every pipeline and the layout.
+    ///
+    /// # Safety
+    /// No submitted GPU work that uses these objects may still be pending (the device is idle
+    /// or lost, or they were never used).
+    pub(crate) unsafe fn destroy(self, device: &Device) {
         for set in self.sets.into_values() {
             for p in [
                 set.surface,
                 set.wire,
                 set.polyline,
+                set.thin_lines,
                 set.points,
                 set.lines3d,
                 set.overlay,
@@ -254,10 +275,11 @@ fn build_set(
         attribute(0, F::R32G32B32_SFLOAT, 0),
         attribute(1, F::R8G8B8A8_UNORM, 12),
     ];
-    let overlay_binding = binding(12);
+    let overlay_binding = binding(20);
     let overlay_attrs = [
         attribute(0, F::R32G32_SFLOAT, 0),
         attribute(1, F::R8G8B8A8_UNORM, 8),
+        attribute(2, F::R32G32_SFLOAT, 12),
     ];
     let tri = vk::PrimitiveTopology::TRIANGLE_LIST;
     let specs = [
@@ -293,7 +315,21 @@ fn build_set(
             fs: ShaderId::PointsFrag,
             bindings: &[],
             attributes: &[],
-            topology: tri,
+            // Large point primitives: a sixth of the vertex work of quads.
+            topology: if device.caps.large_points {
+                vk::PrimitiveTopology::POINT_LIST
+            } else {
+                tri
+            },
+            depth: Depth::Dynamic,
+            blend: false,
+        },
+        Spec {
+            vs: ShaderId::PolylineVert,
+            fs: ShaderId::FlatFrag,
+            bindings: &[],
+            attributes: &[],
+            topology: vk::PrimitiveTopology::LINE_LIST,
             depth: Depth::Dynamic,
             blend: false,
         },
@@ -308,7 +344,7 @@ fn build_set(
         },
         Spec {
             vs: ShaderId::OverlayVert,
-            fs: ShaderId::ColorFrag,
+            fs: ShaderId::OverlayFrag,
             bindings: &overlay_binding,
             attributes: &overlay_attrs,
             topology: tri,
@@ -334,8 +370,9 @@ fn build_set(
         wire: pipelines[1],
         polyline: pipelines[2],
         points: pipelines[3],
-        lines3d: pipelines[4],
-        overlay: pipelines[5],
+        lines3d: pipelines[5],
+        overlay: pipelines[6],
+        thin_lines: pipelines[4],
     })
 }
 

@@ -2,6 +2,7 @@
 
 use std::mem::ManuallyDrop;
 
+use ash::vk;
 use raw_window_handle::RawDisplayHandle;
 
 use super::FRAMES_IN_FLIGHT;
@@ -10,9 +11,13 @@ use super::error::{GpuError, GpuResult};
 use super::frame::FrameSlot;
 use super::grid::GridCache;
 use super::instance::{Instance, InstanceDesc, ValidationMode};
+use super::memory::Buffer;
 use super::mirror::Mirror;
+use super::offscreen::OffscreenTarget;
 use super::pipeline::Pipelines;
+use super::pod::slice_bytes;
 use super::shader::Shaders;
+use super::swapchain::Swapchain;
 use super::upload::Uploader;
 use super::validation::ValidationSink;
 
@@ -30,6 +35,28 @@ pub struct RendererDesc {
     /// Flush host writes even when memory is coherent. Only useful to exercise the
     /// non-coherent path (under validation) on drivers whose memory is all coherent.
     pub always_flush: bool,
+    /// The device to use: the first whose name contains this (case-insensitive), e.g.
+    /// `"llvmpipe"` for Mesa's software rasteriser among several installed drivers. `None`
+    /// follows `PRESPLINE_GPU`, else prefers discrete > integrated > virtual > CPU.
+    pub device: Option<String>,
+}
+
+/// A failure a test makes the renderer report instead of calling Vulkan, to exercise error
+/// paths that real drivers rarely take ([`Renderer::inject_fault`]).
+#[doc(hidden)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Fault {
+    /// The next `vkQueueSubmit2` of a frame returns this result (after its fence was reset).
+    Submit(vk::Result),
+    /// The next static upload's `vkWaitForFences` returns this result after a successful
+    /// submission (the copy may still be running).
+    UploadWait(vk::Result),
+}
+
+/// A resource given back while the GPU might still use it (a wait for it failed).
+pub(crate) enum Orphan {
+    Target(OffscreenTarget),
+    Swapchain(Swapchain),
 }
 
 /// The GPU renderer. See the [module docs](super) for the frame protocol.
@@ -44,7 +71,14 @@ pub struct Renderer {
     pub(crate) shaders: Shaders,
     pub(crate) grids: GridCache,
     pub(crate) uploader: Uploader,
+    /// The HUD font's glyph rows in device memory (read by `overlay.frag` through its address).
+    pub(crate) font: Option<Buffer>,
     pub(crate) always_flush: bool,
+    /// A failure to report at the next matching call (error-path tests).
+    pub(crate) fault: Option<Fault>,
+    /// Objects whose GPU use could not be shown to have ended when they were given back;
+    /// destroyed after the final wait in `Drop`.
+    pub(crate) orphans: Vec<Orphan>,
     // Dropped by hand, in order, after everything above (see `Drop`).
     pub(crate) device: ManuallyDrop<Device>,
     pub(crate) instance: ManuallyDrop<Instance>,
@@ -63,10 +97,11 @@ impl Renderer {
             sync_validation: desc.sync_validation,
             display: desc.display,
         })?;
-        let device = match Device::new(&instance) {
+        let device = match Device::new(&instance, desc.device.as_deref()) {
             Ok(d) => d,
             Err(e) => {
-                instance.destroy();
+                // SAFETY: nothing was created from the instance (the device failed).
+                unsafe { instance.destroy() };
                 return Err(e);
             }
         };
@@ -78,13 +113,24 @@ impl Renderer {
             shaders: Shaders::default(),
             grids: GridCache::default(),
             uploader: Uploader::default(),
+            font: None,
             always_flush: desc.always_flush,
+            fault: None,
+            orphans: Vec::new(),
             device: ManuallyDrop::new(device),
             instance: ManuallyDrop::new(instance),
         };
         renderer.shaders = Shaders::new(&renderer.device)?;
         renderer.pipelines = Pipelines::new(&renderer.device)?;
         renderer.uploader = Uploader::new(&renderer.device)?;
+        renderer.font = Some(renderer.uploader.upload(
+            &renderer.device,
+            "font",
+            slice_bytes(&super::font::glyph_rows()),
+            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS,
+            vk::PipelineStageFlags2::FRAGMENT_SHADER,
+            vk::AccessFlags2::SHADER_STORAGE_READ,
+        )?);
         for _ in 0..FRAMES_IN_FLIGHT {
             let slot = FrameSlot::new(&renderer.device, desc.always_flush)?;
             renderer.frames.push(slot);
@@ -120,6 +166,17 @@ impl Renderer {
             .get(prev)
             .and_then(|f| f.gpu_ms)
             .or_else(|| self.frames.iter().find_map(|f| f.gpu_ms))
+    }
+
+    /// Makes the next matching call fail with `fault` instead of reaching the driver. For
+    /// tests of error paths (a submission that fails, a wait that fails): the renderer must
+    /// report the error, never hang, and stay usable where the error allows.
+    #[doc(hidden)]
+    pub fn inject_fault(&mut self, fault: Fault) {
+        match fault {
+            Fault::Submit(_) => self.fault = Some(fault),
+            Fault::UploadWait(result) => self.uploader.fail_next_wait(result),
+        }
     }
 
     /// Blocks until the GPU has finished all submitted work.
@@ -161,7 +218,9 @@ impl Renderer {
         for (i, b) in mirror.slots.into_iter().enumerate() {
             match self.frames.get_mut(i) {
                 Some(f) => f.release.push(b.buffer),
-                None => self.device.destroy_buffer(b.buffer),
+                // No slot, so no frame ever used this buffer.
+                // SAFETY: a buffer without a frame slot was never bound by a submission.
+                None => unsafe { self.device.destroy_buffer(b.buffer) },
             }
         }
     }
@@ -188,25 +247,45 @@ impl Renderer {
 
 impl Drop for Renderer {
     fn drop(&mut self) {
-        // Even if the device is lost there is nothing better to do than destroy everything.
-        let _ = self.device.wait_idle();
-        let device = &*self.device;
-        for f in std::mem::take(&mut self.frames) {
-            f.destroy(device);
+        match self.device.wait_idle() {
+            // Idle, or lost (nothing executes on a lost device): everything may go.
+            Ok(()) => {}
+            Err(e) if e.is_device_lost() => {}
+            // The GPU may still be running our work: destroying it would be undefined
+            // behaviour, so everything is leaked instead (the process is usually ending).
+            Err(_) => return,
         }
-        std::mem::take(&mut self.grids).destroy(device);
-        std::mem::take(&mut self.uploader).destroy(device);
-        std::mem::take(&mut self.pipelines).destroy(device);
-        std::mem::take(&mut self.shaders).destroy(device);
+        for orphan in std::mem::take(&mut self.orphans) {
+            // SAFETY: the device is idle or lost, so no GPU work uses them.
+            unsafe {
+                match orphan {
+                    Orphan::Target(t) => t.destroy(&self.device),
+                    Orphan::Swapchain(s) => self.destroy_swapchain_now(s),
+                }
+            }
+        }
+        let device = &*self.device;
+        // SAFETY: the device is idle or lost, so no GPU work uses any of these objects.
+        unsafe {
+            for f in std::mem::take(&mut self.frames) {
+                f.destroy(device);
+            }
+            std::mem::take(&mut self.grids).destroy(device);
+            std::mem::take(&mut self.uploader).destroy(device);
+            if let Some(font) = self.font.take() {
+                device.destroy_buffer(font);
+            }
+            std::mem::take(&mut self.pipelines).destroy(device);
+            std::mem::take(&mut self.shaders).destroy(device);
+        }
         // SAFETY: `device` and `instance` are taken exactly once, here, and never used again;
-        // every child object was destroyed above (or by the caller via destroy_*).
-        let (device, instance) = unsafe {
-            (
-                ManuallyDrop::take(&mut self.device),
-                ManuallyDrop::take(&mut self.instance),
-            )
-        };
-        device.destroy();
-        instance.destroy();
+        // every child object was destroyed above (or by the caller via destroy_*), and the
+        // device is idle or lost.
+        unsafe {
+            let device = ManuallyDrop::take(&mut self.device);
+            let instance = ManuallyDrop::take(&mut self.instance);
+            device.destroy();
+            instance.destroy();
+        }
     }
 }

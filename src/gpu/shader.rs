@@ -26,9 +26,10 @@ pub(crate) enum ShaderId {
     Lines3dVert,
     OverlayVert,
     ColorFrag,
+    OverlayFrag,
 }
 
-const SOURCES: [(ShaderId, &str, &[u8]); 10] = [
+const SOURCES: [(ShaderId, &str, &[u8]); 11] = [
     (
         ShaderId::SurfaceVert,
         "surface.vert",
@@ -59,6 +60,11 @@ const SOURCES: [(ShaderId, &str, &[u8]); 10] = [
         spirv!("overlay.vert"),
     ),
     (ShaderId::ColorFrag, "color.frag", spirv!("color.frag")),
+    (
+        ShaderId::OverlayFrag,
+        "overlay.frag",
+        spirv!("overlay.frag"),
+    ),
 ];
 
 /// The shader modules, created once; pipelines for new target formats are built from them.
@@ -77,7 +83,8 @@ impl Shaders {
             match create_module(device, name, bytes) {
                 Ok(m) => shaders.modules.push(m),
                 Err(e) => {
-                    shaders.destroy(device);
+                    // SAFETY: no pipeline was built from these modules yet.
+                    unsafe { shaders.destroy(device) };
                     return Err(e);
                 }
             }
@@ -89,7 +96,12 @@ impl Shaders {
         self.modules[id as usize]
     }
 
-    pub(crate) fn destroy(self, device: &Device) {
+    /// Destroys the modules (pipelines keep their own copies of the code).
+    ///
+    /// # Safety
+    /// No submitted GPU work that uses these objects may still be pending (the device is idle
+    /// or lost, or they were never used).
+    pub(crate) unsafe fn destroy(self, device: &Device) {
         for m in self.modules {
             // SAFETY: pipelines built from the module keep their own copy; modules are unused.
             unsafe { device.raw.destroy_shader_module(m, None) };

@@ -10,12 +10,12 @@ use ash::vk;
 
 use super::FRAMES_IN_FLIGHT;
 use super::draw::Camera;
-use super::error::{GpuError, GpuResult, VkResultExt};
+use super::error::{GpuError, GpuResult, VkResultExt, vk_error};
 use super::frame::{Frame, FrameTarget, TargetView};
 use super::image::full_range;
 use super::offscreen::OffscreenTarget;
-use super::pipeline::{DEPTH_FORMAT, PipelineKey};
-use super::renderer::Renderer;
+use super::pipeline::{DEPTH_FORMAT, PipelineKey, PipelineSet};
+use super::renderer::{Fault, Renderer};
 use super::swapchain::Swapchain;
 
 const DEFAULT_CLEAR: [f32; 4] = [0.02, 0.02, 0.025, 1.0];
@@ -118,6 +118,7 @@ impl Renderer {
         &'a mut self,
         swapchain: &'a mut Swapchain,
     ) -> GpuResult<Option<Frame<'a>>> {
+        self.collect_retired(swapchain, false);
         if swapchain.stale && !self.rebuild_swapchain(swapchain)? {
             return Ok(None);
         }
@@ -132,10 +133,11 @@ impl Renderer {
             return Err(GpuError::Surface("device has no VK_KHR_swapchain".into()));
         };
         let acquire = self.frames[slot].acquire;
+        let limit = u64::try_from(super::WAIT_LIMIT.as_nanos()).unwrap_or(u64::MAX);
         // SAFETY: valid swapchain; the slot's acquire semaphore is unsignalled and not in use
         // (its previous waiter, this slot's last submission, has completed).
         let acquired = unsafe {
-            swapchain_fn.acquire_next_image(swapchain.raw, u64::MAX, acquire, vk::Fence::null())
+            swapchain_fn.acquire_next_image(swapchain.raw, limit, acquire, vk::Fence::null())
         };
         let image_index = match acquired {
             Ok((index, suboptimal)) => {
@@ -147,23 +149,52 @@ impl Renderer {
                 swapchain.stale = true;
                 return Ok(None);
             }
-            Err(result) => {
-                return Err(GpuError::Vk {
-                    call: "vkAcquireNextImageKHR",
-                    result,
-                });
-            }
+            Err(result) => return Err(vk_error("vkAcquireNextImageKHR", result)),
         };
+        // From here on the acquire semaphore is signalled: every way out must consume it.
         let Some(view) = swapchain.view(image_index) else {
+            swapchain.stale = true;
+            self.consume_acquire(slot);
             return Err(GpuError::Surface(format!(
                 "acquired image {image_index} does not exist"
             )));
+        };
+        let pipelines = match self.prepare(view, slot, true) {
+            Ok(p) => p,
+            Err(e) => {
+                swapchain.stale = true;
+                self.consume_acquire(slot);
+                return Err(e);
+            }
         };
         let target = FrameTarget::Swapchain {
             swapchain,
             image_index,
         };
-        self.start(target, view, slot).map(Some)
+        Ok(Some(self.frame(target, view, slot, pipelines)))
+    }
+
+    /// Consumes a signalled acquire semaphore of `slot` with an empty submission that also
+    /// signals the slot's fence, so the slot can acquire again. Best effort: it runs only on
+    /// error paths, whose error is the one reported.
+    pub(crate) fn consume_acquire(&mut self, slot: usize) {
+        let device = &*self.device;
+        let frame_slot = &mut self.frames[slot];
+        let waits = [vk::SemaphoreSubmitInfo::default()
+            .semaphore(frame_slot.acquire)
+            .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)];
+        let submit = [vk::SubmitInfo2::default().wait_semaphore_infos(&waits)];
+        // SAFETY: no submission using the slot's fence is pending (`in_flight` is false: the
+        // slot was waited for at begin and the failed frame never submitted), so it may be
+        // reset; the acquire semaphore has a pending signal and no waiter yet.
+        let consumed = unsafe {
+            device.raw.reset_fences(&[frame_slot.fence]).and_then(|()| {
+                device
+                    .raw
+                    .queue_submit2(device.queue, &submit, frame_slot.fence)
+            })
+        };
+        frame_slot.in_flight = consumed.is_ok();
     }
 
     /// Waits for the next slot's previous submission and recycles its resources.
@@ -179,13 +210,26 @@ impl Renderer {
         view: TargetView,
         slot: usize,
     ) -> GpuResult<Frame<'a>> {
+        let swapchain = matches!(target, FrameTarget::Swapchain { .. });
+        let pipelines = self.prepare(view, slot, swapchain)?;
+        Ok(self.frame(target, view, slot, pipelines))
+    }
+
+    /// The fallible part of starting a frame: pipelines for the target, the slot's command
+    /// buffer begun, the attachments' barriers recorded.
+    fn prepare(
+        &mut self,
+        view: TargetView,
+        slot: usize,
+        swapchain: bool,
+    ) -> GpuResult<PipelineSet> {
         let pipelines = *self
             .pipelines
             .get(&self.device, &self.shaders, pipeline_key(&view))?;
         let frame_slot = &mut self.frames[slot];
         frame_slot.begin_commands(&self.device)?;
         let cmd = frame_slot.cmd;
-        let barriers = begin_barriers(&view, matches!(target, FrameTarget::Swapchain { .. }));
+        let barriers = begin_barriers(&view, swapchain);
         // SAFETY: `cmd` is recording; images are live and owned by the target.
         unsafe {
             self.device.raw.cmd_pipeline_barrier2(
@@ -193,8 +237,19 @@ impl Renderer {
                 &vk::DependencyInfo::default().image_memory_barriers(&barriers),
             )
         };
+        Ok(pipelines)
+    }
+
+    fn frame<'a>(
+        &'a mut self,
+        target: FrameTarget<'a>,
+        view: TargetView,
+        slot: usize,
+        pipelines: PipelineSet,
+    ) -> Frame<'a> {
+        let cmd = self.frames[slot].cmd;
         let number = self.frame_number;
-        Ok(Frame {
+        Frame {
             renderer: self,
             target,
             view,
@@ -211,18 +266,46 @@ impl Renderer {
             },
             flushes: Vec::new(),
             finished: false,
-        })
+            bound: Default::default(),
+            stats: Default::default(),
+            capture: false,
+        }
     }
+}
+
+/// What a successful submission leaves to do: present a swapchain image.
+struct Submitted {
+    present: Option<(vk::SwapchainKHR, u32, vk::Semaphore)>,
 }
 
 impl Frame<'_> {
     /// Records the end of the frame, flushes host writes, submits and presents.
+    ///
+    /// If anything fails before the submission is accepted, the slot stays usable: its fence
+    /// is only waited for when a submission will signal it, and a swapchain image's acquire
+    /// semaphore, already signalled, is consumed by an empty submission so the slot can
+    /// acquire again.
     pub(crate) fn finish_inner(&mut self) -> GpuResult<()> {
+        match self.record_and_submit() {
+            Ok(submitted) => {
+                self.renderer.frame_number += 1;
+                self.present(submitted)
+            }
+            Err(e) => {
+                self.recover_unsubmitted();
+                Err(e)
+            }
+        }
+    }
+
+    /// Ends recording and submits; the offscreen image is copied out when captured.
+    fn record_and_submit(&mut self) -> GpuResult<Submitted> {
         // Begin rendering even for an empty frame so the clear happens.
         self.ensure_rendering();
         let cmd = self.cmd;
         let slot = self.slot;
         let view = self.view;
+        let capture = self.capture;
         let renderer = &mut *self.renderer;
         let device = &*renderer.device;
         let raw = &device.raw;
@@ -232,64 +315,11 @@ impl Frame<'_> {
         unsafe { raw.cmd_end_rendering(cmd) };
         match &mut self.target {
             FrameTarget::Offscreen(target) => {
-                let to_src = [image_barrier(
-                    view.image,
-                    view.format,
-                    (S::COLOR_ATTACHMENT_OUTPUT, A::COLOR_ATTACHMENT_WRITE),
-                    (S::COPY, A::TRANSFER_READ),
-                    (
-                        vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-                        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                    ),
-                )];
-                let readback = &target.readback[slot];
-                let region = vk::BufferImageCopy {
-                    buffer_offset: 0,
-                    buffer_row_length: 0,
-                    buffer_image_height: 0,
-                    image_subresource: vk::ImageSubresourceLayers {
-                        aspect_mask: vk::ImageAspectFlags::COLOR,
-                        mip_level: 0,
-                        base_array_layer: 0,
-                        layer_count: 1,
-                    },
-                    image_offset: vk::Offset3D::default(),
-                    image_extent: vk::Extent3D {
-                        width: view.extent.width,
-                        height: view.extent.height,
-                        depth: 1,
-                    },
-                };
-                let to_host = [vk::BufferMemoryBarrier2::default()
-                    .src_stage_mask(S::COPY)
-                    .src_access_mask(A::TRANSFER_WRITE)
-                    .dst_stage_mask(S::HOST)
-                    .dst_access_mask(A::HOST_READ)
-                    .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                    .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                    .buffer(readback.raw)
-                    .offset(0)
-                    .size(vk::WHOLE_SIZE)];
-                // SAFETY: recording outside rendering; the readback buffer of this slot is
-                // not read by the host until this submission's fence signals.
-                unsafe {
-                    raw.cmd_pipeline_barrier2(
-                        cmd,
-                        &vk::DependencyInfo::default().image_memory_barriers(&to_src),
-                    );
-                    raw.cmd_copy_image_to_buffer(
-                        cmd,
-                        view.image,
-                        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                        readback.raw,
-                        &[region],
-                    );
-                    raw.cmd_pipeline_barrier2(
-                        cmd,
-                        &vk::DependencyInfo::default().buffer_memory_barriers(&to_host),
-                    );
+                // Until this submission is accepted, no pixels are readable.
+                target.last_slot = None;
+                if capture {
+                    record_readback(device, cmd, &view, &target.readback[slot]);
                 }
-                target.last_slot = Some(slot);
             }
             FrameTarget::Swapchain { .. } => {
                 let to_present = [image_barrier(
@@ -351,42 +381,127 @@ impl Frame<'_> {
             .wait_semaphore_infos(&waits)
             .command_buffer_infos(&cmds)
             .signal_semaphore_infos(&signals)];
-        // SAFETY: the fence is signalled and unused (waited at begin); resetting it only now
-        // means an error anywhere above leaves it signalled, so the slot never deadlocks.
-        unsafe {
-            raw.reset_fences(&[frame_slot.fence]).vk("vkResetFences")?;
-            raw.queue_submit2(device.queue, &submit, frame_slot.fence)
-                .vk("vkQueueSubmit2")?;
+        // SAFETY: the slot has no pending submission (begin waited for it, or the last one
+        // failed), so its fence is not in use and may be reset.
+        unsafe { raw.reset_fences(&[frame_slot.fence]) }.vk("vkResetFences")?;
+        if let Some(Fault::Submit(result)) = renderer.fault.take() {
+            return Err(vk_error("vkQueueSubmit2", result));
         }
-        renderer.frame_number += 1;
+        // SAFETY: the command buffer is executable, the fence unsignalled and unused, and the
+        // queue is only used from `&mut Renderer`.
+        unsafe { raw.queue_submit2(device.queue, &submit, frame_slot.fence) }
+            .vk("vkQueueSubmit2")?;
+        frame_slot.in_flight = true;
+        if let FrameTarget::Offscreen(target) = &mut self.target {
+            target.last_slot = capture.then_some(slot);
+        }
+        Ok(Submitted { present })
+    }
 
-        if let (Some((swapchain_raw, index, wait)), Some(swapchain_fn)) =
-            (present, device.swapchain_fn.as_ref())
-        {
-            let swapchains = [swapchain_raw];
-            let indices = [index];
-            let waits = [wait];
-            let info = vk::PresentInfoKHR::default()
-                .wait_semaphores(&waits)
-                .swapchains(&swapchains)
-                .image_indices(&indices);
-            // SAFETY: the image was acquired this frame and its semaphore is signalled by
-            // the submission above.
-            let result = unsafe { swapchain_fn.queue_present(device.queue, &info) };
-            let stale = match result {
-                Ok(suboptimal) => suboptimal,
-                Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => true,
-                Err(result) => {
-                    return Err(GpuError::Vk {
-                        call: "vkQueuePresentKHR",
-                        result,
-                    });
-                }
-            };
-            if let FrameTarget::Swapchain { swapchain, .. } = &mut self.target {
-                swapchain.stale |= stale;
-            }
+    fn present(&mut self, submitted: Submitted) -> GpuResult<()> {
+        let device = &*self.renderer.device;
+        let (Some((swapchain_raw, index, wait)), Some(swapchain_fn)) =
+            (submitted.present, device.swapchain_fn.as_ref())
+        else {
+            return Ok(());
+        };
+        let swapchains = [swapchain_raw];
+        let indices = [index];
+        let waits = [wait];
+        let info = vk::PresentInfoKHR::default()
+            .wait_semaphores(&waits)
+            .swapchains(&swapchains)
+            .image_indices(&indices);
+        // SAFETY: the image was acquired this frame and its semaphore is signalled by the
+        // submission above.
+        let result = unsafe { swapchain_fn.queue_present(device.queue, &info) };
+        let stale = match result {
+            Ok(suboptimal) => suboptimal,
+            Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => true,
+            Err(result) => return Err(vk_error("vkQueuePresentKHR", result)),
+        };
+        if let FrameTarget::Swapchain { swapchain, .. } = &mut self.target {
+            swapchain.stale |= stale;
         }
         Ok(())
+    }
+
+    /// After a failure before submission: a swapchain frame's acquire semaphore is signalled
+    /// and would make the slot's next acquire invalid, so it is consumed, and the swapchain
+    /// is rebuilt at the next begin, which releases the image that will not be presented.
+    fn recover_unsubmitted(&mut self) {
+        let FrameTarget::Swapchain { swapchain, .. } = &mut self.target else {
+            return;
+        };
+        swapchain.stale = true;
+        self.renderer.consume_acquire(self.slot);
+    }
+}
+
+/// Copies the offscreen image into `readback` and makes it visible to the host.
+fn record_readback(
+    device: &super::device::Device,
+    cmd: vk::CommandBuffer,
+    view: &TargetView,
+    readback: &super::memory::Buffer,
+) {
+    use vk::AccessFlags2 as A;
+    use vk::PipelineStageFlags2 as S;
+    let raw = &device.raw;
+    let to_src = [image_barrier(
+        view.image,
+        view.format,
+        (S::COLOR_ATTACHMENT_OUTPUT, A::COLOR_ATTACHMENT_WRITE),
+        (S::COPY, A::TRANSFER_READ),
+        (
+            vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+        ),
+    )];
+    let region = vk::BufferImageCopy {
+        buffer_offset: 0,
+        buffer_row_length: 0,
+        buffer_image_height: 0,
+        image_subresource: vk::ImageSubresourceLayers {
+            aspect_mask: vk::ImageAspectFlags::COLOR,
+            mip_level: 0,
+            base_array_layer: 0,
+            layer_count: 1,
+        },
+        image_offset: vk::Offset3D::default(),
+        image_extent: vk::Extent3D {
+            width: view.extent.width,
+            height: view.extent.height,
+            depth: 1,
+        },
+    };
+    let to_host = [vk::BufferMemoryBarrier2::default()
+        .src_stage_mask(S::COPY)
+        .src_access_mask(A::TRANSFER_WRITE)
+        .dst_stage_mask(S::HOST)
+        .dst_access_mask(A::HOST_READ)
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .buffer(readback.raw)
+        .offset(0)
+        .size(vk::WHOLE_SIZE)];
+    // SAFETY: recording outside rendering; the slot's readback buffer is not read by the host
+    // until this submission's fence signals.
+    unsafe {
+        raw.cmd_pipeline_barrier2(
+            cmd,
+            &vk::DependencyInfo::default().image_memory_barriers(&to_src),
+        );
+        raw.cmd_copy_image_to_buffer(
+            cmd,
+            view.image,
+            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+            readback.raw,
+            &[region],
+        );
+        raw.cmd_pipeline_barrier2(
+            cmd,
+            &vk::DependencyInfo::default().buffer_memory_barriers(&to_host),
+        );
     }
 }

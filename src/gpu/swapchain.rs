@@ -1,14 +1,17 @@
 //! Window surface and swapchain: creation from a raw-window-handle window, present-mode
 //! choice, recreation on resize / out-of-date / suboptimal, and minimised (zero-size) windows.
 
+use std::sync::Arc;
+
 use ash::vk;
 use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 
+use super::FRAMES_IN_FLIGHT;
 use super::device::Device;
 use super::error::{GpuError, GpuResult, VkResultExt};
 use super::frame::TargetView;
 use super::image::{Attachments, create_view};
-use super::renderer::Renderer;
+use super::renderer::{Orphan, Renderer};
 
 /// Parameters for [`Renderer::create_swapchain`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -24,7 +27,12 @@ pub struct SwapchainDesc {
 }
 
 /// A surface and its swapchain. Destroy with [`Renderer::destroy_swapchain`].
+///
+/// It holds a reference to its window, so the window's handles stay valid for as long as the
+/// surface exists.
 pub struct Swapchain {
+    /// Keeps the window (and so its native handles) alive; dropped after the surface is gone.
+    _window: Arc<dyn std::any::Any + Send + Sync>,
     surface: vk::SurfaceKHR,
     pub(crate) raw: vk::SwapchainKHR,
     images: Vec<vk::Image>,
@@ -41,6 +49,21 @@ pub struct Swapchain {
     present_mode: vk::PresentModeKHR,
     /// Set on resize, out-of-date or suboptimal; the next begin recreates.
     pub(crate) stale: bool,
+    /// Swapchains replaced by a rebuild, kept with their semaphores until presentation is
+    /// surely done with them (see [`Retired`]).
+    retired: Vec<Retired>,
+}
+
+/// A swapchain replaced by a rebuild. `vkDeviceWaitIdle` covers queue work but not the
+/// presentation engine, which may still wait on the old swapchain's render-finished
+/// semaphores or show its images, so they are destroyed only after `until` frames have been
+/// submitted: by then every image of the old swapchain has been cycled through by presents
+/// that the presentation engine processes in order. (`VK_EXT_swapchain_maintenance1`'s present
+/// fences would make this exact; lavapipe 22.3 does not offer it.)
+struct Retired {
+    raw: vk::SwapchainKHR,
+    semaphores: Vec<vk::Semaphore>,
+    until: u64,
 }
 
 impl Swapchain {
@@ -92,14 +115,18 @@ impl Swapchain {
     }
 
     /// Destroys views and attachments (not the swapchain, surface or semaphores).
-    fn destroy_images(&mut self, device: &Device) {
+    ///
+    /// # Safety
+    /// The device must be idle (or lost): no frame still renders into these attachments.
+    unsafe fn destroy_images(&mut self, device: &Device) {
         for v in self.views.drain(..) {
             // SAFETY: the caller made the device idle.
             unsafe { device.raw.destroy_image_view(v, None) };
         }
         self.images.clear();
         if let Some(a) = self.attachments.take() {
-            a.destroy(device);
+            // SAFETY: as above.
+            unsafe { a.destroy(device) };
         }
     }
 }
@@ -130,10 +157,15 @@ pub(crate) fn choose_present_mode(modes: &[vk::PresentModeKHR], vsync: bool) -> 
 
 impl Renderer {
     /// Creates a surface for `window` and its swapchain. The renderer must have been created
-    /// with `RendererDesc::display` set to the window's display.
-    pub fn create_swapchain<W>(&mut self, window: &W, desc: &SwapchainDesc) -> GpuResult<Swapchain>
+    /// with `RendererDesc::display` set to the window's display. The swapchain keeps `window`
+    /// alive (the surface must not outlive its window).
+    pub fn create_swapchain<W>(
+        &mut self,
+        window: Arc<W>,
+        desc: &SwapchainDesc,
+    ) -> GpuResult<Swapchain>
     where
-        W: HasDisplayHandle + HasWindowHandle + ?Sized,
+        W: HasDisplayHandle + HasWindowHandle + Send + Sync + 'static,
     {
         let surface_fn = self.instance.surface_fn.as_ref().ok_or_else(|| {
             GpuError::Surface(
@@ -151,8 +183,8 @@ impl Renderer {
             .window_handle()
             .map_err(|e| GpuError::Surface(e.to_string()))?
             .as_raw();
-        // SAFETY: the handles come from a live window that outlives the swapchain (caller's
-        // contract: destroy the swapchain before the window).
+        // SAFETY: the handles come from a live window, which the swapchain keeps alive (it
+        // holds the Arc) until after the surface is destroyed.
         let surface = unsafe {
             ash_window::create_surface(
                 &self.instance.entry,
@@ -188,6 +220,7 @@ impl Renderer {
             }
         };
         let mut swapchain = Swapchain {
+            _window: window,
             surface,
             raw: vk::SwapchainKHR::null(),
             images: Vec::new(),
@@ -204,9 +237,11 @@ impl Renderer {
             samples,
             present_mode: vk::PresentModeKHR::FIFO,
             stale: true,
+            retired: Vec::new(),
         };
         if let Err(e) = self.rebuild_swapchain(&mut swapchain) {
-            self.destroy_swapchain_now(swapchain);
+            // SAFETY: the swapchain was just created: no frame ever rendered into its images.
+            unsafe { self.destroy_swapchain_now(swapchain) };
             return Err(e);
         }
         Ok(swapchain)
@@ -223,7 +258,9 @@ impl Renderer {
         ) else {
             return Err(GpuError::Surface("no surface support".into()));
         };
-        sc.destroy_images(device);
+        let old_images = sc.images.len();
+        // SAFETY: the device is idle (waited above), so no frame renders into them.
+        unsafe { sc.destroy_images(device) };
         // SAFETY: valid physical device and surface for all three queries.
         let (caps, formats, modes) = unsafe {
             (
@@ -292,9 +329,13 @@ impl Renderer {
         // SAFETY: parameters were validated against the surface capabilities above.
         let raw = unsafe { swapchain_fn.create_swapchain(&info, None) }.vk("vkCreateSwapchainKHR");
         if old != vk::SwapchainKHR::null() {
-            // SAFETY: the device is idle, so no image of the old swapchain is in use; it was
-            // retired by passing it as old_swapchain.
-            unsafe { swapchain_fn.destroy_swapchain(old, None) };
+            // Passing it as old_swapchain retired it (even if creation failed); presentation
+            // may still use it and its semaphores, so they are destroyed later.
+            sc.retired.push(Retired {
+                raw: old,
+                semaphores: std::mem::take(&mut sc.render_finished),
+                until: self.frame_number + (FRAMES_IN_FLIGHT + old_images.max(1)) as u64,
+            });
             sc.raw = vk::SwapchainKHR::null();
         }
         sc.raw = raw?;
@@ -324,23 +365,70 @@ impl Renderer {
 
     /// Destroys the swapchain and its surface (waits for the GPU first).
     pub fn destroy_swapchain(&mut self, swapchain: Swapchain) -> GpuResult<()> {
-        let waited = self.wait_idle();
-        self.destroy_swapchain_now(swapchain);
-        waited
+        match self.wait_idle() {
+            Ok(()) => {
+                // SAFETY: the device is idle.
+                unsafe { self.destroy_swapchain_now(swapchain) };
+                Ok(())
+            }
+            Err(e) if e.is_device_lost() => {
+                // SAFETY: nothing executes on a lost device.
+                unsafe { self.destroy_swapchain_now(swapchain) };
+                Err(e)
+            }
+            Err(e) => {
+                // Work may still render into its images: keep it until the renderer goes.
+                self.orphans.push(Orphan::Swapchain(swapchain));
+                Err(e)
+            }
+        }
     }
 
-    fn destroy_swapchain_now(&mut self, mut sc: Swapchain) {
+    /// Destroys retired swapchains whose presents are surely done (`all`: every one, at
+    /// teardown after the device went idle).
+    pub(crate) fn collect_retired(&self, sc: &mut Swapchain, all: bool) {
         let device = &*self.device;
-        sc.destroy_images(device);
-        for s in sc.render_finished.drain(..) {
-            // SAFETY: the device is idle; presents waiting on it have been processed.
-            unsafe { device.raw.destroy_semaphore(s, None) };
-        }
+        let Some(swapchain_fn) = device.swapchain_fn.as_ref() else {
+            return;
+        };
+        let frame = self.frame_number;
+        sc.retired.retain(|r| {
+            if !all && frame < r.until {
+                return true;
+            }
+            // SAFETY: `until` frames have been submitted since the swapchain was retired, so the
+            // presents that waited on these semaphores and showed its images have been processed
+            // (or, at teardown, the device is idle and the surface is about to go).
+            unsafe {
+                for &s in &r.semaphores {
+                    device.raw.destroy_semaphore(s, None);
+                }
+                swapchain_fn.destroy_swapchain(r.raw, None);
+            }
+            false
+        });
+    }
+
+    /// Destroys the swapchain, its retired predecessors, semaphores and surface.
+    ///
+    /// # Safety
+    /// The device must be idle or lost (no frame renders into its images).
+    pub(crate) unsafe fn destroy_swapchain_now(&mut self, mut sc: Swapchain) {
+        self.collect_retired(&mut sc, true);
+        let device = &*self.device;
+        // SAFETY: the caller guarantees an idle (or lost) device.
+        unsafe { sc.destroy_images(device) };
         if let Some(f) = device.swapchain_fn.as_ref()
             && sc.raw != vk::SwapchainKHR::null()
         {
             // SAFETY: idle device, swapchain destroyed once.
             unsafe { f.destroy_swapchain(sc.raw, None) };
+        }
+        for s in sc.render_finished.drain(..) {
+            // SAFETY: the device is idle and the swapchain that presented with these
+            // semaphores is gone. Present completion itself cannot be observed without
+            // VK_EXT_swapchain_maintenance1; this is the teardown order the Vulkan samples use.
+            unsafe { device.raw.destroy_semaphore(s, None) };
         }
         if let Some(f) = self.instance.surface_fn.as_ref() {
             // SAFETY: the swapchain using the surface is gone.

@@ -91,7 +91,12 @@ impl GpuTimer {
         Some(ticks as f64 * self.period_ns * 1e-6)
     }
 
-    pub(crate) fn destroy(self, device: &Device) {
+    /// Destroys the query pool.
+    ///
+    /// # Safety
+    /// No submitted GPU work that uses these objects may still be pending (the device is idle
+    /// or lost, or they were never used).
+    pub(crate) unsafe fn destroy(self, device: &Device) {
         // SAFETY: no pending GPU use (renderer waited for idle).
         unsafe { device.raw.destroy_query_pool(self.pool, None) };
     }

@@ -126,9 +126,15 @@ impl TransientBuffer {
         }
     }
 
-    pub(crate) fn destroy(self, device: &Device) {
+    /// Destroys the slot's transient buffers.
+    ///
+    /// # Safety
+    /// No submitted GPU work that uses these objects may still be pending (the device is idle
+    /// or lost, or they were never used).
+    pub(crate) unsafe fn destroy(self, device: &Device) {
         if let Some(b) = self.buffer {
-            device.destroy_buffer(b);
+            // SAFETY: the caller guarantees nothing pending uses them (this function's contract).
+            unsafe { device.destroy_buffer(b) };
         }
     }
 }

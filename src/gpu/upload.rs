@@ -7,13 +7,29 @@ use ash::vk;
 use gpu_allocator::MemoryLocation;
 
 use super::device::Device;
-use super::error::{GpuError, GpuResult, VkResultExt};
+use super::error::{GpuError, GpuResult, VkResultExt, vk_error};
 use super::memory::{Buffer, BufferDesc};
 
 #[derive(Default)]
 pub(crate) struct Uploader {
     pool: vk::CommandPool,
     fence: vk::Fence,
+    /// Buffers of an upload whose completion could not be established (the wait failed and
+    /// so did waiting for the device): the GPU may still use them, so they are only destroyed
+    /// with the uploader, after the renderer's final wait.
+    orphans: Vec<Buffer>,
+    /// Set when a copy may still be pending on `pool`: the pool and fence are unusable.
+    poisoned: bool,
+    /// Error-path tests: the next wait for an upload reports this instead of waiting.
+    fail_wait: Option<vk::Result>,
+}
+
+/// How far an upload got before failing.
+enum Failure {
+    /// Nothing is pending on the GPU: every resource may be released.
+    Idle(GpuError),
+    /// The copy may still be running: its resources must outlive it.
+    Pending(GpuError),
 }
 
 impl Uploader {
@@ -40,7 +56,16 @@ impl Uploader {
                 });
             }
         };
-        Ok(Self { pool, fence })
+        Ok(Self {
+            pool,
+            fence,
+            ..Self::default()
+        })
+    }
+
+    /// Makes the next upload's fence wait report `result` (error-path tests).
+    pub(crate) fn fail_next_wait(&mut self, result: vk::Result) {
+        self.fail_wait = Some(result);
     }
 
     /// Creates a device-local buffer holding `bytes`, readable by `dst_stage`/`dst_access`
@@ -54,6 +79,11 @@ impl Uploader {
         dst_stage: vk::PipelineStageFlags2,
         dst_access: vk::AccessFlags2,
     ) -> GpuResult<Buffer> {
+        if self.poisoned {
+            return Err(GpuError::DeviceLost {
+                call: "vkDeviceWaitIdle (after an earlier upload failed)",
+            });
+        }
         let size = bytes.len() as u64;
         let staging = device.create_buffer(&BufferDesc {
             name: "staging",
@@ -62,8 +92,22 @@ impl Uploader {
             location: MemoryLocation::CpuToGpu,
         })?;
         let result = self.copy_via(device, name, &staging, bytes, usage, dst_stage, dst_access);
-        device.destroy_buffer(staging);
-        result
+        match result {
+            Ok(dst) => {
+                // SAFETY: the copy that read it completed (its fence was waited for).
+                unsafe { device.destroy_buffer(staging) };
+                Ok(dst)
+            }
+            Err(Failure::Idle(e)) => {
+                // SAFETY: nothing using it is pending (`Failure::Idle`).
+                unsafe { device.destroy_buffer(staging) };
+                Err(e)
+            }
+            Err(Failure::Pending(e)) => {
+                self.orphans.push(staging);
+                Err(e)
+            }
+        }
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -76,32 +120,46 @@ impl Uploader {
         usage: vk::BufferUsageFlags,
         dst_stage: vk::PipelineStageFlags2,
         dst_access: vk::AccessFlags2,
-    ) -> GpuResult<Buffer> {
+    ) -> Result<Buffer, Failure> {
         let base = staging
             .mapped()
-            .ok_or_else(|| GpuError::Internal("staging buffer is not mapped".into()))?;
+            .ok_or_else(|| GpuError::Internal("staging buffer is not mapped".into()))
+            .map_err(Failure::Idle)?;
         // SAFETY: the staging buffer is at least `bytes.len()` long, freshly created, mapped
         // and unaliased.
         unsafe { std::ptr::copy_nonoverlapping(bytes.as_ptr(), base.as_ptr(), bytes.len()) };
         if staging.needs_flush() {
             let atom = device.caps.non_coherent_atom_size;
-            device.flush_ranges(&[staging.mapped_range(0..bytes.len() as u64, atom)])?;
+            device
+                .flush_ranges(&[staging.mapped_range(0..bytes.len() as u64, atom)])
+                .map_err(Failure::Idle)?;
         }
-        let dst = device.create_buffer(&BufferDesc {
-            name,
-            size: bytes.len() as u64,
-            usage: usage | vk::BufferUsageFlags::TRANSFER_DST,
-            location: MemoryLocation::GpuOnly,
-        })?;
-        if let Err(e) = self.submit_copy(device, staging, &dst, dst_stage, dst_access) {
-            // The copy may be in flight if only the wait failed; make sure before freeing.
-            let _ = device.wait_idle();
-            device.destroy_buffer(dst);
-            return Err(e);
+        let dst = device
+            .create_buffer(&BufferDesc {
+                name,
+                size: bytes.len() as u64,
+                usage: usage | vk::BufferUsageFlags::TRANSFER_DST,
+                location: MemoryLocation::GpuOnly,
+            })
+            .map_err(Failure::Idle)?;
+        match self.submit_copy(device, staging, &dst, dst_stage, dst_access) {
+            Ok(()) => Ok(dst),
+            Err(Failure::Idle(e)) => {
+                // SAFETY: nothing using it is pending (`Failure::Idle`).
+                unsafe { device.destroy_buffer(dst) };
+                Err(Failure::Idle(e))
+            }
+            Err(Failure::Pending(e)) => {
+                self.orphans.push(dst);
+                Err(Failure::Pending(e))
+            }
         }
-        Ok(dst)
     }
 
+    /// Records, submits and waits for the copy. The pool and fence are only reset once
+    /// nothing is pending on them: after a failed wait the copy may still be running, so
+    /// the device is waited for first, and if that fails too the uploader is poisoned
+    /// rather than resetting a pool whose command buffer may be pending.
     fn submit_copy(
         &mut self,
         device: &Device,
@@ -109,15 +167,16 @@ impl Uploader {
         dst: &Buffer,
         dst_stage: vk::PipelineStageFlags2,
         dst_access: vk::AccessFlags2,
-    ) -> GpuResult<()> {
+    ) -> Result<(), Failure> {
         let raw = &device.raw;
         let alloc = vk::CommandBufferAllocateInfo::default()
             .command_pool(self.pool)
             .level(vk::CommandBufferLevel::PRIMARY)
             .command_buffer_count(1);
         // SAFETY: the pool is ours and was reset after the previous upload.
-        let cmd =
-            unsafe { raw.allocate_command_buffers(&alloc) }.vk("vkAllocateCommandBuffers")?[0];
+        let cmd = unsafe { raw.allocate_command_buffers(&alloc) }
+            .vk("vkAllocateCommandBuffers")
+            .map_err(Failure::Idle)?[0];
         let begin = vk::CommandBufferBeginInfo::default()
             .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
         let region = vk::BufferCopy {
@@ -140,7 +199,7 @@ impl Uploader {
         let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
         // SAFETY: `cmd` is a fresh primary buffer; handles are live; the fence is unsignalled
         // (created so, and reset after each use); the queue is only used from &mut Renderer.
-        let result = unsafe {
+        let submitted = unsafe {
             raw.begin_command_buffer(cmd, &begin)
                 .vk("vkBeginCommandBuffer")
                 .and_then(|()| {
@@ -155,23 +214,51 @@ impl Uploader {
                     raw.queue_submit2(device.queue, &submit, self.fence)
                         .vk("vkQueueSubmit2")
                 })
-                .and_then(|()| {
-                    raw.wait_for_fences(&[self.fence], true, u64::MAX)
-                        .vk("vkWaitForFences")
-                })
         };
-        // SAFETY: the submission (if any) completed, or failed to start; either way the
-        // command buffer is no longer pending. Resetting returns it to the pool.
+        let outcome = match submitted {
+            // Nothing was submitted: nothing is pending.
+            Err(e) => Err(Failure::Idle(e)),
+            Ok(()) => {
+                let waited = match self.fail_wait.take() {
+                    Some(result) => Err(vk_error("vkWaitForFences", result)),
+                    None => device.wait_fence(self.fence),
+                };
+                match waited {
+                    Ok(()) => Ok(()),
+                    // The copy may still run; only an idle device proves it finished.
+                    Err(e) => match device.wait_idle() {
+                        Ok(()) => Err(Failure::Idle(e)),
+                        Err(_) => {
+                            self.poisoned = true;
+                            return Err(Failure::Pending(e));
+                        }
+                    },
+                }
+            }
+        };
+        // SAFETY: nothing submitted from the pool is pending (the submission failed, its fence
+        // signalled, or the device went idle), so the fence and pool may be reset and the
+        // command buffer freed.
         unsafe {
             let _ = raw.reset_fences(&[self.fence]);
             let _ = raw.reset_command_pool(self.pool, vk::CommandPoolResetFlags::empty());
             raw.free_command_buffers(self.pool, &[cmd]);
         }
-        result
+        outcome
     }
 
-    pub(crate) fn destroy(self, device: &Device) {
-        // SAFETY: every upload waited for its fence; nothing is pending.
+    /// Destroys the pool, the fence and orphaned buffers.
+    ///
+    /// # Safety
+    /// No submitted GPU work that uses these objects may still be pending (the device is idle
+    /// or lost, or they were never used).
+    pub(crate) unsafe fn destroy(self, device: &Device) {
+        for b in self.orphans {
+            // SAFETY: the caller guarantees nothing pending uses them (this function's contract).
+            unsafe { device.destroy_buffer(b) };
+        }
+        // SAFETY: every upload waited for its fence, or the renderer waited for the device
+        // (or lost it) before destroying the uploader.
         unsafe {
             device.raw.destroy_fence(self.fence, None);
             device.raw.destroy_command_pool(self.pool, None);

@@ -5,14 +5,16 @@
 use super::document::{
     Controls, Document, Handle, LOCAL_CURVE_SAMPLES, LOCAL_PATCH_SAMPLES, LocalControls,
 };
+use super::lod::{GridMetrics, Lod};
 use super::style::{NetMode, Palette, ViewOptions, Wire};
 use crate::gpu::{
-    FRAMES_IN_FLIGHT, Frame, GpuResult, GridShape, Mirror, PointRun, PointStyle, PolylineStyle,
-    Renderer, SurfaceGrid, SurfaceStyle,
+    FRAMES_IN_FLIGHT, Frame, GpuResult, GridShape, GridStride, Mirror, PointRun, PointStyle,
+    PolylineStyle, Renderer, SurfaceBatch, SurfaceStyle,
 };
 use crate::model::{Edit, Index2, LocalPath, ModelRef, Target};
 use crate::sampling::{DirtyRegion, DirtySet};
 use glam::DVec3;
+use std::collections::BTreeMap;
 
 /// Where an object's control structures sit in its control mirror (offsets in floats).
 #[derive(Debug, Clone, PartialEq)]
@@ -42,9 +44,16 @@ struct LocalEntry {
     cols: usize,
 }
 
+/// Where an object's samples sit: an arena mirror and a float offset in it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Place {
+    arena: usize,
+    offset: usize,
+}
+
 struct ObjectGpu {
     name: String,
-    samples: Mirror,
+    samples: Place,
     /// Sample rows (surfaces) or samples (curves) each slot has not seen yet.
     dirty: [DirtySet; FRAMES_IN_FLIGHT],
     controls: Mirror,
@@ -55,7 +64,24 @@ struct ObjectGpu {
     /// The control structures changed size: the next upload replaces the control mirror.
     controls_resized: bool,
     layout: ControlLayout,
+    /// Stride chosen for the view in `GpuScene::lod_view`, until the view or the samples change.
+    lod: Option<GridStride>,
+    /// World-space measures of the samples for choosing strides; `None` until measured after
+    /// the samples last changed (the inner `None`: not measurable, drawn in full).
+    metrics: Option<Option<GridMetrics>>,
 }
+
+/// Surfaces of one grid shape and colour in one arena: drawn with one multi-draw per stride.
+#[derive(Debug, Clone, PartialEq)]
+struct SurfaceGroup {
+    /// Object indices, in document order.
+    members: Vec<usize>,
+    shape: GridShape,
+    arena: usize,
+}
+
+/// Floats per arena mirror at most (256 MiB); a larger object gets an arena of its own.
+const ARENA_FLOATS: usize = 64 << 20;
 
 /// What one frame's upload copied.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -64,6 +90,15 @@ pub struct UploadStats {
     pub bytes: usize,
     /// Sample rows (surfaces) and samples (curves) copied.
     pub rows: usize,
+}
+
+/// What one frame's draw of the document cost in surface triangles.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct DrawReport {
+    /// Triangles of the surfaces as drawn (after level of detail).
+    pub triangles: u64,
+    /// Triangles the surfaces would have at full resolution.
+    pub full_triangles: u64,
 }
 
 /// Which handle the cursor is over and which one is selected (for highlighting).
@@ -87,39 +122,82 @@ impl Highlight {
     }
 }
 
+/// The document's GPU side. Samples of all objects live in a few large *arena* mirrors
+/// (surfaces first, in document order, then curves), so a group of same-shaped surfaces is
+/// drawn with one multi-draw per level of detail; control structures have a mirror per object.
 pub struct GpuScene {
+    arenas: Vec<Mirror>,
     objects: Vec<ObjectGpu>,
+    groups: Vec<SurfaceGroup>,
+    /// The view the objects' cached strides were chosen for.
+    lod_view: Option<Lod>,
     scratch: Vec<f32>,
 }
 
 impl GpuScene {
     /// Creates and fills every mirror (all slots).
     pub fn new(renderer: &mut Renderer, doc: &Document) -> GpuResult<Self> {
-        let mut objects = Vec::with_capacity(doc.objects.len());
-        let mut scratch = Vec::new();
+        let (places, sizes) = arena_layout(doc);
+        let mut scene = Self {
+            arenas: Vec::with_capacity(sizes.len()),
+            objects: Vec::with_capacity(doc.objects.len()),
+            groups: surface_groups(doc, &places),
+            lod_view: None,
+            scratch: Vec::new(),
+        };
+        // On failure, give back what was created.
+        match scene.fill(renderer, doc, &places, &sizes) {
+            Ok(()) => Ok(scene),
+            Err(e) => {
+                scene.destroy(renderer);
+                Err(e)
+            }
+        }
+    }
+
+    fn fill(
+        &mut self,
+        renderer: &mut Renderer,
+        doc: &Document,
+        places: &[Place],
+        sizes: &[usize],
+    ) -> GpuResult<()> {
+        for (a, &len) in sizes.iter().enumerate() {
+            let mut data = vec![0.0f32; len.max(3)];
+            for (i, p) in places.iter().enumerate().filter(|(_, p)| p.arena == a) {
+                sample_floats(
+                    doc,
+                    i,
+                    0..doc.objects[i].sampled.grid().dims[0],
+                    &mut self.scratch,
+                );
+                data[p.offset..p.offset + self.scratch.len()].copy_from_slice(&self.scratch);
+            }
+            let mut mirror = renderer.create_mirror(&format!("samples {a}"), data.len())?;
+            let filled = renderer.fill_mirror(&mut mirror, 0, &data);
+            self.arenas.push(mirror);
+            filled?;
+        }
         for (i, o) in doc.objects.iter().enumerate() {
-            let [rows, cols] = o.sampled.grid().dims;
-            let is_surface = o.sampled.grid().normals.is_some();
-            let len = rows * cols * if is_surface { 6 } else { 3 };
-            let mut samples = renderer.create_mirror(&o.name, len)?;
-            sample_floats(doc, i, 0..rows, &mut scratch);
-            renderer.fill_mirror(&mut samples, 0, &scratch)?;
             let (layout, data) = control_floats(&doc.controls(i));
             let mut controls =
                 renderer.create_mirror(&format!("{} controls", o.name), data.len().max(3))?;
-            renderer.fill_mirror(&mut controls, 0, &data)?;
-            objects.push(ObjectGpu {
+            let filled = renderer.fill_mirror(&mut controls, 0, &data);
+            self.objects.push(ObjectGpu {
                 name: o.name.clone(),
-                samples,
+                samples: places[i],
                 dirty: Default::default(),
                 controls,
                 controls_cache: data,
                 controls_dirty: Default::default(),
                 controls_resized: false,
                 layout,
+                lod: None,
+                metrics: None,
             });
+            filled?;
         }
-        Ok(Self { objects, scratch })
+        Ok(())
     }
 
     /// Records what an applied edit changed: the sample rows of `region`, and the control
@@ -243,17 +321,16 @@ impl GpuScene {
         for (i, o) in self.objects.iter_mut().enumerate() {
             let ranges = o.dirty[slot].take();
             if !ranges.is_empty() {
+                // New samples may project differently: measure and choose the stride again.
+                o.lod = None;
+                o.metrics = None;
                 let cols = doc.objects[i].sampled.grid().dims[1];
-                let per = if doc.objects[i].sampled.grid().normals.is_some() {
-                    6
-                } else {
-                    3
-                };
-                let mut w = frame.write_mirror(&mut o.samples);
+                let per = floats_per_sample(doc, i);
+                let mut w = frame.write_mirror(&mut self.arenas[o.samples.arena]);
                 for r in ranges {
                     stats.rows += r.len();
                     sample_floats(doc, i, r.clone(), &mut self.scratch);
-                    w.write(r.start * cols * per, &self.scratch)?;
+                    w.write(o.samples.offset + r.start * cols * per, &self.scratch)?;
                     stats.bytes += self.scratch.len() * 4;
                 }
             }
@@ -274,39 +351,67 @@ impl GpuScene {
         Ok(stats)
     }
 
-    /// Records the draws of every object.
+    /// Records the draws of every object. Each surface is drawn at the stride `lod` picks for
+    /// it (strided index buffers over the full-resolution mirrors; choosing a stride copies
+    /// nothing); surfaces of one group sharing a stride are one multi-draw.
     pub fn draw(
-        &self,
+        &mut self,
         frame: &mut Frame<'_>,
         doc: &Document,
         opts: &ViewOptions,
         hl: &Highlight,
-    ) -> GpuResult<()> {
+        lod: &Lod,
+    ) -> GpuResult<DrawReport> {
         let palette = Palette::default();
+        let mut report = DrawReport::default();
+        if self.lod_view != Some(*lod) {
+            self.lod_view = Some(*lod);
+            self.objects.iter_mut().for_each(|o| o.lod = None);
+        }
         // Opaque surfaces first, then lines and points on top of them.
-        for (i, o) in self.objects.iter().enumerate() {
-            let grid = doc.objects[i].sampled.grid();
-            if grid.normals.is_none() {
-                continue;
-            }
-            let color = palette.surface(doc.objects[i].color);
-            let shape = GridShape {
-                rows: grid.dims[0] as u32,
-                cols: grid.dims[1] as u32,
-            };
-            let sg = SurfaceGrid { offset: 0, shape };
+        for group in &self.groups {
+            let color = palette.surface(doc.objects[group.members[0]].color);
             let style = SurfaceStyle {
                 front: color,
                 back: palette.back_of(color),
                 ..SurfaceStyle::default()
             };
-            frame.draw_surface(&o.samples, sg, &style)?;
-            match opts.wire {
-                Wire::Off => {}
-                Wire::Isolines(every) => {
-                    frame.draw_wire(&o.samples, sg, every.max(1), palette.wire)?
-                }
-                Wire::Full => frame.draw_wire(&o.samples, sg, 1, palette.wire)?,
+            let mut by_stride: BTreeMap<(u32, u32), Vec<usize>> = BTreeMap::new();
+            for &i in &group.members {
+                let o = &mut self.objects[i];
+                let stride = if opts.lod {
+                    let grid = doc.objects[i].sampled.grid();
+                    let metrics = o.metrics.get_or_insert_with(|| GridMetrics::new(grid));
+                    *o.lod.get_or_insert_with(|| lod.stride(metrics.as_ref()))
+                } else {
+                    GridStride::FULL
+                };
+                by_stride
+                    .entry((stride.rows, stride.cols))
+                    .or_default()
+                    .push(o.samples.offset);
+            }
+            let arena = &self.arenas[group.arena];
+            for ((rows, cols), offsets) in &by_stride {
+                let stride = GridStride {
+                    rows: *rows,
+                    cols: *cols,
+                };
+                let n = offsets.len() as u64;
+                report.triangles += 2 * stride.cells(group.shape) * n;
+                report.full_triangles += 2 * GridStride::FULL.cells(group.shape) * n;
+                let batch = SurfaceBatch {
+                    shape: group.shape,
+                    stride,
+                    offsets,
+                };
+                frame.draw_surface_batch(arena, &batch, &style)?;
+                let every = match opts.wire {
+                    Wire::Off => continue,
+                    Wire::Isolines(every) => every.max(1),
+                    Wire::Full => 1,
+                };
+                frame.draw_wire_batch(arena, &batch, every, palette.wire)?;
             }
         }
         for (i, o) in self.objects.iter().enumerate() {
@@ -318,11 +423,16 @@ impl GpuScene {
                     width: opts.curve_width,
                     depth_test: true,
                 };
-                frame.draw_polyline(&o.samples, PointRun::packed(0, grid.dims[0]), &style)?;
+                let run = PointRun {
+                    offset: o.samples.offset,
+                    stride: 3,
+                    count: grid.dims[0],
+                };
+                frame.draw_polyline(&self.arenas[o.samples.arena], run, &style)?;
             }
             self.draw_controls(frame, i, o, opts, hl, &palette)?;
         }
-        Ok(())
+        Ok(report)
     }
 
     fn draw_controls(
@@ -439,24 +549,38 @@ impl GpuScene {
             }
             ControlLayout::LocalPatches(entries) => {
                 let k = LOCAL_PATCH_SAMPLES as u32;
+                let chosen = |e: &LocalEntry| {
+                    hl.selected_local
+                        .is_some_and(|(o, p)| o == i && e.path.starts_with(&p))
+                };
+                // Outline and centre lines only: full wire grids of every patch bury the
+                // surface. All patches in one call, the selected ones on top in their colour.
+                let wire = |frame: &mut Frame<'_>, offsets: &[usize], color| {
+                    let batch = SurfaceBatch {
+                        shape: GridShape { rows: k, cols: k },
+                        stride: GridStride::FULL,
+                        offsets,
+                    };
+                    frame.draw_wire_batch(&o.controls, &batch, (k - 1) / 2, color)
+                };
+                if opts.local_curves {
+                    let offsets: Vec<usize> = entries
+                        .iter()
+                        .filter(|e| !chosen(e))
+                        .map(|e| e.samples)
+                        .collect();
+                    wire(frame, &offsets, palette.local)?;
+                }
+                let selected: Vec<usize> = entries
+                    .iter()
+                    .filter(|e| chosen(e))
+                    .map(|e| e.samples)
+                    .collect();
+                if !selected.is_empty() {
+                    wire(frame, &selected, palette.selected_local)?;
+                }
                 for e in entries {
-                    let chosen = hl
-                        .selected_local
-                        .is_some_and(|(o, p)| o == i && e.path.starts_with(&p));
-                    if opts.local_curves || chosen {
-                        let color = if chosen {
-                            palette.selected_local
-                        } else {
-                            palette.local
-                        };
-                        let sg = SurfaceGrid {
-                            offset: e.samples,
-                            shape: GridShape { rows: k, cols: k },
-                        };
-                        // Outline and centre lines only: full wire grids of every patch bury the surface.
-                        frame.draw_wire(&o.controls, sg, (k - 1) / 2, color)?;
-                    }
-                    if nets || chosen {
+                    if nets || chosen(e) {
                         control_net(frame, &o.controls, e.points, e.rows, e.cols, &net)?;
                         let pick = |h: Handle| match h {
                             Handle::LocalPoint {
@@ -486,15 +610,87 @@ impl GpuScene {
 
     /// Gives every mirror back to the renderer.
     pub fn destroy(self, renderer: &mut Renderer) {
+        for a in self.arenas {
+            renderer.destroy_mirror(a);
+        }
         for o in self.objects {
-            renderer.destroy_mirror(o.samples);
             renderer.destroy_mirror(o.controls);
         }
     }
 }
 
-/// A `rows × cols` control net stored row-major from float `base`: every row and column as a
-/// polyline, columns read with a stride (no copies).
+/// Floats per sample on the GPU: position and normal for surfaces, position for curves.
+fn floats_per_sample(doc: &Document, i: usize) -> usize {
+    if doc.objects[i].sampled.grid().normals.is_some() {
+        6
+    } else {
+        3
+    }
+}
+
+/// Where every object's samples go, and the length of each arena: surfaces first in document
+/// order (so same-shaped neighbours are contiguous), then curves. An arena is closed when the
+/// next object would take it past `ARENA_FLOATS`.
+fn arena_layout(doc: &Document) -> (Vec<Place>, Vec<usize>) {
+    let n = doc.objects.len();
+    let mut places = vec![
+        Place {
+            arena: 0,
+            offset: 0
+        };
+        n
+    ];
+    let mut sizes = vec![0usize];
+    let is_surface = |i: &usize| doc.objects[*i].sampled.grid().normals.is_some();
+    let surfaces = (0..n).filter(is_surface);
+    let curves = (0..n).filter(|i| !is_surface(i));
+    for i in surfaces.chain(curves) {
+        let [rows, cols] = doc.objects[i].sampled.grid().dims;
+        let len = rows * cols * floats_per_sample(doc, i);
+        let last = sizes.len() - 1;
+        if sizes[last] > 0 && sizes[last] + len > ARENA_FLOATS {
+            sizes.push(0);
+        }
+        let arena = sizes.len() - 1;
+        places[i] = Place {
+            arena,
+            offset: sizes[arena],
+        };
+        sizes[arena] += len;
+    }
+    (places, sizes)
+}
+
+/// Surfaces grouped by arena, grid shape and colour (in order of first appearance).
+fn surface_groups(doc: &Document, places: &[Place]) -> Vec<SurfaceGroup> {
+    let mut groups: Vec<SurfaceGroup> = Vec::new();
+    for (i, o) in doc.objects.iter().enumerate() {
+        let grid = o.sampled.grid();
+        if grid.normals.is_none() {
+            continue;
+        }
+        let shape = GridShape {
+            rows: grid.dims[0] as u32,
+            cols: grid.dims[1] as u32,
+        };
+        let arena = places[i].arena;
+        let same = |g: &&mut SurfaceGroup| {
+            g.shape == shape && g.arena == arena && doc.objects[g.members[0]].color == o.color
+        };
+        match groups.iter_mut().find(same) {
+            Some(g) => g.members.push(i),
+            None => groups.push(SurfaceGroup {
+                members: vec![i],
+                shape,
+                arena,
+            }),
+        }
+    }
+    groups
+}
+
+/// A `rows × cols` control net stored row-major from float `base`: every row and column, in
+/// one draw.
 fn control_net(
     frame: &mut Frame<'_>,
     m: &Mirror,
@@ -503,18 +699,15 @@ fn control_net(
     cols: usize,
     style: &PolylineStyle,
 ) -> GpuResult<()> {
-    for r in 0..rows {
-        polyline(frame, m, PointRun::grid_row(base, cols, 3, r), style)?;
+    if rows * cols < 2 {
+        return Ok(());
     }
-    for c in 0..cols {
-        polyline(
-            frame,
-            m,
-            PointRun::grid_column(base, rows, cols, 3, c),
-            style,
-        )?;
-    }
-    Ok(())
+    let run = PointRun {
+        offset: base,
+        stride: 3,
+        count: rows * cols,
+    };
+    frame.draw_net(m, run, cols, style)
 }
 
 /// Polylines need two points; degree-0 local curves have one.

@@ -6,6 +6,7 @@ pub mod analysis;
 pub mod camera;
 pub mod document;
 pub mod gpu_scene;
+pub mod lod;
 pub mod maps;
 pub mod offscreen;
 pub mod overlays;
@@ -13,5 +14,6 @@ pub mod style;
 
 pub use camera::{Bounds, OrbitCamera};
 pub use document::{Controls, DocObject, Document, Handle};
-pub use gpu_scene::{GpuScene, Highlight, UploadStats};
+pub use gpu_scene::{DrawReport, GpuScene, Highlight, UploadStats};
+pub use lod::Lod;
 pub use style::{NetMode, Palette, ViewOptions, Wire};

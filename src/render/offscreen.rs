@@ -6,6 +6,7 @@ use super::gpu_scene::{GpuScene, Highlight};
 use super::analysis::{
     CurveEval, Osculating, badge_overlay, osculating_lines, osculating_overlay,
 };
+use super::lod::Lod;
 use super::maps::legend;
 use super::overlays::overlay_lines;
 use super::style::{Palette, ViewOptions};
@@ -40,14 +41,14 @@ pub fn render_document(renderer: &mut Renderer, doc: &Document, shot: &Shot) -> 
         height: shot.height,
         samples: shot.msaa,
     })?;
-    let scene = match GpuScene::new(renderer, doc) {
+    let mut scene = match GpuScene::new(renderer, doc) {
         Ok(s) => s,
         Err(e) => {
             renderer.destroy_offscreen(target)?;
             return Err(e);
         }
     };
-    let result = record(renderer, &mut target, &scene, doc, shot)
+    let result = record(renderer, &mut target, &mut scene, doc, shot)
         .and_then(|()| renderer.read_pixels(&target));
     scene.destroy(renderer);
     renderer.destroy_offscreen(target)?;
@@ -57,16 +58,19 @@ pub fn render_document(renderer: &mut Renderer, doc: &Document, shot: &Shot) -> 
 fn record(
     renderer: &mut Renderer,
     target: &mut crate::gpu::OffscreenTarget,
-    scene: &GpuScene,
+    scene: &mut GpuScene,
     doc: &Document,
     shot: &Shot,
 ) -> GpuResult<()> {
     let bounds = doc.bounds();
     let camera = shot_camera(doc, shot);
+    let aspect = shot.width as f64 / shot.height as f64;
     let mut frame = renderer.begin_offscreen(target)?;
     frame.set_clear_color(Palette::default().background);
-    frame.set_camera(camera.gpu(shot.width as f64 / shot.height as f64, &bounds));
-    scene.draw(&mut frame, doc, &shot.options, &Highlight::default())?;
+    frame.set_camera(camera.gpu(aspect, &bounds));
+    let viewport = [shot.width as f64, shot.height as f64];
+    let lod = Lod::new(camera.view_proj(aspect, &bounds), viewport, frame.samples());
+    scene.draw(&mut frame, doc, &shot.options, &Highlight::default(), &lod)?;
     let mut lines = overlay_lines(doc, &shot.options, bounds.radius());
     let (w, h) = (shot.width as f64, shot.height as f64);
     let project = |p| camera.project(p, w, h, &bounds).map(|(x, y, _)| (x, y));
@@ -99,6 +103,7 @@ fn record(
     if !overlay.is_empty() {
         frame.draw_overlay(&overlay)?;
     }
+    frame.capture();
     frame.finish()?;
     Ok(())
 }

@@ -55,6 +55,9 @@ pub struct ViewOptions {
     pub curve_width: f32,
     /// Control point size in pixels.
     pub point_size: f32,
+    /// Display level of detail: draw strided subsets of dense surface grids (see
+    /// [`super::lod`]). Off draws every sample.
+    pub lod: bool,
 }
 
 impl Default for ViewOptions {
@@ -71,6 +74,7 @@ impl Default for ViewOptions {
             osculating_at: None,
             curve_width: 2.5,
             point_size: 8.0,
+            lod: true,
         }
     }
 }

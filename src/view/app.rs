@@ -1,20 +1,28 @@
 //! The winit 0.30 application: window, swapchain (resize, minimise, out-of-date), input
 //! translation, the frame loop, scripted input and screenshots.
+//!
+//! `prespline view` draws on demand (`ControlFlow::Wait`): a frame follows input, window
+//! events and scripted actions (frame-numbered script events count as an animation and keep
+//! frames coming; timed ones wake the loop when due), and once activity stops, one more frame
+//! a moment later lets the performance overlay show the last frames' figures. An idle viewer
+//! draws nothing. `prespline bench --window` (a scenario or a frame limit) keeps drawing
+//! continuously.
 
 use super::autosave::Autosave;
 use super::input::{InputEvent, Key, Modifiers, MouseButton};
 use super::scenario::{Scenario, ScenarioDriver};
-use super::script::ScriptPlayer;
+use super::script::{ScriptPlayer, When};
 use super::session::Session;
 use crate::cli::render::validation_mode;
 use crate::gpu::{
-    FRAMES_IN_FLIGHT, OffscreenDesc, Renderer, RendererDesc, Swapchain, SwapchainDesc,
-    ValidationSink,
+    FRAMES_IN_FLIGHT, Fault, OffscreenDesc, Renderer, RendererDesc, Swapchain, SwapchainDesc,
+    ValidationSink, vk,
 };
 use crate::profile::{FrameRecord, Phase, Recorder};
 use crate::scene::Scene;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
 use winit::event::{ElementState, MouseScrollDelta, WindowEvent};
@@ -43,6 +51,10 @@ pub struct ViewArgs {
     pub naive: bool,
     /// Where unsaved edits are kept (`None`: nowhere, as in benchmarks).
     pub autosave: Option<Autosave>,
+    /// MSAA samples; 0 picks the device's default.
+    pub msaa: u32,
+    /// Display level of detail.
+    pub lod: bool,
 }
 
 /// What a viewer run measured.
@@ -56,8 +68,8 @@ struct Running {
     session: Session,
     swapchain: Swapchain,
     renderer: Renderer,
-    // Last: the swapchain and renderer must be destroyed before the window.
-    window: Window,
+    // The swapchain holds the window too, so its handles outlive the surface.
+    window: Arc<Window>,
 }
 
 struct App {
@@ -70,12 +82,31 @@ struct App {
     start: Option<Instant>,
     last: Option<Instant>,
     error: Option<String>,
-    /// Frames run from the end of the previous one, so input handled between redraws counts
-    /// as this frame's input phase.
+    /// Continuous mode (benchmarks): frames run from the end of the previous one, so input
+    /// handled between redraws counts as this frame's input phase. On demand, a frame's record
+    /// starts with its redraw.
     rec: Recorder,
     device: String,
     /// The wake-up this app asked for on the autosave's behalf (so it clears only its own).
     autosave_wakeup: Option<Instant>,
+    /// Draw every frame (a benchmark scenario or a frame limit) instead of on demand.
+    continuous: bool,
+    /// Something changed since the last frame: draw one.
+    dirty: bool,
+    /// When the performance overlay's one slow tick after activity is due.
+    settle_at: Option<Instant>,
+    /// Error-path testing: the frame at which the next submission is made to fail as if the
+    /// device were lost (`PRESPLINE_FAULT=device-lost@N`).
+    fault_at: Option<u64>,
+}
+
+/// Delay of the overlay's last tick after activity stops.
+const SETTLE: Duration = Duration::from_millis(300);
+
+/// `PRESPLINE_FAULT=device-lost@N`: the frame number whose submission reports a lost device.
+fn fault_from_env() -> Option<u64> {
+    let spec = std::env::var("PRESPLINE_FAULT").ok()?;
+    spec.strip_prefix("device-lost@")?.parse().ok()
 }
 
 /// Whether an X11 display is reachable (this build's winit backend is X11; Wayland sessions
@@ -91,7 +122,12 @@ pub fn run(args: ViewArgs) -> Result<ViewRun, String> {
         return Err("no display: DISPLAY is not set (prespline view needs X11 or XWayland; for headless use try `prespline render` or `prespline bench`)".into());
     }
     let event_loop = EventLoop::new().map_err(|e| format!("cannot open the display: {e}"))?;
-    event_loop.set_control_flow(ControlFlow::Poll);
+    let continuous = args.scenario.is_some() || args.max_frames.is_some();
+    event_loop.set_control_flow(if continuous {
+        ControlFlow::Poll
+    } else {
+        ControlFlow::Wait
+    });
     let script = args.script.clone().map(ScriptPlayer::new);
     let rec = Recorder::with_capacity(args.warmup, args.max_frames.unwrap_or(4096));
     let mut app = App {
@@ -107,6 +143,10 @@ pub fn run(args: ViewArgs) -> Result<ViewRun, String> {
         rec,
         device: String::new(),
         autosave_wakeup: None,
+        continuous,
+        dirty: true,
+        settle_at: None,
+        fault_at: fault_from_env(),
     };
     // A panic anywhere in the loop must not lose unsaved edits: write the autosave, then let
     // the panic go on.
@@ -149,9 +189,11 @@ impl App {
         let attrs = Window::default_attributes()
             .with_title(format!("prespline — {}", self.args.title))
             .with_inner_size(PhysicalSize::new(w, h));
-        let window = event_loop
-            .create_window(attrs)
-            .map_err(|e| format!("cannot create a window: {e}"))?;
+        let window = Arc::new(
+            event_loop
+                .create_window(attrs)
+                .map_err(|e| format!("cannot create a window: {e}"))?,
+        );
         let display = window.display_handle().map_err(|e| e.to_string())?.as_raw();
         let mut renderer = Renderer::new(&RendererDesc {
             app_name: "prespline view".into(),
@@ -161,26 +203,42 @@ impl App {
         })
         .map_err(|e| e.to_string())?;
         self.sink = renderer.validation_sink();
+        self.device = renderer.caps().name.clone();
         let size = window.inner_size();
         let swapchain = renderer
             .create_swapchain(
-                &window,
+                Arc::clone(&window),
                 &SwapchainDesc {
                     width: size.width,
                     height: size.height,
                     vsync: self.args.vsync,
-                    samples: 0,
+                    samples: self.args.msaa,
                 },
             )
             .map_err(|e| e.to_string())?;
-        let mut session = Session::new(
+        let session = Session::new(
             &mut renderer,
             &self.args.scene,
             self.args.save_path.clone(),
             [size.width, size.height],
         )
         .map_err(|e| e.to_string())?;
+        let mut session = session;
         session.set_autosave(self.args.autosave.clone());
+        session.naive = self.args.naive;
+        session.options.lod = self.args.lod;
+        if let Some(scenario) = self.args.scenario {
+            let frames = self
+                .args
+                .max_frames
+                .map_or(1, |m| m.saturating_sub(self.args.warmup).max(1));
+            self.driver = Some(ScenarioDriver::new(
+                scenario,
+                &session,
+                self.args.warmup,
+                frames,
+            )?);
+        }
         window.request_redraw();
         self.running = Some(Running {
             session,
@@ -222,7 +280,12 @@ impl App {
         event_loop.exit();
     }
 
+    /// Ends the viewer with one error line. The session is first told to keep its unsaved
+    /// work (a lost device cannot be recovered from, but the document is in main memory).
     fn fail(&mut self, event_loop: &ActiveEventLoop, e: impl ToString) {
+        if let Some(r) = self.running.as_mut() {
+            r.session.on_fatal_exit();
+        }
         self.error.get_or_insert(e.to_string());
         self.shutdown(event_loop);
     }
@@ -230,6 +293,29 @@ impl App {
     fn input(&mut self, e: InputEvent) {
         if let Some(r) = self.running.as_mut() {
             r.session.handle(e);
+            self.dirty = true;
+        }
+    }
+
+    /// When the next frame is due in on-demand mode: now, at an instant, or not until an
+    /// event arrives.
+    fn next_frame(&self) -> Option<Instant> {
+        let now = Instant::now();
+        if self.dirty {
+            return Some(now);
+        }
+        let script =
+            self.script
+                .as_ref()
+                .and_then(ScriptPlayer::next_when)
+                .map(|when| match when {
+                    // Frame-numbered events are an animation: frames keep coming until they run.
+                    When::Frame(_) => now,
+                    When::Seconds(t) => self.start.unwrap_or(now) + Duration::from_secs_f64(t),
+                });
+        match (script, self.settle_at) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
         }
     }
 
@@ -237,6 +323,14 @@ impl App {
         let Some(r) = self.running.as_mut() else {
             return Ok(());
         };
+        let began = Instant::now();
+        let settling = self.settle_at.is_some_and(|t| t <= began);
+        self.dirty = false;
+        self.settle_at = None;
+        if self.fault_at == Some(self.frame) {
+            r.renderer
+                .inject_fault(Fault::Submit(vk::Result::ERROR_DEVICE_LOST));
+        }
         let rec = &mut self.rec;
         if rec.current_frame().is_none() {
             rec.begin_frame();
@@ -261,24 +355,30 @@ impl App {
         let applied = r.session.apply_pending();
         rec.add_samples(applied.samples as u64);
         rec.phase_start(Phase::Present);
-        if let Some(mut frame) = r
+        let size = r.window.inner_size();
+        match r
             .renderer
             .begin_swapchain(&mut r.swapchain)
             .map_err(|e| e.to_string())?
         {
-            if let Some(ms) = frame.gpu_time_ms() {
-                // The slot's previous use was FRAMES_IN_FLIGHT frames ago.
-                rec.set_gpu_ms(index.saturating_sub(FRAMES_IN_FLIGHT), ms);
+            // Out of date (rebuilt next time) or minimised (a resize will come): try again
+            // unless the window has no area.
+            None => self.dirty = size.width > 0 && size.height > 0,
+            Some(mut frame) => {
+                if let Some(ms) = frame.gpu_time_ms() {
+                    // The slot's previous use was FRAMES_IN_FLIGHT frames ago.
+                    rec.set_gpu_ms(index.saturating_sub(FRAMES_IN_FLIGHT), ms);
+                }
+                rec.phase_start(Phase::Upload);
+                let stats = r.session.upload(&mut frame).map_err(|e| e.to_string())?;
+                rec.add_bytes(stats.bytes as u64);
+                rec.phase_start(Phase::Record);
+                r.session
+                    .record(&mut frame, true)
+                    .map_err(|e| e.to_string())?;
+                rec.phase_start(Phase::Submit);
+                frame.finish().map_err(|e| e.to_string())?;
             }
-            rec.phase_start(Phase::Upload);
-            let stats = r.session.upload(&mut frame).map_err(|e| e.to_string())?;
-            rec.add_bytes(stats.bytes as u64);
-            rec.phase_start(Phase::Record);
-            r.session
-                .record(&mut frame, true)
-                .map_err(|e| e.to_string())?;
-            rec.phase_start(Phase::Submit);
-            frame.finish().map_err(|e| e.to_string())?;
         }
         rec.phase_end();
         for (path, hud) in shots {
@@ -288,9 +388,14 @@ impl App {
         }
         r.session.hud.gpu_ms = r.renderer.last_gpu_time_ms();
         let now = Instant::now();
-        if let Some(last) = self.last {
-            r.session.hud.push_frame((now - last).as_secs_f64() * 1e3);
-        }
+        // The interval between frames is the frame time while they come back to back; after
+        // an idle gap it would be the gap, so the frame's own duration stands in.
+        let interval = self.last.map(|last| now - last);
+        let ms = match interval {
+            Some(d) if self.continuous || d < SETTLE => d,
+            _ => now - began,
+        };
+        r.session.hud.push_frame(ms.as_secs_f64() * 1e3);
         self.last = Some(now);
         rec.end_frame();
         self.frame += 1;
@@ -300,9 +405,11 @@ impl App {
             .is_some_and(|m| self.frame as usize >= m)
         {
             r.session.quit = true;
-        } else {
+        } else if self.continuous {
             rec.begin_frame();
             rec.phase_start(Phase::Input);
+        } else if !settling {
+            self.settle_at = Some(now + SETTLE);
         }
         Ok(())
     }
@@ -348,6 +455,7 @@ fn screenshot(r: &mut Running, path: &Path, hud: bool) -> Result<(), String> {
         let mut frame = r.renderer.begin_offscreen(&mut target)?;
         r.session.upload(&mut frame)?;
         r.session.record(&mut frame, hud)?;
+        frame.capture();
         frame.finish()?;
         r.renderer.read_pixels(&target)
     })();
@@ -377,7 +485,12 @@ impl ApplicationHandler for App {
                     r.swapchain.resize(size.width, size.height);
                     r.session.resize(size.width, size.height);
                 }
+                self.dirty = true;
             }
+            WindowEvent::ScaleFactorChanged { .. }
+            | WindowEvent::Focused(_)
+            | WindowEvent::Occluded(false)
+            | WindowEvent::ThemeChanged(_) => self.dirty = true,
             WindowEvent::ModifiersChanged(m) => {
                 let s = m.state();
                 self.input(InputEvent::Modifiers(Modifiers {
@@ -444,11 +557,24 @@ impl ApplicationHandler for App {
     }
 
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
-        self.schedule_autosave(event_loop);
-        // Continuous redraw: the frame-time graph and profiling want a steady stream of frames;
-        // FIFO presentation paces it to the display.
-        if let Some(r) = self.running.as_ref() {
+        let Some(r) = self.running.as_ref() else {
+            return;
+        };
+        if self.continuous {
+            // Benchmarks want a steady stream of frames (paced by presentation).
             r.window.request_redraw();
+        } else {
+            match self.next_frame() {
+                Some(t) if t <= Instant::now() => {
+                    r.window.request_redraw();
+                    event_loop.set_control_flow(ControlFlow::Wait);
+                }
+                Some(t) => event_loop.set_control_flow(ControlFlow::WaitUntil(t)),
+                None => event_loop.set_control_flow(ControlFlow::Wait),
+            }
         }
+        // Unsaved edits are written about a second after the oldest one, also while idle: the
+        // autosave's deadline joins the frame's.
+        self.schedule_autosave(event_loop);
     }
 }

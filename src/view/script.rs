@@ -231,6 +231,11 @@ impl ScriptPlayer {
     pub fn finished(&self) -> bool {
         self.next >= self.events.len()
     }
+
+    /// When the next event is due (`None` once all have run).
+    pub fn next_when(&self) -> Option<When> {
+        self.events.get(self.next).map(|e| e.when)
+    }
 }
 
 /// An ERBS local: `l` or a path `[l, l2, …]` (curves); `[k, l]` or a path

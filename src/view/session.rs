@@ -18,6 +18,7 @@ use crate::model::{
 use crate::render::analysis::{
     CurveEval, Osculating, badge_overlay, osculating_lines, osculating_overlay,
 };
+use crate::render::lod::Lod;
 use crate::render::maps::{SurfaceMap, legend};
 use crate::render::overlays::overlay_lines;
 use crate::cli::render::DRAW_USES;
@@ -395,15 +396,19 @@ impl Session {
 
     /// Records the scene, overlays and (with `hud`) the overlay text and graph into the frame.
     pub fn record(&mut self, frame: &mut Frame<'_>, hud: bool) -> GpuResult<()> {
+        let aspect = self.size[0] / self.size[1];
         frame.set_clear_color(Palette::default().background);
-        frame.set_camera(self.camera.gpu(self.size[0] / self.size[1], &self.bounds));
+        frame.set_camera(self.camera.gpu(aspect, &self.bounds));
         let hl = Highlight {
             hovered: self.hovered.map(|p| p.handle),
             selected: self.selected,
             selected_local: self.selected_local,
             hovered_object: self.hovered_object,
         };
-        self.gpu.draw(frame, &self.doc, &self.options, &hl)?;
+        let view_proj = self.camera.view_proj(aspect, &self.bounds);
+        let lod = Lod::new(view_proj, self.size, frame.samples());
+        let report = self.gpu.draw(frame, &self.doc, &self.options, &hl, &lod)?;
+        self.hud.triangles = (report.triangles, report.full_triangles);
         let mut lines = overlay_lines(&self.doc, &self.options, self.bounds.radius());
         let mut analysis = Vec::new();
         if self.osculating
@@ -805,6 +810,14 @@ impl Session {
             (Key::Char('t'), false) => self.options.frenet = !self.options.frenet,
             (Key::Char('k'), false) => self.options.curvature_comb = !self.options.curvature_comb,
             (Key::Char('p'), false) => self.hud.visible = !self.hud.visible,
+            (Key::Char('d'), false) => {
+                self.options.lod = !self.options.lod;
+                self.set_status(if self.options.lod {
+                    "level of detail: on (dense surfaces drawn from a strided subset)"
+                } else {
+                    "level of detail: off (every sample drawn)"
+                });
+            }
             (Key::Char('h'), false) | (Key::F1, _) => self.show_help = !self.show_help,
             (Key::Char('f'), false) => self.frame_selection(),
             (Key::Char('a'), false) => self.frame_all(),

@@ -7,21 +7,28 @@ use std::path::PathBuf;
 
 use glam::{Mat4, Vec3};
 use prespline::gpu::{
-    Camera, GridShape, LAVAPIPE_ICD, Pixels, Renderer, RendererDesc, ValidationMode,
-    ValidationSink, force_driver_files,
+    Camera, GridShape, Pixels, Renderer, RendererDesc, ValidationMode, ValidationSink, vk,
 };
 
-/// Renderer on lavapipe with the validation layer required.
+/// Renderer on lavapipe (chosen by name among the installed drivers, and checked to be the
+/// CPU device llvmpipe) with the validation layer required.
 pub fn renderer_with(always_flush: bool) -> (Renderer, ValidationSink) {
-    force_driver_files(LAVAPIPE_ICD);
     let renderer = Renderer::new(&RendererDesc {
         app_name: "prespline-tests".into(),
         validation: ValidationMode::Required,
         sync_validation: true,
         display: None,
         always_flush,
+        device: Some("llvmpipe".into()),
     })
     .unwrap_or_else(|e| panic!("cannot create renderer on lavapipe: {e}"));
+    let caps = renderer.caps();
+    assert!(
+        caps.device_type == vk::PhysicalDeviceType::CPU && caps.name.contains("llvmpipe"),
+        "GPU tests must run on lavapipe (llvmpipe, a CPU device), got {} ({:?})",
+        caps.name,
+        caps.device_type
+    );
     let sink = renderer
         .validation_sink()
         .expect("validation is required, so a sink exists");
