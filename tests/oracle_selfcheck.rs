@@ -1,7 +1,9 @@
 //! Tests of the reference evaluator (`tests/oracle/`) itself: exact lecture numbers, the
 //! expo-rational B-function against an mpmath table, B-function identities, finite differences,
 //! partition of unity, ERBS interpolation, an independent Cox–de Boor basis-function path, edit
-//! semantics, the scene round trip and the comparison logic used against the product.
+//! semantics, refinement by blossoming (knot insertion, degree elevation: hand-worked cases,
+//! unchanged shapes, refined knot vectors), the scene round trip and the comparison logic used
+//! against the product.
 
 // Index loops over derivative orders and coordinates read best as they are written in the books.
 #![allow(clippy::needless_range_loop)]
@@ -9,13 +11,15 @@
 mod oracle;
 
 use oracle::bfunction::{self, BFunction, EXPO_SCALE};
+use oracle::blossom::Spline;
 use oracle::compare::{compare_output, nan_max};
+use oracle::condition::{compare_conditioned, compare_refined_outputs, condition_scales};
 use oracle::eval::{
     self, Basis, Homogeneous, Point3, bspline_derivatives, project_curve_derivatives,
 };
 use oracle::random::{self, Kind, Options};
 use oracle::rng::Rng;
-use oracle::scene::{Edit, Index, Object, Scene, Shape, apply_edits, sample_params};
+use oracle::scene::{Edit, Elevation, Index, Object, Scene, Shape, apply_edits, sample_params};
 use serde_json::{Value, json};
 
 fn close(a: f64, b: f64, tol: f64) -> bool {
@@ -1675,4 +1679,844 @@ fn random_generator_covers_the_contract() {
             "generator rarely produces {key:?}: {seen:?}"
         );
     }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Structural edits: refinement by blossoming (tests/oracle/blossom.rs)
+// ---------------------------------------------------------------------------------------------
+
+/// A random homogeneous degree-p spline with n points on a random (clamped or not, possibly
+/// discontinuous) knot vector.
+fn random_spline(rng: &mut Rng, p: usize, n: usize) -> Spline<4> {
+    let knots = random::random_bspline_knots(rng, p, n);
+    let points = (0..n)
+        .map(|_| {
+            let x: Point3 = std::array::from_fn(|_| rng.range(-10.0, 10.0));
+            eval::homogeneous(x, rng.range(0.2, 5.0))
+        })
+        .collect();
+    Spline {
+        degree: p,
+        knots,
+        points,
+    }
+}
+
+fn max_abs<const D: usize>(points: &[[f64; D]]) -> f64 {
+    points.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()))
+}
+
+fn distance<const D: usize>(a: [f64; D], b: [f64; D]) -> f64 {
+    (0..D).fold(0.0f64, |m, k| m.max((a[k] - b[k]).abs()))
+}
+
+/// The non-empty spans of the domain: s in p..n with t_s < t_{s+1}.
+fn domain_spans<const D: usize>(s: &Spline<D>) -> Vec<usize> {
+    (s.degree..s.points.len())
+        .filter(|&i| s.knots[i] < s.knots[i + 1])
+        .collect()
+}
+
+#[test]
+fn blossom_is_the_curve_on_its_diagonal_symmetric_and_multiaffine() {
+    let mut rng = Rng::new(2024);
+    let mut worst = [0.0f64; 3];
+    for _ in 0..300 {
+        let p = rng.int(0, 7);
+        let n = p + 1 + rng.int(0, 6);
+        let s = random_spline(&mut rng, p, n);
+        let scale = max_abs(&s.points);
+        for span in domain_spans(&s) {
+            let (lo, hi) = (s.knots[span], s.knots[span + 1]);
+            let t = rng.range(lo, hi);
+            let diagonal = s.blossom(span, &vec![t; p]);
+            let curve = bspline_derivatives(p, &s.knots, &s.points, t, 0)[0];
+            worst[0] = worst[0].max(distance(diagonal, curve) / scale);
+            // Symmetric: any order of the arguments (drawn from the knots that shape the span).
+            let (first, last) = (s.knots[span + 1 - p.max(1)], s.knots[span + p.max(1)]);
+            let args: Vec<f64> = (0..p).map(|_| rng.range(first, last)).collect();
+            let f = s.blossom(span, &args);
+            let mut shuffled = args.clone();
+            for i in (1..shuffled.len()).rev() {
+                shuffled.swap(i, rng.int(0, i));
+            }
+            worst[1] = worst[1].max(distance(f, s.blossom(span, &shuffled)) / scale);
+            // Affine in each argument (here the first): f(αx + (1−α)y, …) = α f(x, …) + (1−α) f(y, …).
+            if p > 0 {
+                // Dyadic α, x, y: the mixed argument is exact, so only the blossom rounds.
+                let alpha = *rng.pick(&[-0.5, 0.25, 0.75, 1.5]);
+                let dyadic = |x: f64| (x * 1024.0).round() / 1024.0;
+                let (x, y) = (dyadic(rng.range(lo, hi)), dyadic(rng.range(lo, hi)));
+                let mut at = args.clone();
+                at[0] = alpha * x + (1.0 - alpha) * y;
+                let mixed = s.blossom(span, &at);
+                at[0] = x;
+                let fx = s.blossom(span, &at);
+                at[0] = y;
+                let fy = s.blossom(span, &at);
+                let expected = eval::add(eval::scale(alpha, fx), eval::scale(1.0 - alpha, fy));
+                worst[2] = worst[2].max(distance(mixed, expected) / scale.max(max_abs(&[fx, fy])));
+            }
+        }
+    }
+    println!("blossom diagonal/symmetry/affinity: worst {worst:?}");
+    assert!(worst.iter().all(|&w| w < 1e-13), "{worst:?}");
+}
+
+#[test]
+fn blossom_at_the_knots_gives_the_control_points() {
+    // de Boor–Ramshaw: P_j = f_s(t_{j+1}, …, t_{j+p}) for every domain span s that P_j shapes.
+    let mut rng = Rng::new(7);
+    let mut checked = 0;
+    for _ in 0..300 {
+        let p = rng.int(0, 7);
+        let n = p + 1 + rng.int(0, 6);
+        let s = random_spline(&mut rng, p, n);
+        let scale = max_abs(&s.points);
+        for span in domain_spans(&s) {
+            for j in span - p..=span {
+                let f = s.blossom(span, &s.knots[j + 1..=j + p]);
+                assert!(
+                    distance(f, s.points[j]) <= 1e-13 * scale,
+                    "P_{j} from span {span}: {f:?} vs {:?} (knots {:?})",
+                    s.points[j],
+                    s.knots
+                );
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 1000);
+}
+
+#[test]
+fn elevated_blossom_by_subsets_equals_one_at_a_time_elevation() {
+    let mut rng = Rng::new(11);
+    for _ in 0..100 {
+        let p = rng.int(0, 5);
+        let e = rng.int(0, 3);
+        let n = p + 1 + rng.int(0, 4);
+        let s = random_spline(&mut rng, p, n);
+        let span = *rng.pick(&domain_spans(&s));
+        let args: Vec<f64> = (0..p + e).map(|_| rng.range(-3.0, 3.0)).collect();
+        let a = s.elevated_blossom(span, &args);
+        let b = s.elevated_blossom_recursive(span, &args);
+        let scale = max_abs(&[a]).max(max_abs(&s.points));
+        assert!(
+            distance(a, b) <= 1e-14 * scale,
+            "p {p} e {e}: {a:?} vs {b:?}"
+        );
+        // On the diagonal, the elevated blossom is still the curve.
+        let t = rng.range(s.knots[span], s.knots[span + 1]);
+        let diagonal = s.elevated_blossom(span, &vec![t; p + e]);
+        assert!(distance(diagonal, s.blossom(span, &vec![t; p])) <= 1e-13 * max_abs(&s.points));
+    }
+}
+
+fn curve_points(object: &Object) -> (&Basis, &Vec<Point3>, &Option<Vec<f64>>) {
+    match &object.shape {
+        Shape::Curve {
+            basis,
+            points,
+            weights,
+        } => (basis, points, weights),
+        _ => panic!("not a curve"),
+    }
+}
+
+fn assert_points(actual: &[Point3], expected: &[[f64; 3]], tol: f64, what: &str) {
+    assert_eq!(actual.len(), expected.len(), "{what}: point count");
+    for (i, (a, e)) in actual.iter().zip(expected).enumerate() {
+        assert_point(*a, *e, tol, &format!("{what}: point {i}"));
+    }
+}
+
+#[test]
+fn bezier_degree_elevation_by_hand() {
+    // Q_i = i/(n+1) P_{i−1} + (1 − i/(n+1)) P_i for the lecture's cubic (n = 3):
+    // Q_1 = P_0/4 + 3 P_1/4, Q_2 = (P_1 + P_2)/2, Q_3 = 3 P_2/4 + P_3/4.
+    let mut scene = Scene {
+        objects: vec![curve(&LECTURE_POINTS, None, Basis::Bezier)],
+    };
+    apply_edits(
+        &mut scene,
+        &[parse_edit(json!({"object": "c", "elevate_degree": 1}))],
+    )
+    .unwrap();
+    let c = &scene.objects[0];
+    assert_eq!(
+        c.type_name(),
+        "bezier_curve",
+        "elevation keeps a Bézier curve Bézier"
+    );
+    let (basis, points, weights) = curve_points(c);
+    assert_eq!(*basis, Basis::Bezier);
+    assert!(weights.is_none());
+    assert_points(
+        points,
+        &[
+            [1.0, 1.0, 0.0],
+            [1.0, 7.75, 0.0],
+            [5.5, 10.0, 0.0],
+            [10.0, 7.75, 0.0],
+            [10.0, 1.0, 0.0],
+        ],
+        1e-14,
+        "elevated lecture cubic",
+    );
+    // The formula on random Bézier curves of degree 0..=10, and e = 2 as two steps of 1.
+    let mut rng = Rng::new(5);
+    for _ in 0..100 {
+        let n = rng.int(0, 10);
+        let p: Vec<[f64; 3]> = (0..=n)
+            .map(|_| std::array::from_fn(|_| rng.range(-10.0, 10.0)))
+            .collect();
+        let once = Spline::bezier(&p).elevate(1).unwrap();
+        let expected: Vec<[f64; 3]> = (0..=n + 1)
+            .map(|i| {
+                let a = i as f64 / (n + 1) as f64;
+                match i {
+                    0 => p[0],
+                    _ if i == n + 1 => p[n],
+                    _ => eval::add(eval::scale(a, p[i - 1]), eval::scale(1.0 - a, p[i])),
+                }
+            })
+            .collect();
+        assert_points(&once.points, &expected, 1e-13, &format!("degree {n} + 1"));
+        let twice = Spline::bezier(&p).elevate(2).unwrap();
+        let stepwise = Spline::bezier(&once.points).elevate(1).unwrap();
+        assert_points(&twice.points, &stepwise.points, 1e-13, "e = 2 = 1 + 1");
+        assert_eq!(twice.knots, Spline::<3>::bezier(&twice.points).knots);
+    }
+}
+
+#[test]
+fn single_knot_insertion_into_uniform_cubic_by_hand() {
+    // Knots 0..7, domain [3, 4]; t = 3.5 lies in span 3. Worked by hand:
+    //   Q_0 = P_0, Q_1 = P_0/6 + 5 P_1/6, Q_2 = (P_1 + P_2)/2, Q_3 = 5 P_2/6 + P_3/6, Q_4 = P_3.
+    let mut scene = Scene {
+        objects: vec![curve(
+            &LECTURE_POINTS,
+            None,
+            Basis::BSpline {
+                degree: 3,
+                knots: (0..8).map(f64::from).collect(),
+            },
+        )],
+    };
+    let before = scene.clone();
+    apply_edits(
+        &mut scene,
+        &[parse_edit(json!({"object": "c", "insert_knot": 3.5}))],
+    )
+    .unwrap();
+    let (basis, points, _) = curve_points(&scene.objects[0]);
+    assert_eq!(
+        *basis,
+        Basis::BSpline {
+            degree: 3,
+            knots: vec![0.0, 1.0, 2.0, 3.0, 3.5, 4.0, 5.0, 6.0, 7.0]
+        }
+    );
+    assert_points(
+        points,
+        &[
+            [1.0, 1.0, 0.0],
+            [1.0, 8.5, 0.0],
+            [5.5, 10.0, 0.0],
+            [10.0, 8.5, 0.0],
+            [10.0, 1.0, 0.0],
+        ],
+        1e-14,
+        "uniform cubic, t = 3.5",
+    );
+    assert!(compare_output(&before, 3, &scene.sample_json(3), 1e-14).ok());
+
+    // The lecture's Bézier cubic, t = 1/2 three times: de Casteljau's subdivision
+    // P_0, P_01, P_012, P_0123, P_123, P_23, P_3, and the object becomes a B-spline.
+    let mut scene = Scene {
+        objects: vec![curve(&LECTURE_POINTS, None, Basis::Bezier)],
+    };
+    apply_edits(
+        &mut scene,
+        &[parse_edit(
+            json!({"object": "c", "insert_knot": 0.5, "times": 3}),
+        )],
+    )
+    .unwrap();
+    assert_eq!(scene.objects[0].type_name(), "bspline_curve");
+    let (basis, points, _) = curve_points(&scene.objects[0]);
+    assert_eq!(
+        *basis,
+        Basis::BSpline {
+            degree: 3,
+            knots: vec![0.0, 0.0, 0.0, 0.0, 0.5, 0.5, 0.5, 1.0, 1.0, 1.0, 1.0]
+        }
+    );
+    assert_points(
+        points,
+        &[
+            [1.0, 1.0, 0.0],
+            [1.0, 5.5, 0.0],
+            [3.25, 7.75, 0.0],
+            [5.5, 7.75, 0.0],
+            [7.75, 7.75, 0.0],
+            [10.0, 5.5, 0.0],
+            [10.0, 1.0, 0.0],
+        ],
+        1e-14,
+        "Bézier subdivision at 1/2",
+    );
+}
+
+#[test]
+fn refined_quarter_circle_stays_on_the_circle() {
+    // Homogeneous elevation of (1,0) (1,1) (0,1) with weights 1, 1/√2, 1:
+    // H_1 = H_0/3 + 2 H_1/3, so w_1 = (1 + √2)/3 and Q_1 = (1/3 + √2/3, √2/3)/w_1.
+    let r = std::f64::consts::FRAC_1_SQRT_2;
+    let mut scene = Scene {
+        objects: vec![curve(
+            &[[1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
+            Some(vec![1.0, r, 1.0]),
+            Basis::Bezier,
+        )],
+    };
+    apply_edits(
+        &mut scene,
+        &[parse_edit(json!({"object": "c", "elevate_degree": 1}))],
+    )
+    .unwrap();
+    let (_, points, weights) = curve_points(&scene.objects[0]);
+    let w1 = (1.0 + 2.0 * r) / 3.0;
+    let weights = weights.as_ref().unwrap();
+    assert!(close(weights[1], w1, 1e-15) && close(weights[2], w1, 1e-15));
+    assert!(close(weights[0], 1.0, 0.0) && close(weights[3], 1.0, 0.0));
+    assert_point(points[1], [1.0, 2.0 * r / 3.0 / w1, 0.0], 1e-15, "Q_1");
+    apply_edits(
+        &mut scene,
+        &[
+            parse_edit(json!({"object": "c", "insert_knot": 0.3, "times": 2})),
+            parse_edit(json!({"object": "c", "insert_knot": 0.8})),
+        ],
+    )
+    .unwrap();
+    for j in 0..=64 {
+        let [x, y, _] = scene.objects[0].curve_derivatives(j as f64 / 64.0, 0)[0];
+        let radius = (x * x + y * y).sqrt();
+        assert!(close(radius, 1.0, 4e-16), "radius {radius} at {j}/64");
+    }
+}
+
+/// Max over objects and derivative orders of |after − before| relative to the condition
+/// scales of the two nets (`oracle::condition`), at the oracle's parameters (the domain does
+/// not change).
+fn shape_change(before: &Scene, after: &Scene, n: usize) -> f64 {
+    let report = compare_refined_outputs(
+        before,
+        after,
+        n,
+        &before.sample_json(n),
+        &after.sample_json(n),
+        f64::INFINITY,
+    );
+    assert!(report.problems.is_empty(), "{}", report.describe());
+    report.max_relative_error
+}
+
+/// Checks knots, degree and control counts of every direction after one structural edit.
+fn check_structure(before: &Object, after: &Object, edit: &Edit) {
+    let was = random::refinable_directions(before).unwrap();
+    let now = random::refinable_directions(after).unwrap();
+    let what = format!("{edit:?}");
+    match edit {
+        Edit::InsertKnot {
+            direction,
+            t,
+            times,
+            ..
+        } => {
+            let times = times.unwrap_or(1);
+            let dir = direction.unwrap_or(0);
+            for d in 0..was.len() {
+                let ((p, k, n), (q, k2, n2)) = (&was[d], &now[d]);
+                assert_eq!(p, q, "{what}: degree");
+                if d != dir {
+                    assert_eq!((k, n), (k2, n2), "{what}: other direction");
+                    continue;
+                }
+                assert_eq!(*n2, n + times, "{what}: control count");
+                let mult = |ks: &[f64]| ks.iter().filter(|&&x| x == *t).count();
+                assert_eq!(mult(k2), mult(k) + times, "{what}: multiplicity");
+                assert!(mult(k2) <= *q, "{what}: multiplicity above the degree");
+                let mut expected = k.clone();
+                expected.extend(std::iter::repeat_n(*t, times));
+                expected.sort_by(f64::total_cmp);
+                assert_eq!(*k2, expected, "{what}: refined knot vector");
+            }
+            if before.type_name().starts_with("bezier") {
+                assert!(after.type_name().starts_with("bspline"), "{what}: type");
+            }
+        }
+        Edit::ElevateDegree { by, .. } => {
+            for (d, e) in by.amounts().into_iter().enumerate() {
+                let ((p, k, n), (q, k2, n2)) = (&was[d], &now[d]);
+                if e == 0 {
+                    assert_eq!((p, n), (q, n2), "{what}: unelevated direction");
+                    continue;
+                }
+                assert_eq!(*q, p + e, "{what}: degree");
+                let (a, b) = (k[*p], k[*n]);
+                assert!(k2[..=*q].iter().all(|&x| x == a), "{what}: clamped start");
+                assert!(k2[*n2..].iter().all(|&x| x == b), "{what}: clamped end");
+                assert_eq!(k2.len(), n2 + q + 1, "{what}: knot count");
+                let interior = |ks: &[f64]| -> Vec<f64> {
+                    let mut v: Vec<f64> = ks.iter().copied().filter(|&x| a < x && x < b).collect();
+                    v.dedup();
+                    v
+                };
+                assert_eq!(interior(k), interior(k2), "{what}: interior knot values");
+                for x in interior(k) {
+                    let mult = |ks: &[f64]| ks.iter().filter(|&&y| y == x).count();
+                    assert_eq!(mult(k2), mult(k) + e, "{what}: multiplicity of {x}");
+                }
+            }
+            assert_eq!(before.type_name(), after.type_name(), "{what}: type");
+        }
+        _ => unreachable!(),
+    }
+}
+
+#[test]
+fn structural_edits_keep_the_shape_and_refine_the_knots() {
+    let kinds = [
+        Kind::BezierCurve,
+        Kind::BSplineCurve,
+        Kind::BezierSurface,
+        Kind::BSplineSurface,
+    ];
+    let opts = Options {
+        max_samples: 7,
+        high_degree_chance: 0.0,
+        ..Options::default()
+    };
+    let mut worst = 0.0f64;
+    let mut edits_checked = 0;
+    for seed in 0..150 {
+        // Derivatives up to 4, rational objects included, against the unrefined model.
+        let n = (seed % 5) as usize;
+        let mix = random::StructuralMix {
+            max_points: 16,
+            ..Default::default()
+        };
+        let original = random::random_scene(seed, &kinds, &opts);
+        let mut rng = Rng::new(seed ^ 0x5EED);
+        let mut scene = original.clone();
+        for _ in 0..rng.int(1, 5) {
+            let i = rng.int(0, scene.objects.len() - 1);
+            let Some(edit) = random::random_structural_edit(&mut rng, &scene.objects[i], &mix)
+            else {
+                continue;
+            };
+            let before = scene.objects[i].clone();
+            edit.apply(&mut scene).unwrap();
+            check_structure(&before, &scene.objects[i], &edit);
+            edits_checked += 1;
+        }
+        let change = shape_change(&original, &scene, n);
+        assert!(
+            change < 1e-14,
+            "seed {seed}: shape changed by {change:e}\nbefore: {}\nafter: {}",
+            original.to_json(),
+            scene.to_json()
+        );
+        worst = worst.max(change);
+    }
+    println!("{edits_checked} structural edits; worst scaled shape change {worst:e}");
+    assert!(edits_checked > 200);
+}
+
+#[test]
+fn structural_edits_round_trip_and_bad_values_are_refused() {
+    let scene = Scene::from_json(&json!({"objects": [
+        {"name": "c", "type": "bspline_curve", "degree": 2, "knots": [0, 0, 0, 1, 1, 2, 2, 2],
+         "points": [[0, 0, 0], [1, 1, 0], [2, 0, 0], [3, 1, 0], [4, 0, 0]], "samples": 5},
+        {"name": "s", "type": "bezier_surface",
+         "points": [[[0, 0, 0], [0, 1, 0]], [[1, 0, 0], [1, 1, 1]]], "samples": [3, 3]},
+        {"name": "e", "type": "erbs_curve", "knots": [0, 0, 1, 1],
+         "local": [{"points": [[0, 0, 0]]}, {"points": [[1, 1, 1]]}], "samples": 3}
+    ]}))
+    .unwrap();
+    let good = [
+        json!({"object": "c", "insert_knot": 0.5}),
+        json!({"object": "c", "insert_knot": 0.5, "times": 2}),
+        json!({"object": "c", "insert_knot": 1.5, "times": 1}),
+        json!({"object": "c", "elevate_degree": 3}),
+        json!({"object": "s", "insert_knot": {"v": 0.25}}),
+        json!({"object": "s", "elevate_degree": {"u": 1}}),
+        json!({"object": "s", "elevate_degree": {"u": 0, "v": 2}}),
+    ];
+    for g in &good {
+        let edit = parse_edit(g.clone());
+        assert_eq!(edit.to_json(), *g, "round trip");
+        let mut s = scene.clone();
+        edit.apply(&mut s).unwrap_or_else(|e| panic!("{g}: {e}"));
+        assert!(shape_change(&scene, &s, 2) < 1e-14, "{g}");
+    }
+    let bad = [
+        json!({"object": "c", "insert_knot": 0}),
+        json!({"object": "c", "insert_knot": 2}),
+        json!({"object": "c", "insert_knot": -1}),
+        json!({"object": "c", "insert_knot": 1}),
+        json!({"object": "c", "insert_knot": 0.5, "times": 3}),
+        json!({"object": "c", "insert_knot": 0.5, "times": 0}),
+        json!({"object": "c", "elevate_degree": 0}),
+        json!({"object": "c", "elevate_degree": 63}),
+        json!({"object": "c", "insert_knot": {"u": 0.5}}),
+        json!({"object": "s", "insert_knot": 0.5}),
+        json!({"object": "s", "elevate_degree": {}}),
+        json!({"object": "s", "elevate_degree": {"u": 0, "v": 0}}),
+        json!({"object": "e", "insert_knot": 0.5}),
+        json!({"object": "e", "elevate_degree": 1}),
+    ];
+    for b in &bad {
+        let mut s = scene.clone();
+        let result = Edit::from_json(b).and_then(|e| e.apply(&mut s));
+        assert!(result.is_err(), "{b} accepted");
+        assert_eq!(s, scene, "{b}: the model changed");
+    }
+    for b in [
+        json!({"object": "c", "insert_knot": "0.5"}),
+        json!({"object": "c", "insert_knot": 0.5, "times": -1}),
+        json!({"object": "c", "elevate_degree": 1.5}),
+        json!({"object": "s", "insert_knot": {"w": 0.5}}),
+        json!({"object": "s", "insert_knot": {"u": 0.5, "v": 0.5}}),
+    ] {
+        assert!(Edit::from_json(&b).is_err(), "{b} parsed");
+    }
+}
+
+#[test]
+fn random_structural_edits_cover_the_contract() {
+    use std::collections::BTreeMap;
+    let mut seen: BTreeMap<&str, usize> = BTreeMap::new();
+    let mut mark = |key: &'static str, yes: bool| {
+        if yes {
+            *seen.entry(key).or_default() += 1;
+        }
+    };
+    let opts = Options {
+        max_samples: 9,
+        high_degree_chance: 0.0,
+        ..Options::default()
+    };
+    let mix = random::StructuralMix::default();
+    for seed in 0..150 {
+        let scene = random::random_scene(seed, &Kind::ALL, &opts);
+        let mut rng = Rng::new(seed);
+        let edits = random::random_edits_with_structure(&mut rng, &scene, 25, &mix);
+        let json_edits = Value::Array(edits.iter().map(Edit::to_json).collect());
+        assert_eq!(oracle::scene::parse_edits(&json_edits).unwrap(), edits);
+        let mut model = scene.clone();
+        for (i, edit) in edits.iter().enumerate() {
+            let object = model.object(edit.object()).unwrap().clone();
+            let rational = matches!(
+                &object.shape,
+                Shape::Curve {
+                    weights: Some(_),
+                    ..
+                } | Shape::Surface {
+                    weights: Some(_),
+                    ..
+                }
+            );
+            let bezier = object.type_name().starts_with("bezier");
+            let later_point_edit = edits[i + 1..]
+                .iter()
+                .any(|e| e.object() == edit.object() && matches!(e, Edit::PointDelta { .. }));
+            match edit {
+                Edit::InsertKnot {
+                    direction,
+                    t,
+                    times,
+                    ..
+                } => {
+                    let dirs = random::refinable_directions(&object).unwrap();
+                    let (_, knots, _) = &dirs[direction.unwrap_or(0)];
+                    mark("insert into a curve", direction.is_none());
+                    mark("insert in u", *direction == Some(0));
+                    mark("insert in v", *direction == Some(1));
+                    mark("insert times > 1", times.unwrap_or(1) > 1);
+                    mark("insert times written", times.is_some());
+                    mark("insert at an existing knot", knots.contains(t));
+                    mark(
+                        "insert at a sample parameter",
+                        object.params()[direction.unwrap_or(0)].contains(t),
+                    );
+                    mark("insert into a Bézier object", bezier);
+                    mark("insert into a rational object", rational);
+                    mark("point edit after an insertion", later_point_edit);
+                }
+                Edit::ElevateDegree { by, .. } => {
+                    let dirs = random::refinable_directions(&object).unwrap();
+                    let unclamped = dirs.iter().any(|(p, k, _)| k[0] != k[*p]);
+                    mark("elevate a curve", matches!(by, Elevation::Curve(_)));
+                    mark("elevate by 2", by.amounts().contains(&2));
+                    mark(
+                        "elevate a surface, one direction omitted",
+                        matches!(
+                            by,
+                            Elevation::Surface { u: None, .. } | Elevation::Surface { v: None, .. }
+                        ),
+                    );
+                    mark(
+                        "elevate a surface, both directions",
+                        by.amounts().iter().filter(|&&e| e > 0).count() == 2,
+                    );
+                    mark("elevate a Bézier object", bezier);
+                    mark("elevate a rational object", rational);
+                    mark("elevate an unclamped object", unclamped);
+                    mark("point edit after an elevation", later_point_edit);
+                }
+                _ => {}
+            }
+            edit.apply(&mut model).unwrap();
+        }
+    }
+    println!("{seen:#?}");
+    for key in [
+        "insert into a curve",
+        "insert in u",
+        "insert in v",
+        "insert times > 1",
+        "insert times written",
+        "insert at an existing knot",
+        "insert at a sample parameter",
+        "insert into a Bézier object",
+        "insert into a rational object",
+        "point edit after an insertion",
+        "elevate a curve",
+        "elevate by 2",
+        "elevate a surface, one direction omitted",
+        "elevate a surface, both directions",
+        "elevate a Bézier object",
+        "elevate a rational object",
+        "elevate an unclamped object",
+        "point edit after an elevation",
+    ] {
+        assert!(
+            seen.get(key).copied().unwrap_or(0) >= 3,
+            "generator rarely produces {key:?}: {seen:?}"
+        );
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Condition scales (tests/oracle/condition.rs), the measure of the structural agreement tests
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn condition_scales_by_hand() {
+    // C(t) = (1−t) P0 + t P1 with P0 = (1,0,0), P1 = (3,0,0), at t = 0 and 1:
+    //   order 0: Σ|N_i||P_i| = (1−t)·1 + t·3, largest 3;  order 1: |−1|·1 + |1|·3 = 4.
+    let line = |weights: Option<Vec<f64>>| {
+        curve(&[[1.0, 0.0, 0.0], [3.0, 0.0, 0.0]], weights, Basis::Bezier)
+    };
+    let params = vec![vec![0.0, 1.0]];
+    assert_eq!(
+        condition_scales(&line(None), &params, 1).unwrap(),
+        vec![3.0, 4.0]
+    );
+    // With unit weights the quotient rule adds the weights' bounds (w = 1, w' = 0, C = 1 + 2t,
+    // C' = 2): order 0: (1+2t) + 1·|C| = 2 + 4t → 6; order 1: 4 + 1·|C'| + (|−1|+|1|)·|C| + 0
+    // = 8 + 4t → 12.
+    assert_eq!(
+        condition_scales(&line(Some(vec![1.0, 1.0])), &params, 1).unwrap(),
+        vec![6.0, 12.0]
+    );
+    // ERBS objects have none.
+    let scene = random::random_scene(1, &[Kind::ErbsCurve], &Options::default());
+    let erbs = &scene.objects[0];
+    assert!(condition_scales(erbs, &erbs.params(), 1).is_none());
+}
+
+#[test]
+fn condition_scales_bound_values_and_rounding_of_the_net() {
+    let kinds = [
+        Kind::BezierCurve,
+        Kind::BSplineCurve,
+        Kind::BezierSurface,
+        Kind::BSplineSurface,
+    ];
+    let opts = Options {
+        max_samples: 9,
+        ..Options::default()
+    };
+    let mut worst = 0.0f64;
+    for seed in 0..60 {
+        let scene = random::random_scene(seed, &kinds, &opts);
+        let n = (seed % 4) as usize + 1;
+        // A polynomial order's condition scale is at least its largest value.
+        for object in &scene.objects {
+            if matches!(
+                object.shape,
+                Shape::Curve { weights: None, .. } | Shape::Surface { weights: None, .. }
+            ) {
+                let scales = condition_scales(object, &object.params(), n).unwrap();
+                let values = object.sample_json(n)["samples"].clone();
+                let largest = flatten_numbers(&values)
+                    .into_iter()
+                    .fold(0.0f64, |m, x| m.max(x.abs()));
+                let top = scales.iter().fold(0.0f64, |m, &x| m.max(x));
+                assert!(
+                    top >= largest * (1.0 - 1e-15),
+                    "seed {seed}: {top} < {largest}"
+                );
+            }
+        }
+        // Rounding every control coordinate and weight by a relative δ moves each sample by
+        // at most δ times the condition scale (first order).
+        let delta = 1e-11;
+        let mut rng = Rng::new(seed);
+        let mut nudge = |x: &mut f64| *x *= 1.0 + delta * rng.range(-1.0, 1.0);
+        let mut perturbed = scene.clone();
+        for object in &mut perturbed.objects {
+            match &mut object.shape {
+                Shape::Curve {
+                    points, weights, ..
+                } => {
+                    points.iter_mut().flatten().for_each(&mut nudge);
+                    weights.iter_mut().flatten().for_each(&mut nudge);
+                }
+                Shape::Surface {
+                    points, weights, ..
+                } => {
+                    points.iter_mut().flatten().flatten().for_each(&mut nudge);
+                    weights.iter_mut().flatten().flatten().for_each(&mut nudge);
+                }
+                _ => unreachable!(),
+            }
+        }
+        let report = compare_conditioned(&scene, n, &perturbed.sample_json(n), f64::INFINITY);
+        assert!(report.problems.is_empty(), "{}", report.describe());
+        worst = worst.max(report.max_relative_error / delta);
+    }
+    println!("rounding by δ moved samples by at most {worst:.3} δ·(condition scale)");
+    assert!(worst <= 1.0 + 1e-3, "{worst}");
+    assert!(worst > 0.05, "the perturbation did not register: {worst}");
+}
+
+#[test]
+fn conditioned_comparisons_detect_mismatches() {
+    let kinds = [
+        Kind::BezierCurve,
+        Kind::BSplineSurface,
+        Kind::ErbsCurve,
+        Kind::BSplineCurve,
+    ];
+    let opts = Options {
+        max_samples: 5,
+        rational_chance: 0.5,
+        ..Options::default()
+    };
+    // A seed whose B-spline surface has room for a knot in u.
+    let scene = (0..)
+        .map(|seed| random::random_scene(seed, &kinds, &opts))
+        .find(|s| {
+            matches!(&s.objects[1].shape,
+                Shape::Surface { basis: [Basis::BSpline { degree, .. }, _], points, .. }
+                    if *degree >= 1 && points.len() > *degree)
+        })
+        .unwrap();
+    let n = 2;
+    let out = scene.sample_json(n);
+    let report = compare_conditioned(&scene, n, &out, 1e-13);
+    assert!(report.ok(), "{}", report.describe());
+    assert!(report.compared > 0);
+
+    // One number of the surface and of a curve off by 1e-11 of its condition scale: one
+    // mismatch each, located.
+    for (object, path, slot) in [
+        (1usize, vec![1usize, 0, 1, 0, 2], n + 1),
+        (3, vec![2, 1, 0], 1),
+    ] {
+        let o = &scene.objects[object];
+        let scale = condition_scales(o, &o.params(), n).unwrap()[slot];
+        let mut bad = out.clone();
+        let mut cell = &mut bad["objects"][object]["samples"];
+        for &i in &path {
+            cell = &mut cell[i];
+        }
+        let x = cell.as_f64().unwrap();
+        *cell = json!(x + 1e-11 * scale);
+        let report = compare_conditioned(&scene, n, &bad, 1e-13);
+        assert_eq!(report.mismatch_count, 1, "{}", report.describe());
+        assert_eq!(report.mismatches[0].object, format!("o{object}"));
+    }
+    // The ERBS curve is held to its values by compare_output.
+    let mut bad = out.clone();
+    let x = bad["objects"][2]["samples"][1][0][0].as_f64().unwrap();
+    bad["objects"][2]["samples"][1][0][0] = json!(x + 1e-9 * x.abs().max(1.0));
+    assert_eq!(
+        compare_conditioned(&scene, n, &bad, 1e-13).mismatch_count,
+        1
+    );
+    // A last-bit change passes.
+    let mut fine = out.clone();
+    let x = fine["objects"][0]["samples"][1][1][0].as_f64().unwrap();
+    fine["objects"][0]["samples"][1][1][0] = json!(x * (1.0 + f64::EPSILON));
+    assert!(compare_conditioned(&scene, n, &fine, 1e-13).ok());
+    // Structure: a missing object, a wrong type, a non-number.
+    let mut missing = out.clone();
+    missing["objects"].as_array_mut().unwrap().remove(0);
+    assert!(!compare_conditioned(&scene, n, &missing, 1e-13).ok());
+    let mut typed = out.clone();
+    typed["objects"][0]["type"] = json!("bspline_curve");
+    assert!(!compare_conditioned(&scene, n, &typed, 1e-13).ok());
+    let mut nan = out.clone();
+    nan["objects"][3]["samples"][0][0][1] = json!(null);
+    assert!(!compare_conditioned(&scene, n, &nan, 1e-13).ok());
+
+    // compare_refined_outputs: a correct refinement passes, a refined net off by 1e-10 does not.
+    let mut refined = scene.clone();
+    apply_edits(
+        &mut refined,
+        &[
+            parse_edit(json!({"object": "o0", "elevate_degree": 1})),
+            parse_edit(
+                json!({"object": "o1", "insert_knot": {"u": refined_middle(&scene.objects[1])}}),
+            ),
+        ],
+    )
+    .unwrap();
+    let after = refined.sample_json(n);
+    let report = compare_refined_outputs(&scene, &refined, n, &out, &after, 1e-13);
+    assert!(report.ok(), "{}", report.describe());
+    let mut wrong = refined.clone();
+    if let Shape::Surface { points, .. } = &mut wrong.objects[1].shape {
+        let p = &mut points[1][0];
+        p[0] += 1e-10 * p[0].abs().max(1.0);
+    }
+    let report = compare_refined_outputs(&scene, &refined, n, &out, &wrong.sample_json(n), 1e-13);
+    assert!(!report.ok() && report.mismatch_count > 0);
+    // Changed parameters are a problem, not a pass.
+    let mut moved = after.clone();
+    let t = moved["objects"][0]["params"][1].as_f64().unwrap();
+    moved["objects"][0]["params"][1] = json!(t + 1e-12);
+    assert!(!compare_refined_outputs(&scene, &refined, n, &out, &moved, 1e-13).ok());
+}
+
+/// A parameter inside the u domain of a B-spline surface that is not a knot there.
+fn refined_middle(object: &Object) -> f64 {
+    let (a, b) = object.domains()[0];
+    let Shape::Surface {
+        basis: [Basis::BSpline { knots, .. }, _],
+        ..
+    } = &object.shape
+    else {
+        unreachable!()
+    };
+    (1..)
+        .map(|k| a + (b - a) * (0.5 + 0.1 / f64::from(k)))
+        .find(|t| !knots.contains(t))
+        .unwrap()
 }

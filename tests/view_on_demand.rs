@@ -40,9 +40,9 @@ fn example() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/bspline_surface.json")
 }
 
-/// Runs the viewer without input until a scripted quit at `quit_s` seconds; returns the
-/// number of frames it drew.
-fn frames_until_quit(dir: &Path, quit_s: f64) -> usize {
+/// Runs the viewer without input until a scripted quit at `quit_s` seconds; returns the start
+/// time (seconds since the first frame) of every frame it drew.
+fn frame_starts(dir: &Path, quit_s: f64) -> Vec<f64> {
     let script = dir.join(format!("quit-{quit_s}.json"));
     std::fs::write(&script, format!(r#"[{{"t": {quit_s}, "quit": true}}]"#)).unwrap();
     let profile = dir.join(format!("profile-{quit_s}"));
@@ -58,7 +58,10 @@ fn frames_until_quit(dir: &Path, quit_s: f64) -> usize {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "viewer failed: {err}");
     let csv = std::fs::read_to_string(profile.join("frames.csv")).unwrap();
-    csv.lines().count() - 1
+    csv.lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
+        .collect()
 }
 
 #[test]
@@ -67,17 +70,19 @@ fn an_idle_viewer_draws_no_frames() {
         return;
     }
     let dir = scratch("idle");
-    let short = frames_until_quit(&dir, 1.5);
-    let long = frames_until_quit(&dir, 6.5);
-    eprintln!("frames: {short} when quitting at 1.5 s, {long} at 6.5 s");
-    // Start-up (first frame, window events, the overlay's settle tick) and the quit frame.
+    // Start-up (first frame, window events, the overlay's settle tick) is over well within
+    // 2.5 s even on a loaded machine; then nothing may be drawn until the scripted quit.
+    let starts = frame_starts(&dir, 7.0);
+    let idle: Vec<f64> = starts
+        .iter()
+        .copied()
+        .filter(|&t| t > 2.5 && t < 6.9)
+        .collect();
+    eprintln!("{} frames, at {starts:?} s", starts.len());
+    assert!(!starts.is_empty(), "the viewer drew nothing at all");
     assert!(
-        (2..=8).contains(&short),
-        "{short} frames in a short idle session"
-    );
-    assert_eq!(
-        long, short,
-        "frames were drawn during 5 s without input ({long} against {short})"
+        idle.is_empty(),
+        "frames were drawn during 4.4 s without input, at {idle:?} s"
     );
 }
 

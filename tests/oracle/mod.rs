@@ -15,8 +15,13 @@
 //! * Expo-rational B-function: graded composite Gauss–Legendre quadrature for B, Taylor
 //!   arithmetic (series exponential) for the derivatives.
 //!
-//! Submodules: [`bfunction`] (the five B-functions), [`eval`] (point evaluation), [`scene`]
+//! * Structural edits (knot insertion, degree elevation): blossoms (polar forms) evaluated by a
+//!   de Boor triangle with one argument per level, not Böhm's insertion or Bézier decomposition.
+//!
+//! Submodules: [`bfunction`] (the five B-functions), [`eval`] (point evaluation), [`blossom`]
+//! (refinement by polar forms), [`scene`]
 //! (scene/edit JSON, model, `sample` output), [`compare`] (product vs oracle, error measure),
+//! [`condition`] (condition scales for refined control nets),
 //! [`random`] + [`rng`] (seeded scenes and edit lists). `gen_expo_table.py` regenerates
 //! `tests/data/expo_bfunction_reference.json` with mpmath; the tests themselves need no Python.
 //!
@@ -29,7 +34,9 @@
 #![allow(dead_code)]
 
 pub mod bfunction;
+pub mod blossom;
 pub mod compare;
+pub mod condition;
 pub mod eval;
 pub mod random;
 pub mod rng;

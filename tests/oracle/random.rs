@@ -9,7 +9,7 @@
 use super::bfunction::BFunction;
 use super::eval::{Basis, Point3};
 use super::rng::Rng;
-use super::scene::{Edit, Index, Object, Scene, Shape};
+use super::scene::{Edit, Elevation, Index, Object, Scene, Shape};
 
 /// The six object types.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -473,13 +473,213 @@ pub fn random_edit(rng: &mut Rng, object: &Object) -> Edit {
     }
 }
 
-/// `count` random edits on random objects of `scene` (indices stay valid: edits never change
-/// point counts).
+/// `count` random edits on random objects of `scene` (indices stay valid: these edits never
+/// change point counts).
 pub fn random_edits(rng: &mut Rng, scene: &Scene, count: usize) -> Vec<Edit> {
     (0..count)
         .map(|_| {
             let object = rng.pick(&scene.objects);
             random_edit(rng, object)
+        })
+        .collect()
+}
+
+// ---------------------------------------------------------------------------------------------
+// Structural edits (knot insertion, degree elevation)
+// ---------------------------------------------------------------------------------------------
+
+/// Knobs for edit lists with structural edits mixed in.
+#[derive(Clone, Debug)]
+pub struct StructuralMix {
+    /// Probability that an edit on a Bézier/B-spline object is structural.
+    pub chance: f64,
+    /// Elevation never raises a degree above this.
+    pub max_degree: usize,
+    /// No structural edit on a direction that already has this many control points.
+    pub max_points: usize,
+}
+
+impl Default for StructuralMix {
+    fn default() -> Self {
+        StructuralMix {
+            chance: 0.3,
+            max_degree: 6,
+            max_points: 24,
+        }
+    }
+}
+
+/// One direction of a Bézier/B-spline object as (degree, knots, control-point count); a Bézier
+/// direction as the clamped B-spline on [0, 1].
+fn direction_knots(basis: &Basis, n: usize) -> (usize, Vec<f64>) {
+    match basis {
+        Basis::Bezier => {
+            let mut knots = vec![0.0; n];
+            knots.extend(std::iter::repeat_n(1.0, n));
+            (n - 1, knots)
+        }
+        Basis::BSpline { degree, knots } => (*degree, knots.clone()),
+    }
+}
+
+/// Per direction (degree, knots, point count) of a Bézier/B-spline object; None for ERBS.
+pub fn refinable_directions(object: &Object) -> Option<Vec<(usize, Vec<f64>, usize)>> {
+    match &object.shape {
+        Shape::Curve { basis, points, .. } => {
+            let (p, k) = direction_knots(basis, points.len());
+            Some(vec![(p, k, points.len())])
+        }
+        Shape::Surface { basis, points, .. } => {
+            let counts = [points.len(), points[0].len()];
+            Some(
+                (0..2)
+                    .map(|d| {
+                        let (p, k) = direction_knots(&basis[d], counts[d]);
+                        (p, k, counts[d])
+                    })
+                    .collect(),
+            )
+        }
+        Shape::ErbsCurve { .. } | Shape::ErbsSurface { .. } => None,
+    }
+}
+
+fn multiplicity(knots: &[f64], t: f64) -> usize {
+    knots.iter().filter(|&&k| k == t).count()
+}
+
+/// A knot parameter strictly inside the domain with room for at least one more copy, and how
+/// many copies to insert: an existing interior knot, a sample parameter, or any value inside a
+/// span (short new spans included: `oracle::condition` measures what they cost).
+fn random_insertion(
+    rng: &mut Rng,
+    degree: usize,
+    knots: &[f64],
+    n: usize,
+    params: &[f64],
+) -> Option<(f64, usize)> {
+    let (a, b) = (knots[degree], knots[n]);
+    let room = |t: f64| degree.saturating_sub(multiplicity(knots, t));
+    let inside = |t: &f64| a < *t && *t < b && room(*t) > 0;
+    let spans: Vec<(f64, f64)> = (degree..n)
+        .map(|s| (knots[s], knots[s + 1]))
+        .filter(|(lo, hi)| lo < hi)
+        .collect();
+    let existing: Vec<f64> = knots.iter().copied().filter(inside).collect();
+    let on_samples: Vec<f64> = params.iter().copied().filter(inside).collect();
+    let t = match rng.int(0, 9) {
+        0..=2 if !existing.is_empty() => *rng.pick(&existing),
+        3..=4 if !on_samples.is_empty() => *rng.pick(&on_samples),
+        _ => {
+            let (lo, hi) = *rng.pick(&spans);
+            lo + (hi - lo) * rng.range(0.02, 0.98)
+        }
+    };
+    if !inside(&t) {
+        return None;
+    }
+    let times = if rng.chance(0.7) {
+        1
+    } else {
+        rng.int(1, room(t))
+    };
+    Some((t, times))
+}
+
+/// A random `insert_knot` edit valid for `object` (a random direction for surfaces), or None
+/// when no direction has room (degree 0, or every candidate knot already at full multiplicity).
+pub fn random_insertion_edit(rng: &mut Rng, object: &Object) -> Option<Edit> {
+    let directions = refinable_directions(object)?;
+    let params = object.params();
+    let dir = rng.int(0, directions.len() - 1);
+    let (degree, knots, n) = &directions[dir];
+    let (t, times) = random_insertion(rng, *degree, knots, *n, &params[dir])?;
+    Some(Edit::InsertKnot {
+        object: object.name.clone(),
+        direction: (directions.len() == 2).then_some(dir),
+        t,
+        // `times` is optional in the contract when it is 1; write it now and then anyway.
+        times: if times == 1 && rng.chance(0.6) {
+            None
+        } else {
+            Some(times)
+        },
+    })
+}
+
+/// A random `elevate_degree` edit valid for `object` that keeps every degree ≤ `mix.max_degree`.
+pub fn random_elevation_edit(rng: &mut Rng, object: &Object, mix: &StructuralMix) -> Option<Edit> {
+    let directions = refinable_directions(object)?;
+    let amount = |degree: usize, rng: &mut Rng| -> usize {
+        let e = if rng.chance(0.75) { 1 } else { 2 };
+        if degree + e <= mix.max_degree { e } else { 0 }
+    };
+    let by = if directions.len() == 1 {
+        let e = amount(directions[0].0, rng);
+        (e > 0).then_some(Elevation::Curve(e))?
+    } else {
+        let which = rng.int(0, 2); // u only, v only, both
+        let u = if which != 1 {
+            amount(directions[0].0, rng)
+        } else {
+            0
+        };
+        let v = if which != 0 {
+            amount(directions[1].0, rng)
+        } else {
+            0
+        };
+        if u == 0 && v == 0 {
+            return None;
+        }
+        // A zero direction is written as 0 or left out.
+        let write = |e: usize, rng: &mut Rng| (e > 0 || rng.chance(0.5)).then_some(e);
+        Elevation::Surface {
+            u: write(u, rng),
+            v: write(v, rng),
+        }
+    };
+    Some(Edit::ElevateDegree {
+        object: object.name.clone(),
+        by,
+    })
+}
+
+/// A random structural edit for `object` (insertion or elevation), or None when none fits
+/// `mix` (an ERBS object, a direction at `max_points`, degrees at the limit).
+pub fn random_structural_edit(rng: &mut Rng, object: &Object, mix: &StructuralMix) -> Option<Edit> {
+    let directions = refinable_directions(object)?;
+    if directions.iter().any(|(_, _, n)| *n >= mix.max_points) {
+        return None;
+    }
+    if rng.chance(0.55) {
+        random_insertion_edit(rng, object).or_else(|| random_elevation_edit(rng, object, mix))
+    } else {
+        random_elevation_edit(rng, object, mix).or_else(|| random_insertion_edit(rng, object))
+    }
+}
+
+/// `count` random edits on random objects of `scene` with structural edits mixed in. Each edit
+/// is drawn for the model as edited so far, so later edits address refined control nets.
+pub fn random_edits_with_structure(
+    rng: &mut Rng,
+    scene: &Scene,
+    count: usize,
+    mix: &StructuralMix,
+) -> Vec<Edit> {
+    let mut model = scene.clone();
+    (0..count)
+        .map(|_| {
+            let object = &model.objects[rng.int(0, model.objects.len() - 1)];
+            let structural = if rng.chance(mix.chance) {
+                random_structural_edit(rng, object, mix)
+            } else {
+                None
+            };
+            let edit = structural.unwrap_or_else(|| random_edit(rng, object));
+            edit.apply(&mut model)
+                .unwrap_or_else(|e| panic!("generated an invalid edit {edit:?}: {e}"));
+            edit
         })
         .collect()
 }

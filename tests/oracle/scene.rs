@@ -4,6 +4,7 @@
 use serde_json::{Map, Value, json};
 
 use super::bfunction::BFunction;
+use super::blossom::Spline;
 use super::eval::{
     self, Basis, Homogeneous, Point3, erbs_curve_derivatives, erbs_surface_derivatives,
     homogeneous, project_curve_derivatives, project_surface_derivatives,
@@ -751,6 +752,35 @@ pub enum Edit {
         point: Index,
         delta: Point3,
     },
+    /// Insert the knot `t` `times` times (`None`: the field is omitted, meaning 1); `direction`
+    /// is `None` for curves (`"insert_knot": t`), 0/1 for a surface's u/v (`{"u": t}`).
+    InsertKnot {
+        object: String,
+        direction: Option<usize>,
+        t: f64,
+        times: Option<usize>,
+    },
+    /// Raise the degree, keeping the shape.
+    ElevateDegree { object: String, by: Elevation },
+}
+
+/// The amount of an `elevate_degree` edit, as written.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Elevation {
+    /// `"elevate_degree": e` on a curve.
+    Curve(usize),
+    /// `"elevate_degree": {"u": a, "v": b}` on a surface; an omitted direction means 0.
+    Surface { u: Option<usize>, v: Option<usize> },
+}
+
+impl Elevation {
+    /// Per-direction amounts: one entry for curves, [u, v] for surfaces.
+    pub fn amounts(self) -> Vec<usize> {
+        match self {
+            Elevation::Curve(e) => vec![e],
+            Elevation::Surface { u, v } => vec![u.unwrap_or(0), v.unwrap_or(0)],
+        }
+    }
 }
 
 impl Edit {
@@ -769,6 +799,53 @@ impl Edit {
                 None => Ok(()),
             }
         };
+        if has("insert_knot") {
+            only(&["object", "insert_knot", "times"])?;
+            let at = &o["insert_knot"];
+            let kctx = format!("{ctx}.insert_knot");
+            let (direction, t) = match at.as_object() {
+                Some(dirs) if dirs.len() == 1 => {
+                    let (key, value) = dirs.iter().next().unwrap();
+                    let dir = match key.as_str() {
+                        "u" => 0,
+                        "v" => 1,
+                        _ => return Err(format!("{kctx}: expected {{\"u\": t}} or {{\"v\": t}}")),
+                    };
+                    (Some(dir), number(value, &kctx)?)
+                }
+                Some(_) => return Err(format!("{kctx}: expected one direction")),
+                None => (None, number(at, &kctx)?),
+            };
+            let times = match o.get("times") {
+                None => None,
+                Some(v) => Some(count(v, &format!("{ctx}.times"))?),
+            };
+            return Ok(Edit::InsertKnot {
+                object,
+                direction,
+                t,
+                times,
+            });
+        }
+        if has("elevate_degree") {
+            only(&["object", "elevate_degree"])?;
+            let by = &o["elevate_degree"];
+            let ectx = format!("{ctx}.elevate_degree");
+            let by = match by.as_object() {
+                Some(dirs) => {
+                    if let Some(k) = dirs.keys().find(|k| *k != "u" && *k != "v") {
+                        return Err(format!("{ectx}: unexpected direction {k:?}"));
+                    }
+                    let amount = |k: &str| dirs.get(k).map(|v| count(v, &ectx)).transpose();
+                    Elevation::Surface {
+                        u: amount("u")?,
+                        v: amount("v")?,
+                    }
+                }
+                None => Elevation::Curve(count(by, &ectx)?),
+            };
+            return Ok(Edit::ElevateDegree { object, by });
+        }
         if has("local") {
             let local = Index::from_json(&o["local"], &format!("{ctx}.local"))?;
             if has("transform") {
@@ -841,6 +918,41 @@ impl Edit {
             } => json!({
                 "object": object, "local": local.to_json(), "point": point.to_json(), "delta": delta
             }),
+            Edit::InsertKnot {
+                object,
+                direction,
+                t,
+                times,
+            } => {
+                let at = match direction {
+                    None => json!(t),
+                    Some(0) => json!({ "u": t }),
+                    Some(_) => json!({ "v": t }),
+                };
+                let mut m = Map::new();
+                m.insert("object".into(), json!(object));
+                m.insert("insert_knot".into(), at);
+                if let Some(k) = times {
+                    m.insert("times".into(), json!(k));
+                }
+                Value::Object(m)
+            }
+            Edit::ElevateDegree { object, by } => {
+                let by = match by {
+                    Elevation::Curve(e) => json!(e),
+                    Elevation::Surface { u, v } => {
+                        let mut m = Map::new();
+                        if let Some(a) = u {
+                            m.insert("u".into(), json!(a));
+                        }
+                        if let Some(b) = v {
+                            m.insert("v".into(), json!(b));
+                        }
+                        Value::Object(m)
+                    }
+                };
+                json!({"object": object, "elevate_degree": by})
+            }
         }
     }
 
@@ -849,7 +961,9 @@ impl Edit {
             Edit::PointDelta { object, .. }
             | Edit::Weight { object, .. }
             | Edit::LocalTransform { object, .. }
-            | Edit::LocalPointDelta { object, .. } => object,
+            | Edit::LocalPointDelta { object, .. }
+            | Edit::InsertKnot { object, .. }
+            | Edit::ElevateDegree { object, .. } => object,
         }
     }
 
@@ -859,6 +973,40 @@ impl Edit {
         let ctx = format!("edit on {}", obj.name);
         let bad = || format!("{ctx}: index out of range or wrong kind of object");
         match (self, &mut obj.shape) {
+            (
+                Edit::InsertKnot {
+                    direction,
+                    t,
+                    times,
+                    ..
+                },
+                shape,
+            ) => {
+                let refinement = Refinement::Insert {
+                    t: *t,
+                    times: times.unwrap_or(1),
+                };
+                refine(shape, *direction, refinement).map_err(|e| format!("{ctx}: {e}"))?;
+            }
+            (Edit::ElevateDegree { by, .. }, shape) => {
+                let amounts = by.amounts();
+                if amounts.iter().all(|&e| e == 0) {
+                    return Err(format!("{ctx}: elevate_degree: must be at least 1"));
+                }
+                let directions: Vec<Option<usize>> = match by {
+                    Elevation::Curve(_) => vec![None],
+                    Elevation::Surface { .. } => vec![Some(0), Some(1)],
+                };
+                // Both directions or neither: refine a copy.
+                let mut refined = shape.clone();
+                for (direction, e) in directions.into_iter().zip(amounts) {
+                    if e > 0 || direction.is_none() {
+                        refine(&mut refined, direction, Refinement::Elevate(e))
+                            .map_err(|e| format!("{ctx}: {e}"))?;
+                    }
+                }
+                *shape = refined;
+            }
             (Edit::PointDelta { point, delta, .. }, Shape::Curve { points, .. }) => {
                 let Index::One(i) = *point else {
                     return Err(bad());
@@ -965,6 +1113,163 @@ impl Edit {
             _ => return Err(bad()),
         }
         Ok(())
+    }
+}
+
+/// A structural edit of one direction.
+#[derive(Clone, Copy, Debug)]
+enum Refinement {
+    Insert { t: f64, times: usize },
+    Elevate(usize),
+}
+
+impl Refinement {
+    fn apply<const D: usize>(self, spline: &Spline<D>) -> Result<Spline<D>, String> {
+        match self {
+            Refinement::Insert { t, times } => spline.insert_knot(t, times),
+            Refinement::Elevate(0) => Err("elevate_degree: must be at least 1".into()),
+            Refinement::Elevate(e) => spline.elevate(e),
+        }
+    }
+}
+
+/// The basis after refining: a Bézier direction stays Bézier only under elevation.
+fn refined_basis<const D: usize>(was: &Basis, r: Refinement, spline: &Spline<D>) -> Basis {
+    match (was, r) {
+        (Basis::Bezier, Refinement::Elevate(_)) => Basis::Bezier,
+        _ => Basis::BSpline {
+            degree: spline.degree,
+            knots: spline.knots.clone(),
+        },
+    }
+}
+
+/// A refined basis and its control polygons (or grid rows).
+type Refined<const D: usize> = (Basis, Vec<Vec<[f64; D]>>);
+
+/// Refines every control polygon in `lines` (all on `basis`); returns the new basis and lines.
+fn refine_lines<const D: usize>(
+    basis: &Basis,
+    lines: &[Vec<[f64; D]>],
+    r: Refinement,
+) -> Result<Refined<D>, String> {
+    let mut out = Vec::with_capacity(lines.len());
+    let mut new_basis = None;
+    for line in lines {
+        let spline = match basis {
+            Basis::Bezier => Spline::bezier(line),
+            Basis::BSpline { degree, knots } => Spline {
+                degree: *degree,
+                knots: knots.clone(),
+                points: line.clone(),
+            },
+        };
+        let refined = r.apply(&spline)?;
+        new_basis.get_or_insert_with(|| refined_basis(basis, r, &refined));
+        out.push(refined.points);
+    }
+    Ok((new_basis.expect("at least one control polygon"), out))
+}
+
+fn transpose<T: Copy>(grid: &[Vec<T>]) -> Vec<Vec<T>> {
+    (0..grid[0].len())
+        .map(|j| grid.iter().map(|row| row[j]).collect())
+        .collect()
+}
+
+/// Refines a grid of control points along `dir` (0: u, i.e. every column; 1: v, every row).
+fn refine_grid<const D: usize>(
+    basis: &Basis,
+    grid: &[Vec<[f64; D]>],
+    dir: usize,
+    r: Refinement,
+) -> Result<Refined<D>, String> {
+    if dir == 0 {
+        let (b, columns) = refine_lines(basis, &transpose(grid), r)?;
+        Ok((b, transpose(&columns)))
+    } else {
+        refine_lines(basis, grid, r)
+    }
+}
+
+fn project(h: Homogeneous) -> (Point3, f64) {
+    ([h[0] / h[3], h[1] / h[3], h[2] / h[3]], h[3])
+}
+
+/// Applies a structural edit to `shape` (`direction`: None for curves, Some(0/1) for u/v).
+/// Rational shapes are refined in homogeneous coordinates.
+fn refine(shape: &mut Shape, direction: Option<usize>, r: Refinement) -> Result<(), String> {
+    let field = match r {
+        Refinement::Insert { .. } => "insert_knot",
+        Refinement::Elevate(_) => "elevate_degree",
+    };
+    match (shape, direction) {
+        (
+            Shape::Curve {
+                basis,
+                points,
+                weights,
+            },
+            None,
+        ) => {
+            if let Some(w) = weights {
+                let (b, mut lines) = refine_lines(basis, &[lift_curve(points, Some(w))], r)?;
+                let (p, w): (Vec<Point3>, Vec<f64>) =
+                    lines.remove(0).into_iter().map(project).unzip();
+                (*basis, *points, *weights) = (b, p, Some(w));
+            } else {
+                let (b, mut lines) = refine_lines(basis, std::slice::from_ref(points), r)?;
+                (*basis, *points) = (b, lines.remove(0));
+            }
+            Ok(())
+        }
+        (
+            Shape::Surface {
+                basis,
+                points,
+                weights,
+            },
+            Some(dir),
+        ) => {
+            let new_basis = if weights.is_some() {
+                let (b, grid) =
+                    refine_grid(&basis[dir], &lift_surface(points, weights.as_ref()), dir, r)?;
+                let (p, w): (Vec<Vec<Point3>>, Vec<Vec<f64>>) = grid
+                    .into_iter()
+                    .map(|row| row.into_iter().map(project).unzip())
+                    .unzip();
+                (*points, *weights) = (p, Some(w));
+                b
+            } else {
+                let (b, grid) = refine_grid(&basis[dir], points, dir, r)?;
+                *points = grid;
+                b
+            };
+            basis[dir] = new_basis;
+            // A Bézier surface refined by insertion in one direction is a B-spline surface in both.
+            if matches!(basis[dir], Basis::BSpline { .. }) {
+                let counts = [points.len(), points[0].len()];
+                for (other, n) in counts.into_iter().enumerate() {
+                    if basis[other] == Basis::Bezier {
+                        let clamped = Spline::<3>::bezier(&vec![[0.0; 3]; n]);
+                        basis[other] = Basis::BSpline {
+                            degree: clamped.degree,
+                            knots: clamped.knots,
+                        };
+                    }
+                }
+            }
+            Ok(())
+        }
+        (Shape::Curve { .. }, Some(_)) => {
+            Err(format!("{field}: a curve takes a number, not a direction"))
+        }
+        (Shape::Surface { .. }, None) => Err(format!(
+            "{field}: a surface needs a direction {{\"u\": …}} or {{\"v\": …}}"
+        )),
+        (Shape::ErbsCurve { .. } | Shape::ErbsSurface { .. }, _) => {
+            Err(format!("{field}: ERBS objects are not refined this way"))
+        }
     }
 }
 
