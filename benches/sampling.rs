@@ -2,7 +2,9 @@
 //! a bicubic clamped uniform surface with 100×100 control points sampled 512×512 with S, Su, Sv
 //! and normals; a cubic curve with 1000 control points sampled 100 000 times with C, C'; edits of
 //! one interior point, one boundary point, ten random points, and an ERBS local-patch rotation;
-//! structural edits of the surface (knot insertion, degree elevation), each with its undo.
+//! structural edits of the surface (knot insertion, degree elevation), each with its undo;
+//! the interior point edit with the curvature map off (S, Su, Sv, normals) and on (also Suu,
+//! Suv, Svv and K, H per sample).
 //!
 //! `cargo bench --bench sampling` runs criterion and then prints a summary table (full sampling
 //! time, M samples/s, µs per edit, samples touched, edit/full ratio) from criterion's estimates.
@@ -192,6 +194,26 @@ fn bench(c: &mut Criterion) {
             })
         });
     }
+    g.finish();
+
+    // The same edit with the analysis map off and on (the budget: on ≤ 2 × off).
+    let mut g = c.benchmark_group("analysis");
+    g.measurement_time(Duration::from_secs(3));
+    let (_, _, batch) = &scenarios()[0];
+    for (id, mode) in MAP_MODES {
+        let mut obj = SampledObject::new(&surface(), mode);
+        g.bench_function(BenchmarkId::from_parameter(id), |b| {
+            b.iter(|| {
+                for e in batch {
+                    black_box(obj.apply(e).expect("the bench's edits fit their objects"));
+                }
+            })
+        });
+    }
+    g.finish();
+
+    let mut g = c.benchmark_group("edit");
+    g.measurement_time(Duration::from_secs(3));
     let surface = surface();
     let Model::Surface(model) = &surface else {
         unreachable!("the surface workload is a B-spline surface")
@@ -263,6 +285,32 @@ fn summary() {
     }
 }
 
+/// The curvature map's sample modes, by benchmark id.
+const MAP_MODES: [(&str, SampleMode); 2] = [
+    ("interior point, map off", SampleMode::Render),
+    ("interior point, map on", SampleMode::Analysis),
+];
+
+fn analysis_summary() {
+    println!("\n| edit (100 × 100 surface, 512² samples) | µs | samples touched |");
+    println!("|---|---:|---:|");
+    let (_, _, batch) = &scenarios()[0];
+    for (id, mode) in MAP_MODES {
+        let mut obj = SampledObject::new(&surface(), mode);
+        let touched = obj.apply(&batch[0]).map_or(0, |r| r.samples());
+        match mean_ns("analysis", id) {
+            Some(ns) => println!("| {id} | {:.2} | {touched} |", ns / 1e3),
+            None => println!("| {id} | not measured | {touched} |"),
+        }
+    }
+    if let (Some(off), Some(on)) = (
+        mean_ns("analysis", MAP_MODES[0].0),
+        mean_ns("analysis", MAP_MODES[1].0),
+    ) {
+        println!("\nmap on / map off: {:.2}×", on / off);
+    }
+}
+
 fn structural_summary() {
     println!("\n| structural edit (100 × 100 surface, 512² samples) | µs |");
     println!("|---|---:|");
@@ -282,6 +330,7 @@ fn main() {
     // leaves fresh estimates to summarise.
     if std::env::args().any(|a| a == "--bench") {
         summary();
+        analysis_summary();
         structural_summary();
     }
 }

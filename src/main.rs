@@ -4,6 +4,7 @@
 use clap::{Args, Parser, Subcommand};
 use prespline::cli::files::{SampleOverride, SamplesArg};
 use prespline::cli::{self, CliError};
+use prespline::render::maps::SurfaceMap;
 use prespline::render::{NetMode, OrbitCamera, ViewOptions, Wire};
 use prespline::sampling::budget::{self, MemoryBudget};
 use prespline::view::scenario::Scenario;
@@ -128,6 +129,10 @@ enum Command {
         /// default (1 on CPU rasterisers, 4 on GPUs).
         #[arg(long, default_value_t = 4)]
         msaa: u32,
+        /// Draw the osculating circle of curve NAME at parameter T, labelled with its
+        /// curvature, radius and torsion.
+        #[arg(long, value_name = "NAME@T", value_parser = parse_osculating)]
+        osculating: Option<(String, f64)>,
         #[command(flatten)]
         display: DisplayArgs,
         #[command(flatten)]
@@ -200,6 +205,14 @@ struct DisplayArgs {
     /// Draw curvature combs along curves.
     #[arg(long)]
     comb: bool,
+    /// Draw continuity badges (G0/G1/G2, C1/C2 from left and right derivatives) at curve
+    /// junctions and at knots of multiplicity > 1.
+    #[arg(long)]
+    badges: bool,
+    /// Colour surfaces by an analysis map, with a legend: gaussian, mean, kmax, kmin
+    /// (principal curvatures) or zebra (reflection lines).
+    #[arg(long, value_name = "MAP", value_parser = SurfaceMap::parse)]
+    analysis: Option<SurfaceMap>,
     /// Draw every sample of every surface (no display level of detail).
     #[arg(long)]
     no_lod: bool,
@@ -218,6 +231,8 @@ impl DisplayArgs {
             normals: self.normals,
             frenet: self.frenet,
             curvature_comb: self.comb,
+            badges: self.badges,
+            analysis: self.analysis,
             lod: !self.no_lod,
             ..ViewOptions::default()
         }
@@ -299,6 +314,7 @@ fn main() -> ExitCode {
             camera,
             edits,
             msaa,
+            osculating,
             display,
             samples,
             memory,
@@ -308,8 +324,13 @@ fn main() -> ExitCode {
             &samples.counts(),
             &memory.budget(),
         )
-        .and_then(|doc| {
-            cli::render::run(&doc, &out, size.0, size.1, camera, display.options(), msaa)
+        .and_then(|mut doc| {
+            let mut options = display.options();
+            cli::render::show_analysis(&mut doc, options.analysis, &memory.budget())?;
+            if let Some((name, t)) = &osculating {
+                options.osculating_at = Some(cli::render::osculating_at(&doc, name, *t)?);
+            }
+            cli::render::run(&doc, &out, size.0, size.1, camera, options, msaa)
         })
         .map(|line| eprintln!("{line}")),
         Command::Convert {
@@ -327,6 +348,19 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// `NAME@T` of `--osculating`.
+fn parse_osculating(s: &str) -> Result<(String, f64), String> {
+    let (name, t) = s
+        .rsplit_once('@')
+        .ok_or_else(|| format!("'{s}' is not NAME@T"))?;
+    let t: f64 = t
+        .parse()
+        .ok()
+        .filter(|t: &f64| t.is_finite())
+        .ok_or_else(|| format!("'{t}' is not a parameter value"))?;
+    Ok((name.to_string(), t))
 }
 
 fn print(text: &str) -> Result<(), CliError> {

@@ -2,7 +2,10 @@
 //! `--samples` override, and `prespline convert`.
 
 use super::CliError;
-use crate::model::{CurveModel, ErbsCurveModel, ErbsSurfaceModel, Model, SurfaceModel};
+use crate::model::{
+    BezierSplineModel, CatmullRomModel, CurveModel, ErbsCurveModel, ErbsSurfaceModel, Model,
+    SurfaceModel,
+};
 use crate::scene::obj::{Format, load_obj, save_scene_file};
 use crate::scene::{MAX_CURVE_SAMPLES, MAX_SURFACE_SAMPLES, Scene};
 use std::path::Path;
@@ -74,6 +77,12 @@ impl SampleOverride {
                 }
                 (Model::ErbsCurve(m), Some(n), _) => {
                     ErbsCurveModel::new(m.curve().clone(), n).map(Model::ErbsCurve)
+                }
+                (Model::CatmullRom(m), Some(n), _) => {
+                    CatmullRomModel::new(m.spline().clone(), n).map(Model::CatmullRom)
+                }
+                (Model::BezierSpline(m), Some(n), _) => {
+                    BezierSplineModel::new(m.spline().clone(), n).map(Model::BezierSpline)
                 }
                 (Model::Surface(m), _, Some(n)) => {
                     SurfaceModel::new(m.form(), m.surface().clone(), n).map(Model::Surface)

@@ -3,6 +3,7 @@
 use super::CliError;
 use super::files::{SampleOverride, load_scene};
 use crate::gpu::{Renderer, RendererDesc, ValidationMode};
+use crate::render::maps::SurfaceMap;
 use crate::render::offscreen::{Shot, render_document};
 use crate::render::{Document, OrbitCamera, ViewOptions};
 use crate::sampling::SampleMode;
@@ -85,6 +86,46 @@ pub fn load_document(
             .map_err(|err| CliError::in_file(path, SceneError(err.to_string())))?;
     }
     Ok(doc)
+}
+
+/// Shows `map` on the document's surfaces (`--analysis`). A curvature map keeps second
+/// partials and K, H per sample: the scene is budgeted for that first (one line naming the
+/// object when it does not fit).
+pub fn show_analysis(
+    doc: &mut Document,
+    map: Option<SurfaceMap>,
+    budget: &MemoryBudget,
+) -> Result<(), CliError> {
+    if let Some(m) = map.filter(|m| m.needs_curvature()) {
+        check_scene(&doc.to_scene(), SampleMode::Analysis, DRAW_USES, budget)
+            .map_err(|e| CliError(format!("--analysis {}: {e}", m.name())))?;
+    }
+    doc.set_analysis(map);
+    Ok(())
+}
+
+/// The object index and parameter of `--osculating NAME@T`, checked: a curve object, T in its
+/// domain.
+pub fn osculating_at(doc: &Document, name: &str, t: f64) -> Result<(usize, f64), CliError> {
+    let i = doc
+        .objects
+        .iter()
+        .position(|o| o.name == name)
+        .ok_or_else(|| CliError(format!("--osculating: unknown object '{name}'")))?;
+    let model = doc.objects[i].sampled.model();
+    if model.is_surface() {
+        return Err(CliError(format!(
+            "--osculating: object '{name}' is a {}, not a curve",
+            model.type_name()
+        )));
+    }
+    let (a, b) = model.domain()[0];
+    if !(a..=b).contains(&t) {
+        return Err(CliError(format!(
+            "--osculating: parameter {t} is outside the domain [{a}, {b}] of object '{name}'"
+        )));
+    }
+    Ok((i, t))
 }
 
 /// Renders `doc` headless and writes `out` (PNG); returns a one-line summary.

@@ -156,13 +156,27 @@ impl BSplineCurve {
         }
     }
 
-    /// c(t), c'(t), …, c^(n)(t) through the B-spline-Hermite matrix M_{d,i}(t).
+    /// c(t), c'(t), …, c^(n)(t) through the B-spline-Hermite matrix M_{d,i}(t) (at a knot: the
+    /// right limit, as FindSpan gives).
     pub fn derivatives(&self, t: f64, n: usize) -> Vec<DVec3> {
+        self.one_sided_derivatives(t, n, false)
+    }
+
+    /// Limits of c, c', …, c^(n) as the parameter approaches t from the left (`from_left`) or
+    /// the right: the polynomial of the span on that side evaluated at t. At an interior knot of
+    /// multiplicity m the two differ from order d − m + 1 on in general; elsewhere they agree.
+    pub fn one_sided_derivatives(&self, t: f64, n: usize, from_left: bool) -> Vec<DVec3> {
         let d = self.degree;
-        let span = self.find_span(t);
         let (a, b) = self.domain();
+        let t = t.clamp(a, b);
+        let span = if from_left && t > a {
+            // The last span [t_i, t_{i+1}) with t_i < t.
+            (self.knots.partition_point(|&k| k < t) - 1).max(d)
+        } else {
+            self.find_span(t)
+        };
         let mut m = vec![0.0; (d + 1) * (d + 1)];
-        hermite_into(&self.knots, d, span, t.clamp(a, b), &mut m);
+        hermite_into(&self.knots, d, span, t, &mut m);
         let first = span - d;
         match &self.weights {
             None => combine_rows(&m, d, &self.points[first..=span], n),

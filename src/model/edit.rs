@@ -2,7 +2,8 @@
 //! kinds, and the frame-merging of edits.
 
 use super::{
-    CurveEdit, ErbsCurveEdit, ErbsSurfaceEdit, Index2, LocalPath, Model, ModelRef, SurfaceEdit,
+    BezierSplineEdit, CatmullRomEdit, CurveEdit, ErbsCurveEdit, ErbsSurfaceEdit, Index2, LocalPath,
+    Model, ModelRef, SurfaceEdit,
 };
 use std::fmt::Debug;
 
@@ -73,6 +74,11 @@ pub enum ObjectEdit {
     Surface(SurfaceEdit),
     ErbsCurve(ErbsCurveEdit),
     ErbsSurface(ErbsSurfaceEdit),
+    CatmullRom(CatmullRomEdit),
+    BezierSpline(BezierSplineEdit),
+    /// Replace the whole model, possibly by one of another kind with the same sample counts
+    /// (conversion of a Catmull–Rom or Bézier spline to its `bspline_curve`, and its undo).
+    Replace(Box<Model>),
 }
 
 /// One edit of one object (`object` indexes the scene's objects).
@@ -82,21 +88,24 @@ pub struct Edit {
     pub edit: ObjectEdit,
 }
 
-/// Calls `$f` on the kind's edit inside an [`ObjectEdit`].
+/// Calls `$f` on the kind's edit inside an [`ObjectEdit`]; `$replace` for a replacement.
 macro_rules! each_kind {
-    ($e:expr, $x:ident => $body:expr) => {
+    ($e:expr, $x:ident => $body:expr, $replace:expr) => {
         match $e {
             ObjectEdit::Curve($x) => $body,
             ObjectEdit::Surface($x) => $body,
             ObjectEdit::ErbsCurve($x) => $body,
             ObjectEdit::ErbsSurface($x) => $body,
+            ObjectEdit::CatmullRom($x) => $body,
+            ObjectEdit::BezierSpline($x) => $body,
+            ObjectEdit::Replace(_) => $replace,
         }
     };
 }
 
 impl ObjectEdit {
     pub fn target(&self) -> Target {
-        each_kind!(self, e => e.target())
+        each_kind!(self, e => e.target(), Target::Structure)
     }
 
     /// Whether the edit changes the object's structure (knots, degree, control counts).
@@ -110,7 +119,7 @@ impl ObjectEdit {
         each_kind!(self, e => {
             let next = KindEdit::from_object(next)?;
             e.merge(next).map(KindEdit::into_object)
-        })
+        }, None)
     }
 
     /// Checks the edit against a model (of its own kind).
@@ -120,6 +129,9 @@ impl ObjectEdit {
             (ObjectEdit::Surface(e), ModelRef::Surface(m)) => e.validate(m),
             (ObjectEdit::ErbsCurve(e), ModelRef::ErbsCurve(m)) => e.validate(m),
             (ObjectEdit::ErbsSurface(e), ModelRef::ErbsSurface(m)) => e.validate(m),
+            (ObjectEdit::CatmullRom(e), ModelRef::CatmullRom(m)) => e.validate(m),
+            (ObjectEdit::BezierSpline(e), ModelRef::BezierSpline(m)) => e.validate(m),
+            (ObjectEdit::Replace(new), m) => check_replacement(new.as_ref().as_ref(), m),
             (e, m) => Err(edit_kind_mismatch(e, m.type_name())),
         }
     }
@@ -131,6 +143,9 @@ impl ObjectEdit {
             (ObjectEdit::Surface(e), ModelRef::Surface(m)) => e.inverse(m).into_object(),
             (ObjectEdit::ErbsCurve(e), ModelRef::ErbsCurve(m)) => e.inverse(m).into_object(),
             (ObjectEdit::ErbsSurface(e), ModelRef::ErbsSurface(m)) => e.inverse(m).into_object(),
+            (ObjectEdit::CatmullRom(e), ModelRef::CatmullRom(m)) => e.inverse(m).into_object(),
+            (ObjectEdit::BezierSpline(e), ModelRef::BezierSpline(m)) => e.inverse(m).into_object(),
+            (ObjectEdit::Replace(_), m) => ObjectEdit::Replace(Box::new(m.to_model())),
             (e, m) => return Err(edit_kind_mismatch(e, m.type_name())),
         })
     }
@@ -142,7 +157,29 @@ impl ObjectEdit {
             ObjectEdit::Surface(_) => "surface",
             ObjectEdit::ErbsCurve(_) => "ERBS curve",
             ObjectEdit::ErbsSurface(_) => "ERBS surface",
+            ObjectEdit::CatmullRom(_) => "Catmull–Rom",
+            ObjectEdit::BezierSpline(_) => "Bézier spline",
+            ObjectEdit::Replace(_) => "replacement",
         }
+    }
+}
+
+/// A replacement keeps the sample grid (curve or surface, and its counts), so samplers and GPU
+/// mirrors keep their size.
+fn check_replacement(new: ModelRef<'_>, old: ModelRef<'_>) -> Result<(), EditError> {
+    if new.is_surface() == old.is_surface() && new.sample_dims() == old.sample_dims() {
+        Ok(())
+    } else {
+        Err(EditError::new(
+            "object",
+            format!(
+                "a {} with samples {:?} cannot replace a {} with samples {:?}",
+                new.type_name(),
+                new.sample_dims(),
+                old.type_name(),
+                old.sample_dims()
+            ),
+        ))
     }
 }
 
@@ -160,6 +197,9 @@ pub(super) fn apply_to_model(model: &mut Model, edit: &ObjectEdit) -> Result<(),
         (Model::Surface(m), ObjectEdit::Surface(e)) => e.apply(m),
         (Model::ErbsCurve(m), ObjectEdit::ErbsCurve(e)) => e.apply(m),
         (Model::ErbsSurface(m), ObjectEdit::ErbsSurface(e)) => e.apply(m),
+        (Model::CatmullRom(m), ObjectEdit::CatmullRom(e)) => e.apply(m),
+        (Model::BezierSpline(m), ObjectEdit::BezierSpline(e)) => e.apply(m),
+        (m, ObjectEdit::Replace(new)) => *m = (**new).clone(),
         (m, e) => return Err(edit_kind_mismatch(e, m.type_name())),
     }
     Ok(())

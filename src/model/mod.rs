@@ -12,6 +12,7 @@ mod curve;
 mod edit;
 mod erbs;
 mod points;
+mod splines;
 mod surface;
 
 pub use curve::{CurveEdit, CurveModel};
@@ -21,6 +22,9 @@ pub use erbs::{
     LocalPath,
 };
 pub use points::{PointEdit, PointNet};
+pub use splines::{
+    BezierSplineEdit, BezierSplineModel, CatmullRomEdit, CatmullRomModel, ChainEdit, ChainModel,
+};
 pub use surface::{SurfaceEdit, SurfaceModel};
 
 /// Largest polynomial degree per direction (files, degree elevation). Evaluation works for any
@@ -54,6 +58,8 @@ pub enum Model {
     Surface(SurfaceModel),
     ErbsCurve(ErbsCurveModel),
     ErbsSurface(ErbsSurfaceModel),
+    CatmullRom(CatmullRomModel),
+    BezierSpline(BezierSplineModel),
 }
 
 /// A borrowed [`Model`] (samplers own their kind's model; this is how others read it).
@@ -63,6 +69,8 @@ pub enum ModelRef<'a> {
     Surface(&'a SurfaceModel),
     ErbsCurve(&'a ErbsCurveModel),
     ErbsSurface(&'a ErbsSurfaceModel),
+    CatmullRom(&'a CatmullRomModel),
+    BezierSpline(&'a BezierSplineModel),
 }
 
 impl Model {
@@ -73,6 +81,8 @@ impl Model {
             Model::Surface(m) => ModelRef::Surface(m),
             Model::ErbsCurve(m) => ModelRef::ErbsCurve(m),
             Model::ErbsSurface(m) => ModelRef::ErbsSurface(m),
+            Model::CatmullRom(m) => ModelRef::CatmullRom(m),
+            Model::BezierSpline(m) => ModelRef::BezierSpline(m),
         }
     }
 
@@ -114,6 +124,8 @@ impl<'a> ModelRef<'a> {
             },
             ModelRef::ErbsCurve(_) => "erbs_curve",
             ModelRef::ErbsSurface(_) => "erbs_surface",
+            ModelRef::CatmullRom(_) => "catmull_rom",
+            ModelRef::BezierSpline(_) => "bezier_spline",
         }
     }
 
@@ -125,6 +137,8 @@ impl<'a> ModelRef<'a> {
         match self {
             ModelRef::Curve(m) => [m.samples(), 1],
             ModelRef::ErbsCurve(m) => [m.samples(), 1],
+            ModelRef::CatmullRom(m) => [m.samples(), 1],
+            ModelRef::BezierSpline(m) => [m.samples(), 1],
             ModelRef::Surface(m) => m.samples(),
             ModelRef::ErbsSurface(m) => m.samples(),
         }
@@ -134,8 +148,21 @@ impl<'a> ModelRef<'a> {
         match self {
             ModelRef::Curve(m) => vec![m.curve().domain()],
             ModelRef::ErbsCurve(m) => vec![m.curve().domain()],
+            ModelRef::CatmullRom(m) => vec![m.spline().domain()],
+            ModelRef::BezierSpline(m) => vec![m.spline().domain()],
             ModelRef::Surface(m) => m.surface().domain().to_vec(),
             ModelRef::ErbsSurface(m) => m.surface().domain().to_vec(),
+        }
+    }
+
+    /// The equivalent B-spline curve (Catmull–Rom and Bézier splines: their Bézier chain), or
+    /// `None` for kinds that are not such a chain.
+    #[must_use]
+    pub fn to_bspline_curve(&self) -> Option<Model> {
+        match *self {
+            ModelRef::CatmullRom(m) => Some(Model::Curve(m.chain_form())),
+            ModelRef::BezierSpline(m) => Some(Model::Curve(m.chain_form())),
+            _ => None,
         }
     }
 
@@ -147,6 +174,8 @@ impl<'a> ModelRef<'a> {
             ModelRef::Surface(m) => Model::Surface(m.clone()),
             ModelRef::ErbsCurve(m) => Model::ErbsCurve(m.clone()),
             ModelRef::ErbsSurface(m) => Model::ErbsSurface(m.clone()),
+            ModelRef::CatmullRom(m) => Model::CatmullRom(m.clone()),
+            ModelRef::BezierSpline(m) => Model::BezierSpline(m.clone()),
         }
     }
 }

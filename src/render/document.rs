@@ -2,12 +2,13 @@
 //! structures (polygons, nets, ERBS local curves and patches) that are drawn and picked.
 
 use super::camera::Bounds;
+use super::maps::{SurfaceMap, symmetric_range};
 use crate::geom::erbs::{ErbsCurve, ErbsSurface};
 use crate::geom::knots::uniform_params;
 use crate::geom::{LocalCurve as GeomLocalCurve, LocalPatch as GeomLocalPatch};
 use crate::model::{
-    CurveEdit, Edit, EditError, ErbsCurveEdit, ErbsSurfaceEdit, Index2, KindEdit, LocalEdit,
-    LocalPath, Model, ModelRef, ObjectEdit, PointEdit, SurfaceEdit,
+    BezierSplineEdit, CatmullRomEdit, CurveEdit, Edit, EditError, ErbsCurveEdit, ErbsSurfaceEdit,
+    Index2, KindEdit, LocalEdit, LocalPath, Model, ModelRef, ObjectEdit, PointEdit, SurfaceEdit,
 };
 use crate::sampling::{DirtyRegion, SampleMode, SampledObject};
 use crate::scene::{Scene, SceneObject};
@@ -121,6 +122,120 @@ impl Document {
         }
     }
 
+    /// Samples every surface for `map` (second partials with K and H for the curvature maps,
+    /// what shading needs otherwise); returns the objects re-sampled, whose every sample
+    /// changed (models are kept exactly).
+    pub fn set_analysis(&mut self, map: Option<SurfaceMap>) -> Vec<usize> {
+        let mode = match map {
+            Some(m) if m.needs_curvature() => SampleMode::Analysis,
+            _ => SampleMode::Render,
+        };
+        let mut changed = Vec::new();
+        for (i, o) in self.objects.iter_mut().enumerate() {
+            if o.sampled.model().is_surface() && o.sampled.mode() != mode {
+                o.sampled = SampledObject::new(&o.sampled.model().to_model(), mode);
+                changed.push(i);
+            }
+        }
+        changed
+    }
+
+    /// The half range of `map`'s colour scale over every surface (see [`symmetric_range`]).
+    pub fn map_range(&self, map: SurfaceMap) -> f64 {
+        symmetric_range(self.objects.iter().flat_map(|o| {
+            o.sampled
+                .grid()
+                .curvatures
+                .iter()
+                .flatten()
+                .map(move |&kh| map.value(kh))
+        }))
+    }
+
+    /// The weight of a control point (1 for polynomial objects), or `None` for handles that
+    /// have no weight (ERBS local points, Catmull–Rom and Bézier spline handles).
+    pub fn weight_of(&self, handle: Handle) -> Option<f64> {
+        let model = self.objects.get(handle.object())?.sampled.model();
+        match (handle, model) {
+            (
+                Handle::Point {
+                    point: Index2::One(k),
+                    ..
+                },
+                ModelRef::Curve(c),
+            ) => Some(c.curve().weights().map_or(1.0, |w| w[k])),
+            (
+                Handle::Point {
+                    point: Index2::Two(i, j),
+                    ..
+                },
+                ModelRef::Surface(s),
+            ) => {
+                let s = s.surface();
+                Some(s.weights().map_or(1.0, |w| w[i * s.count()[1] + j]))
+            }
+            _ => None,
+        }
+    }
+
+    /// The edit setting a control point's weight (a polynomial object becomes rational), or
+    /// why it cannot be set.
+    pub fn set_weight(&self, handle: Handle, weight: f64) -> Result<Edit, String> {
+        let model = self.objects[handle.object()].sampled.model();
+        let edit: ObjectEdit = match (handle, model) {
+            (
+                Handle::Point {
+                    point: Index2::One(point),
+                    ..
+                },
+                ModelRef::Curve(_),
+            ) => CurveEdit::Point(PointEdit::Weight { point, weight }).into_object(),
+            (
+                Handle::Point {
+                    point: Index2::Two(i, j),
+                    ..
+                },
+                ModelRef::Surface(_),
+            ) => SurfaceEdit::Point(PointEdit::Weight {
+                point: [i, j],
+                weight,
+            })
+            .into_object(),
+            (_, ModelRef::CatmullRom(_) | ModelRef::BezierSpline(_)) => {
+                return Err(format!(
+                    "a {} has no weights: B converts it to a bspline_curve first",
+                    model.type_name()
+                ));
+            }
+            _ => {
+                return Err(format!(
+                    "the points of an {} have no weights",
+                    model.type_name()
+                ));
+            }
+        };
+        edit.validate(model).map_err(|e| e.to_string())?;
+        Ok(Edit {
+            object: handle.object(),
+            edit,
+        })
+    }
+
+    /// The edit replacing a Catmull–Rom or Bézier spline by its equivalent `bspline_curve`.
+    pub fn to_bspline(&self, object: usize) -> Result<Edit, String> {
+        let model = self.objects[object].sampled.model();
+        let chain = model.to_bspline_curve().ok_or_else(|| {
+            format!(
+                "only Catmull–Rom and Bézier splines convert to a bspline_curve (this is a {})",
+                model.type_name()
+            )
+        })?;
+        Ok(Edit {
+            object,
+            edit: ObjectEdit::Replace(Box::new(chain)),
+        })
+    }
+
     /// Applies a validated edit through the delta path.
     pub fn apply(&mut self, edit: &Edit) -> Result<DirtyRegion, EditError> {
         self.objects[edit.object].sampled.apply(&edit.edit)
@@ -145,6 +260,11 @@ impl Document {
     pub fn controls(&self, i: usize) -> Controls {
         match self.objects[i].sampled.model() {
             ModelRef::Curve(c) => Controls::Polygon(c.curve().points().to_vec()),
+            // The interpolated points.
+            ModelRef::CatmullRom(c) => Controls::Polygon(c.spline().points().to_vec()),
+            // Bézier points, or the de Boor polygon of splines edited through it (their Bézier
+            // points are drawn as an overlay).
+            ModelRef::BezierSpline(c) => Controls::Polygon(c.spline().handles()),
             ModelRef::Surface(s) => {
                 let s = s.surface();
                 let [rows, cols] = s.count();
@@ -162,6 +282,16 @@ impl Document {
     /// Every pickable control point of object `i` with its position (no sampling: cheap).
     pub fn handles(&self, i: usize) -> Vec<(Handle, DVec3)> {
         let object = i;
+        let polygon = |points: Vec<DVec3>| {
+            points
+                .into_iter()
+                .enumerate()
+                .map(|(k, q)| {
+                    let point = Index2::One(k);
+                    (Handle::Point { object, point }, q)
+                })
+                .collect()
+        };
         let local_points = |path: LocalPath<Index2>, pts: &[DVec3], cols: usize| {
             pts.iter()
                 .enumerate()
@@ -182,6 +312,8 @@ impl Document {
                 .collect::<Vec<_>>()
         };
         match self.objects[i].sampled.model() {
+            ModelRef::CatmullRom(c) => polygon(c.spline().points().to_vec()),
+            ModelRef::BezierSpline(c) => polygon(c.spline().handles()),
             ModelRef::Curve(c) => c
                 .curve()
                 .points()
@@ -246,6 +378,20 @@ impl Document {
                 },
                 ModelRef::Curve(_),
             ) => CurveEdit::Point(PointEdit::Move { point, delta }).into_object(),
+            (
+                Handle::Point {
+                    point: Index2::One(point),
+                    ..
+                },
+                ModelRef::CatmullRom(_),
+            ) => CatmullRomEdit::Point(PointEdit::Move { point, delta }).into_object(),
+            (
+                Handle::Point {
+                    point: Index2::One(point),
+                    ..
+                },
+                ModelRef::BezierSpline(_),
+            ) => BezierSplineEdit::Move { point, delta }.into_object(),
             (
                 Handle::Point {
                     point: Index2::Two(i, j),

@@ -2,10 +2,12 @@
 //! dirty tracking, display options and overlays. Used by `prespline render` (offscreen) and the
 //! viewer (swapchain).
 
+pub mod analysis;
 pub mod camera;
 pub mod document;
 pub mod gpu_scene;
 pub mod lod;
+pub mod maps;
 pub mod offscreen;
 pub mod overlays;
 pub mod style;

@@ -1,9 +1,11 @@
 //! Headless rendering of a document into pixels (`prespline render`, golden-image tests).
 
+use super::analysis::{CurveEval, Osculating, badge_overlay, osculating_lines, osculating_overlay};
 use super::camera::OrbitCamera;
 use super::document::Document;
 use super::gpu_scene::{GpuScene, Highlight};
 use super::lod::Lod;
+use super::maps::legend;
 use super::overlays::overlay_lines;
 use super::style::{Palette, ViewOptions};
 use crate::gpu::{GpuResult, OffscreenDesc, Pixels, Renderer};
@@ -67,9 +69,37 @@ fn record(
     let viewport = [shot.width as f64, shot.height as f64];
     let lod = Lod::new(camera.view_proj(aspect, &bounds), viewport, frame.samples());
     scene.draw(&mut frame, doc, &shot.options, &Highlight::default(), &lod)?;
-    let lines = overlay_lines(doc, &shot.options, bounds.radius());
+    let mut lines = overlay_lines(doc, &shot.options, bounds.radius());
+    let (w, h) = (shot.width as f64, shot.height as f64);
+    let project = |p| camera.project(p, w, h, &bounds).map(|(x, y, _)| (x, y));
+    let mut overlay = Vec::new();
+    if let Some((i, t)) = shot.options.osculating_at
+        && let Some(o) = doc.objects.get(i).and_then(|o| {
+            let curve = CurveEval::of(o.sampled.model())?;
+            Osculating::at(&curve, t)
+        })
+    {
+        lines.extend(osculating_lines(&o));
+        if let Some(at) = project(o.point) {
+            overlay.extend(osculating_overlay(
+                &doc.objects[i].name,
+                &o,
+                at,
+                [w as f32, h as f32],
+            ));
+        }
+    }
     if !lines.is_empty() {
         frame.draw_lines3d(&lines)?;
+    }
+    if shot.options.badges {
+        overlay.extend(badge_overlay(doc, project));
+    }
+    if let Some(map) = shot.options.analysis {
+        overlay.extend(legend(map, doc.map_range(map), w as f32, h as f32));
+    }
+    if !overlay.is_empty() {
+        frame.draw_overlay(&overlay)?;
     }
     frame.capture();
     frame.finish()?;

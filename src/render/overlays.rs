@@ -3,11 +3,12 @@
 //! shown (a few hundred evaluations).
 
 use super::document::Document;
-use super::style::ViewOptions;
+use super::style::{NetMode, ViewOptions};
+use crate::geom::Handles;
 use crate::geom::differential::frenet_frame;
 use crate::geom::knots::uniform_params;
 use crate::gpu::LineVertex;
-use crate::model::ModelRef;
+use crate::model::{Model, ModelRef};
 use glam::DVec3;
 
 /// Frames drawn per curve.
@@ -21,6 +22,9 @@ const NORMALS_PER_DIRECTION: usize = 32;
 pub fn overlay_lines(doc: &Document, opts: &ViewOptions, scale: f64) -> Vec<LineVertex> {
     let mut out = Vec::new();
     for o in &doc.objects {
+        if opts.control_nets != NetMode::Off {
+            bezier_points_of_deboor_splines(&mut out, o.sampled.model(), scale);
+        }
         let grid = o.sampled.grid();
         if let (true, Some(normals)) = (opts.normals, &grid.normals) {
             let [rows, cols] = grid.dims;
@@ -49,6 +53,13 @@ pub fn overlay_lines(doc: &Document, opts: &ViewOptions, scale: f64) -> Vec<Line
                 Box::new(move |t| c.curve().derivatives(t, 3)),
                 c.curve().domain(),
             ),
+            m @ (ModelRef::CatmullRom(_) | ModelRef::BezierSpline(_)) => {
+                let Some(Model::Curve(chain)) = m.to_bspline_curve() else {
+                    continue;
+                };
+                let domain = chain.curve().domain();
+                (Box::new(move |t| chain.curve().derivatives(t, 3)), domain)
+            }
             _ => continue,
         };
         if opts.frenet {
@@ -87,6 +98,29 @@ pub fn overlay_lines(doc: &Document, opts: &ViewOptions, scale: f64) -> Vec<Line
         }
     }
     out
+}
+
+/// The Bézier polygon of a spline edited through de Boor points (C1 quadratic, C2 cubic), with
+/// a small cross on each Bézier point: the lecture's A-frame picture next to the de Boor
+/// polygon the control net shows.
+fn bezier_points_of_deboor_splines(out: &mut Vec<LineVertex>, model: ModelRef<'_>, scale: f64) {
+    let ModelRef::BezierSpline(s) = model else {
+        return;
+    };
+    let s = s.spline();
+    if s.handle_kind() != Handles::DeBoor {
+        return;
+    }
+    let color = [200, 150, 90, 255];
+    for w in s.points().windows(2) {
+        line(out, w[0], w[1], color);
+    }
+    let r = 0.006 * scale;
+    for &p in s.points() {
+        for d in [DVec3::X, DVec3::Y, DVec3::Z] {
+            line(out, p - d * r, p + d * r, color);
+        }
+    }
 }
 
 fn line(out: &mut Vec<LineVertex>, a: DVec3, b: DVec3, color: [u8; 4]) {

@@ -44,6 +44,13 @@ pub struct ViewOptions {
     pub frenet: bool,
     /// Curvature combs along curves.
     pub curvature_comb: bool,
+    /// Continuity badges at curve junctions and multiple knots.
+    pub badges: bool,
+    /// A colour map (or zebra stripes) on surfaces, with its legend.
+    pub analysis: Option<super::maps::SurfaceMap>,
+    /// The osculating circle of curve object `.0` at parameter `.1` (`render --osculating`;
+    /// the viewer follows the cursor instead).
+    pub osculating_at: Option<(usize, f64)>,
     /// Curve width in pixels.
     pub curve_width: f32,
     /// Control point size in pixels.
@@ -62,6 +69,9 @@ impl Default for ViewOptions {
             normals: false,
             frenet: false,
             curvature_comb: false,
+            badges: false,
+            analysis: None,
+            osculating_at: None,
             curve_width: 2.5,
             point_size: 8.0,
             lod: true,

@@ -52,6 +52,18 @@ impl Extent {
                 rational: m.curve().is_rational(),
                 erbs_locals: None,
             },
+            Model::CatmullRom(_) => Extent {
+                samples,
+                degree: vec![3],
+                rational: false,
+                erbs_locals: None,
+            },
+            Model::BezierSpline(m) => Extent {
+                samples,
+                degree: vec![m.spline().degree()],
+                rational: false,
+                erbs_locals: None,
+            },
             Model::Surface(m) => Extent {
                 samples,
                 degree: m.surface().degree().to_vec(),
@@ -178,6 +190,8 @@ pub fn estimate(extent: &Extent, mode: SampleMode, uses: Uses) -> Estimate {
         (SampleMode::Derivatives(g), true) => (g, (g + 1) * (g + 1)),
         (SampleMode::Render, false) => (1, 2),
         (SampleMode::Render, true) => (1, 3),
+        (SampleMode::Analysis, false) => (1, 2),
+        (SampleMode::Analysis, true) => (2, 6),
     };
     let (g, stride) = (g as u128, stride as u128);
     let n = extent.sample_count();
@@ -227,8 +241,15 @@ pub fn estimate(extent: &Extent, mode: SampleMode, uses: Uses) -> Estimate {
             format!("{samples_text} × {orders} × 32 B"),
         );
     }
-    if surface && mode == SampleMode::Render {
+    if surface && matches!(mode, SampleMode::Render | SampleMode::Analysis) {
         e.add("normals", n * VEC3, format!("{samples_text} × 24 B"));
+    }
+    if surface && mode == SampleMode::Analysis {
+        e.add(
+            "curvatures",
+            n * 2 * F64,
+            format!("{samples_text} × [K, H] × 16 B"),
+        );
     }
     if let Some(locals) = &extent.erbs_locals {
         // Blend weights: per direction m × 2 × (g+1) f64. Local samples: every parent sample

@@ -3,10 +3,14 @@
 
 use super::grid::{PartialSet, SampleGrid};
 use crate::geom::knots::uniform_params;
-use crate::model::ModelRef;
+use crate::model::{ChainModel, ModelRef};
 
 /// Samples `model` point by point through the geometry layer's own evaluators.
 pub fn exact_grid(model: ModelRef<'_>, set: &PartialSet) -> SampleGrid {
+    // Catmull–Rom and Bézier splines: the de Boor evaluation of their Bézier chain.
+    if let Some(chain) = model.to_bspline_curve() {
+        return exact_grid(chain.as_ref(), set);
+    }
     let domain = model.domain();
     let [mu, mv] = model.sample_dims();
     let g = set.max_order();
@@ -38,6 +42,13 @@ pub fn exact_grid(model: ModelRef<'_>, set: &PartialSet) -> SampleGrid {
                     for (slot, &(a, b)) in list.iter().enumerate() {
                         out[slot] = p.get(a, b);
                     }
+                }
+                // Converted above; this is the same evaluation, only slower.
+                ModelRef::CatmullRom(m) => {
+                    out.copy_from_slice(&m.chain_form().curve().derivatives(u, g))
+                }
+                ModelRef::BezierSpline(m) => {
+                    out.copy_from_slice(&m.chain_form().curve().derivatives(u, g))
                 }
             }
         }

@@ -14,6 +14,8 @@ pub enum PartialSet {
     Square(usize),
     /// S, Su, Sv: what shading needs.
     Shading,
+    /// S, Su, Sv, Suu, Suv, Svv: shading and surface curvature (the analysis maps).
+    Curvature,
 }
 
 impl PartialSet {
@@ -23,6 +25,7 @@ impl PartialSet {
             PartialSet::Curve(g) => (0..=g).map(|r| (r, 0)).collect(),
             PartialSet::Square(g) => (0..=g).flat_map(|a| (0..=g).map(move |b| (a, b))).collect(),
             PartialSet::Shading => vec![(0, 0), (1, 0), (0, 1)],
+            PartialSet::Curvature => vec![(0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2)],
         }
     }
 
@@ -32,6 +35,7 @@ impl PartialSet {
             PartialSet::Curve(g) => g + 1,
             PartialSet::Square(g) => (g + 1) * (g + 1),
             PartialSet::Shading => 3,
+            PartialSet::Curvature => 6,
         }
     }
 
@@ -44,6 +48,7 @@ impl PartialSet {
         match *self {
             PartialSet::Curve(g) | PartialSet::Square(g) => g,
             PartialSet::Shading => 1,
+            PartialSet::Curvature => 2,
         }
     }
 
@@ -54,7 +59,8 @@ impl PartialSet {
 }
 
 /// Samples of one object: `data[(i * cols + j) * stride + p]` is partial p of sample (i, j)
-/// (curves: one column). Surfaces built for shading also keep unit normals.
+/// (curves: one column). Surfaces built for shading also keep unit normals, and those with
+/// second partials ([`PartialSet::Curvature`]) their Gaussian and mean curvature.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SampleGrid {
     /// [rows, cols]: [m, 1] for curves, [mu, mv] for surfaces.
@@ -63,6 +69,9 @@ pub struct SampleGrid {
     pub data: Vec<DVec3>,
     /// Unit normals (surfaces with `Shading`, or `Square(g ≥ 1)` when requested), row-major.
     pub normals: Option<Vec<DVec3>>,
+    /// [K, H] per sample, row-major: Gaussian and mean curvature with the normal orientation of
+    /// `normals` (`Curvature` grids with normals only).
+    pub curvatures: Option<Vec<[f64; 2]>>,
 }
 
 impl SampleGrid {
@@ -71,9 +80,11 @@ impl SampleGrid {
         let stride = partials.len();
         Self {
             dims,
-            partials,
             data: vec![DVec3::ZERO; n * stride],
             normals: with_normals.then(|| vec![DVec3::Z; n]),
+            curvatures: (with_normals && partials == PartialSet::Curvature)
+                .then(|| vec![[0.0; 2]; n]),
+            partials,
         }
     }
 

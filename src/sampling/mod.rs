@@ -7,6 +7,8 @@
 
 pub mod axis;
 pub mod budget;
+pub mod chain_curve;
+pub mod curvature;
 pub mod dirty;
 pub mod erbs_axis;
 pub mod erbs_curve;

@@ -11,6 +11,12 @@ pub trait NormalSource {
     /// (Su, Sv, Suv) at (u, v).
     fn first_partials(&self, u: f64, v: f64) -> (DVec3, DVec3, DVec3);
     fn domain(&self) -> [(f64, f64); 2];
+
+    /// [K, H] next to (u, v) where the samples' Su × Sv vanishes (the limit from the inside of
+    /// the domain), or `None` when the model cannot say (such samples show as undefined).
+    fn curvature_near(&self, _u: f64, _v: f64) -> Option<[f64; 2]> {
+        None
+    }
 }
 
 /// Recomputes normals of the samples in `rows × cols` from the stored Su, Sv.
@@ -33,7 +39,7 @@ pub fn update(
     };
     let mv = grid.dims[1];
     let mut degenerate = Vec::new();
-    for i in rows {
+    for i in rows.clone() {
         for j in cols.clone() {
             let base = (i * mv + j) * stride;
             match regular_normal(grid.data[base + iu], grid.data[base + iv]) {
@@ -43,6 +49,7 @@ pub fn update(
         }
     }
     resolve_degenerate(grid, &degenerate, params, model);
+    super::curvature::update(grid, rows, cols, params, model);
 }
 
 /// Storage slots of Su and Sv.

@@ -1,13 +1,17 @@
 //! The sampler trait every object kind implements, drift control on top of it, and a
 //! pre-evaluated object of any kind.
 
+use super::chain_curve::ChainCurveSampler;
 use super::dirty::DirtyRegion;
 use super::erbs_curve::ErbsCurveSampler;
 use super::erbs_surface::ErbsSurfaceSampler;
 use super::grid::{PartialSet, SampleGrid};
 use super::spline_curve::SplineCurveSampler;
 use super::spline_surface::SplineSurfaceSampler;
-use crate::model::{EditError, KindEdit, Model, ModelRef, ObjectEdit, edit_kind_mismatch};
+use crate::model::{
+    BezierSplineEdit, CatmullRomEdit, EditError, KindEdit, Model, ModelRef, ObjectEdit,
+    edit_kind_mismatch,
+};
 
 /// What to keep per sample.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -16,6 +20,9 @@ pub enum SampleMode {
     Derivatives(usize),
     /// Curves c, c'; surfaces S, Su, Sv and unit normals (what the renderer draws).
     Render,
+    /// As `Render`, and surfaces also Suu, Suv, Svv with Gaussian and mean curvature per
+    /// sample (the analysis colour maps, updated by the delta path like the positions).
+    Analysis,
 }
 
 impl SampleMode {
@@ -25,6 +32,7 @@ impl SampleMode {
         match self {
             SampleMode::Derivatives(g) => (g, PartialSet::Square(g), false),
             SampleMode::Render => (1, PartialSet::Shading, true),
+            SampleMode::Analysis => (1, PartialSet::Curvature, true),
         }
     }
 }
@@ -147,6 +155,8 @@ pub enum SampledObject {
     Surface(Tracked<SplineSurfaceSampler>),
     ErbsCurve(Tracked<ErbsCurveSampler>),
     ErbsSurface(Tracked<ErbsSurfaceSampler>),
+    CatmullRom(Tracked<ChainCurveSampler<CatmullRomEdit>>),
+    BezierSpline(Tracked<ChainCurveSampler<BezierSplineEdit>>),
 }
 
 /// Runs `$body` with `$s` bound to the kind's tracked sampler.
@@ -157,6 +167,8 @@ macro_rules! each_sampler {
             SampledObject::Surface($s) => $body,
             SampledObject::ErbsCurve($s) => $body,
             SampledObject::ErbsSurface($s) => $body,
+            SampledObject::CatmullRom($s) => $body,
+            SampledObject::BezierSpline($s) => $body,
         }
     };
 }
@@ -180,6 +192,22 @@ impl SampledObject {
                 set,
                 normals,
             ))),
+            Model::CatmullRom(m) => {
+                Self::CatmullRom(Tracked::new(ChainCurveSampler::new(m.clone(), order)))
+            }
+            Model::BezierSpline(m) => {
+                Self::BezierSpline(Tracked::new(ChainCurveSampler::new(m.clone(), order)))
+            }
+        }
+    }
+
+    /// The sample mode this object was built with.
+    pub fn mode(&self) -> SampleMode {
+        let grid = self.grid();
+        match (&grid.partials, grid.normals.is_some()) {
+            (PartialSet::Curve(1), _) | (PartialSet::Shading, true) => SampleMode::Render,
+            (PartialSet::Curvature, true) => SampleMode::Analysis,
+            (p, _) => SampleMode::Derivatives(p.max_order()),
         }
     }
 
@@ -195,6 +223,8 @@ impl SampledObject {
             SampledObject::Surface(s) => ModelRef::Surface(s.model()),
             SampledObject::ErbsCurve(s) => ModelRef::ErbsCurve(s.model()),
             SampledObject::ErbsSurface(s) => ModelRef::ErbsSurface(s.model()),
+            SampledObject::CatmullRom(s) => ModelRef::CatmullRom(s.model()),
+            SampledObject::BezierSpline(s) => ModelRef::BezierSpline(s.model()),
         }
     }
 
@@ -215,8 +245,22 @@ impl SampledObject {
     /// periodic rebuild's). An edit of another kind, or one that does not fit the model, is an
     /// error and changes nothing.
     pub fn apply(&mut self, edit: &ObjectEdit) -> Result<DirtyRegion, EditError> {
+        if let ObjectEdit::Replace(model) = edit {
+            edit.validate(self.model())?;
+            let interval = each_sampler!(self, s => s.interval);
+            *self = SampledObject::new(model, self.mode());
+            self.set_rebuild_interval(interval);
+            let [rows, _] = self.grid().dims;
+            return Ok(DirtyRegion::curve(0..rows).union(self.full_region()));
+        }
         let name = self.type_name();
         each_sampler!(self, s => apply_kind(s, edit, name))
+    }
+
+    /// Every sample.
+    fn full_region(&self) -> DirtyRegion {
+        let [rows, cols] = self.grid().dims;
+        DirtyRegion::surface(0..rows, 0..cols)
     }
 
     /// Exact re-evaluation of everything touched since the last rebuild (drift reset).

@@ -21,7 +21,7 @@ use std::ops::Range;
 
 /// Sample rows per group: four f64 lanes fill two SSE2 registers (one AVX register). Measured on
 /// the portable x86-64 build: 2 lanes leave the coefficient loads unshared, 8 spill.
-const LANES: usize = 4;
+pub(crate) const LANES: usize = 4;
 
 /// Q0 = M_u[0]·C and Q1 = M_u[1]·C at one control column for L sample rows: x, y, z of Q0, then
 /// of Q1, each with one lane per row.
@@ -330,7 +330,10 @@ fn normals_staged<const L: usize>(stage: &mut [Lanes<L>; 10]) {
 /// without branches so that each step is one SIMD operation across the lanes: the normals, and
 /// per lane 1 if regular (the normal is exactly `regular_normal`'s) else 0.
 #[inline(always)]
-fn unit_normals<const L: usize>(u: [[f64; L]; 3], v: [[f64; L]; 3]) -> ([[f64; L]; 3], [f64; L]) {
+pub(crate) fn unit_normals<const L: usize>(
+    u: [[f64; L]; 3],
+    v: [[f64; L]; 3],
+) -> ([[f64; L]; 3], [f64; L]) {
     let lanes = |f: &dyn Fn(usize) -> f64| -> [f64; L] { std::array::from_fn(f) };
     let cx = lanes(&|l| u[1][l] * v[2][l] - v[1][l] * u[2][l]);
     let cy = lanes(&|l| u[2][l] * v[0][l] - v[2][l] * u[0][l]);

@@ -157,6 +157,30 @@ impl SplineSurfaceSampler {
             self.resolve_degenerate(&degenerate);
             return DirtyRegion::surface(rows, cols);
         }
+        if self.grid.curvatures.is_some() {
+            // Curvature maps: the six partials, normals and [K, H] in one pass.
+            let mut degenerate = Vec::new();
+            let [tu, tv] = &self.tables;
+            let (rows, cols) = super::curvature::translate(
+                [tu, tv],
+                [k, l],
+                delta,
+                &mut self.grid,
+                &mut degenerate,
+            );
+            self.resolve_degenerate(&degenerate);
+            let params = [
+                self.tables[0].params.as_slice(),
+                self.tables[1].params.as_slice(),
+            ];
+            super::curvature::resolve_degenerate(
+                &mut self.grid,
+                &degenerate,
+                params,
+                self.model.surface(),
+            );
+            return DirtyRegion::surface(rows, cols);
+        }
         let (rows, cols) = (self.tables[0].range(k), self.tables[1].range(l));
         let [tu, tv] = &self.tables;
         let stride = self.grid.stride();
@@ -368,5 +392,17 @@ impl NormalSource for TensorSurface {
 
     fn domain(&self) -> [(f64, f64); 2] {
         TensorSurface::domain(self)
+    }
+
+    /// The curvature a small step towards the domain centre, where Su × Sv no longer vanishes
+    /// (poles of a sphere, collapsed edges): 1e-3, then 1e-2 of the domain size. Closer in, the
+    /// fundamental forms' determinant vanishes quadratically and rounding dominates.
+    fn curvature_near(&self, u: f64, v: f64) -> Option<[f64; 2]> {
+        let [(u0, u1), (v0, v1)] = TensorSurface::domain(self);
+        let (uc, vc) = (0.5 * (u0 + u1), 0.5 * (v0 + v1));
+        [1e-3, 1e-2].into_iter().find_map(|eps| {
+            let (un, vn) = (u + eps * (uc - u), v + eps * (vc - v));
+            self.curvatures(un, vn).map(|(k, h)| [k, h])
+        })
     }
 }

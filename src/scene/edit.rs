@@ -5,8 +5,8 @@
 use super::json::*;
 use super::{Scene, SceneError};
 use crate::model::{
-    CurveEdit, Edit, EditError, ErbsCurveEdit, ErbsSurfaceEdit, KindEdit, LocalEdit, LocalPath,
-    Model, ModelRef, ObjectEdit, PointEdit, SurfaceEdit,
+    BezierSplineEdit, CatmullRomEdit, CurveEdit, Edit, EditError, ErbsCurveEdit, ErbsSurfaceEdit,
+    KindEdit, LocalEdit, LocalPath, Model, ModelRef, ObjectEdit, PointEdit, SurfaceEdit,
 };
 use glam::DMat4;
 use serde_json::{Map, Value};
@@ -70,6 +70,9 @@ fn parse_edit(
     obj: &Map<String, Value>,
     model: ModelRef<'_>,
 ) -> Result<ObjectEdit, SceneError> {
+    if obj.contains_key("to_bspline") {
+        return to_bspline(at, obj, model);
+    }
     if let ModelRef::ErbsCurve(_) | ModelRef::ErbsSurface(_) = model {
         return erbs_edit(at, obj, model.is_surface());
     }
@@ -77,6 +80,20 @@ fn parse_edit(
         return structural(at, obj, model);
     }
     Ok(match model {
+        ModelRef::CatmullRom(_) => {
+            CatmullRomEdit::Point(point_edit(at, obj, |v| index(at, "point", v))?).into_object()
+        }
+        ModelRef::BezierSpline(_) => match point_edit(at, obj, |v| index(at, "point", v))? {
+            PointEdit::Move { point, delta } => {
+                BezierSplineEdit::Move { point, delta }.into_object()
+            }
+            _ => {
+                return Err(at.err(
+                    "weight",
+                    "a bezier_spline has no weights (its segments are polynomial; convert it to a bspline_curve first)",
+                ));
+            }
+        },
         ModelRef::Curve(_) => {
             CurveEdit::Point(point_edit(at, obj, |v| index(at, "point", v))?).into_object()
         }
@@ -299,12 +316,50 @@ fn local_edit<I: Copy + Default>(
     })
 }
 
+/// `{"object": o, "to_bspline": true}`: a Catmull–Rom or Bézier spline becomes the equivalent
+/// `bspline_curve` (later edits address its B-spline control points).
+fn to_bspline(
+    at: &At,
+    obj: &Map<String, Value>,
+    model: ModelRef<'_>,
+) -> Result<ObjectEdit, SceneError> {
+    check_fields(at, obj, &["object", "to_bspline"])?;
+    if obj["to_bspline"] != Value::Bool(true) {
+        return Err(at.err(
+            "to_bspline",
+            format!("expected true, found {}", obj["to_bspline"]),
+        ));
+    }
+    let chain = model.to_bspline_curve().ok_or_else(|| {
+        at.err(
+            "to_bspline",
+            format!(
+                "only catmull_rom and bezier_spline objects convert to a bspline_curve, not a {}",
+                model.type_name()
+            ),
+        )
+    })?;
+    Ok(ObjectEdit::Replace(Box::new(chain)))
+}
+
 /// `insert_knot` (with optional `times`) and `elevate_degree`, per kind.
 fn structural(
     at: &At,
     obj: &Map<String, Value>,
     model: ModelRef<'_>,
 ) -> Result<ObjectEdit, SceneError> {
+    let ty = model.type_name();
+    if let ModelRef::CatmullRom(_) | ModelRef::BezierSpline(_) = model {
+        let field = if obj.contains_key("insert_knot") {
+            "insert_knot"
+        } else {
+            "elevate_degree"
+        };
+        return Err(at.err(
+            field,
+            format!("a {ty} keeps its own segment structure; convert it first ({{\"object\": …, \"to_bspline\": true}}) to refine it"),
+        ));
+    }
     let surface = model.is_surface();
     if let Some(v) = obj.get("insert_knot") {
         check_fields(at, obj, &["object", "insert_knot", "times"])?;

@@ -54,6 +54,18 @@ impl Scene {
     pub fn find(&self, name: &str) -> Option<usize> {
         self.objects.iter().position(|o| o.name == name)
     }
+
+    /// The scene with every Catmull–Rom and Bézier spline replaced by its equivalent
+    /// `bspline_curve` (the B-spline of its Bézier chain; same shape, samples and colour).
+    #[must_use]
+    pub fn with_bspline_curves(mut self) -> Scene {
+        for o in &mut self.objects {
+            if let Some(m) = o.model.as_ref().to_bspline_curve() {
+                o.model = m;
+            }
+        }
+        self
+    }
 }
 
 /// Replaces `path` with `bytes` atomically and durably: the bytes go to a temporary file in the

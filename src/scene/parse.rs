@@ -2,9 +2,13 @@
 
 use super::json::*;
 use super::{MAX_CURVE_SAMPLES, MAX_DEGREE, MAX_SURFACE_SAMPLES, Scene, SceneError, SceneObject};
-use crate::geom::{BFunctionKind, BSplineCurve, GeomError, KnotVector, TensorSurface};
+use crate::geom::{
+    BFunctionKind, BSplineCurve, BezierSpline, CatmullRom, GeomError, JoinContinuity, KnotVector,
+    Parametrization, TensorSurface,
+};
 use crate::model::{
-    CurveModel, EditError, ErbsCurveModel, ErbsSurfaceModel, Model, SplineForm, SurfaceModel,
+    BezierSplineModel, CatmullRomModel, CurveModel, EditError, ErbsCurveModel, ErbsSurfaceModel,
+    Model, SplineForm, SurfaceModel,
 };
 use glam::DVec3;
 use serde_json::{Map, Value};
@@ -72,11 +76,67 @@ fn parse_object(i: usize, v: &Value) -> Result<SceneObject, SceneError> {
             let m = ErbsSurfaceModel::new(s, surface_samples(&at, obj)?);
             Model::ErbsSurface(m.map_err(|e| edit(&at, e))?)
         }
+        "catmull_rom" => {
+            check_fields(
+                &at,
+                obj,
+                &with(&OBJECT_FIELDS, &["points", "parametrization", "closed"]),
+            )?;
+            let points = as_points(&at, "points", require(&at, obj, "points")?)?;
+            let parametrization = match opt(obj, "parametrization") {
+                None => Parametrization::default(),
+                Some(v) => {
+                    let name = as_str(&at, "parametrization", v)?;
+                    Parametrization::from_name(name).ok_or_else(|| {
+                        at.err(
+                            "parametrization",
+                            format!(
+                                "unknown parametrization '{name}' (expected one of: uniform, centripetal, chordal)"
+                            ),
+                        )
+                    })?
+                }
+            };
+            let closed = match opt(obj, "closed") {
+                None => false,
+                Some(v) => v.as_bool().ok_or_else(|| {
+                    at.err(
+                        "closed",
+                        format!("expected true or false, found {}", kind(v)),
+                    )
+                })?,
+            };
+            let c = CatmullRom::new(points, parametrization, closed).map_err(|e| geom(&at, e))?;
+            let m = CatmullRomModel::new(c, curve_samples(&at, obj)?);
+            Model::CatmullRom(m.map_err(|e| edit(&at, e))?)
+        }
+        "bezier_spline" => {
+            check_fields(
+                &at,
+                obj,
+                &with(&OBJECT_FIELDS, &["degree", "knots", "points", "continuity"]),
+            )?;
+            let degree = as_usize(&at, "degree", "degree", require(&at, obj, "degree")?)?;
+            check_degree(&at, "degree", degree)?;
+            let knots = as_f64_list(&at, "knots", "knot", require(&at, obj, "knots")?)?;
+            let points = as_points(&at, "points", require(&at, obj, "points")?)?;
+            let name = as_str(&at, "continuity", require(&at, obj, "continuity")?)?;
+            let continuity = JoinContinuity::from_name(name).ok_or_else(|| {
+                at.err(
+                    "continuity",
+                    format!("unknown continuity '{name}' (expected one of: C0, G1, C1, C2)"),
+                )
+            })?;
+            let c =
+                BezierSpline::new(degree, knots, points, continuity).map_err(|e| geom(&at, e))?;
+            let m = BezierSplineModel::new(c, curve_samples(&at, obj)?);
+            Model::BezierSpline(m.map_err(|e| edit(&at, e))?)
+        }
         other => {
             return Err(at.err(
                 "type",
                 format!(
-                    "unknown type '{other}' (expected one of: bezier_curve, bspline_curve, erbs_curve, bezier_surface, bspline_surface, erbs_surface)"
+                    "unknown type '{other}' (expected one of: bezier_curve, bspline_curve, erbs_curve, catmull_rom, bezier_spline, bezier_surface, bspline_surface, erbs_surface)"
                 ),
             ));
         }

@@ -3,7 +3,7 @@
 
 use super::{Scene, SceneObject};
 use crate::geom::erbs::{ErbsCurve, ErbsSurface, LocalCurve, LocalPatch};
-use crate::geom::{BFunctionKind, TensorSurface};
+use crate::geom::{BFunctionKind, Parametrization, TensorSurface};
 use crate::model::{Model, SplineForm};
 use glam::DVec3;
 use std::fmt::Write;
@@ -64,6 +64,27 @@ fn write_object(s: &mut String, o: &SceneObject) {
             weights(s, p);
         }
         Model::ErbsSurface(m) => erbs_surface(s, m.surface()),
+        Model::CatmullRom(m) => {
+            let c = m.spline();
+            field(s, "points", &points(c.points()));
+            if c.parametrization() != Parametrization::Uniform {
+                field(
+                    s,
+                    "parametrization",
+                    &format!("\"{}\"", c.parametrization().name()),
+                );
+            }
+            if c.closed() {
+                field(s, "closed", "true");
+            }
+        }
+        Model::BezierSpline(m) => {
+            let c = m.spline();
+            field(s, "degree", &c.degree().to_string());
+            field(s, "knots", &numbers(c.knots()));
+            field(s, "points", &points(c.points()));
+            field(s, "continuity", &format!("\"{}\"", c.continuity().name()));
+        }
     }
     match o.model.sample_dims() {
         [m, _] if !o.model.is_surface() => field(s, "samples", &m.to_string()),

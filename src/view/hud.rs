@@ -44,6 +44,22 @@ pub const KEY_HELP: &[(&str, &str)] = &[
         "E / Shift+E",
         "elevate the degree of the selected curve or surface (in u / in v)",
     ),
+    (
+        "Alt+drag on a point / Shift+W",
+        "change its weight (up: heavier) / type its weight; a polynomial object becomes rational",
+    ),
+    (
+        "B",
+        "convert the selected Catmull-Rom or Bezier spline to a bspline_curve",
+    ),
+    (
+        "J / O",
+        "continuity badges at joins / osculating circle, curvature, torsion at the cursor",
+    ),
+    (
+        "M",
+        "surface map: Gaussian, mean, max and min principal curvature, zebra, off",
+    ),
     ("Ctrl+Z / Ctrl+Shift+Z (Ctrl+Y)", "undo / redo"),
     ("Ctrl+S", "save the scene file"),
     ("F / A / Home", "frame selection / frame all / reset camera"),

@@ -78,6 +78,12 @@ impl Refine {
                 times: 1,
             }
             .into_object(),
+            ModelRef::CatmullRom(_) | ModelRef::BezierSpline(_) => {
+                return Err(format!(
+                    "a {} keeps its segments: B converts it to a bspline_curve first",
+                    model.type_name()
+                ));
+            }
             _ => return Err("ERBS objects are not refined by B-spline knot insertion".into()),
         };
         edit.validate(model).map_err(|e| e.to_string())?;

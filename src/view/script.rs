@@ -10,8 +10,11 @@
 //!  {"frame": 7, "key": "r"}, {"frame": 8, "type": "30"}, {"frame": 9, "key": "enter"},
 //!  {"frame": 10, "key": "z", "ctrl": true}, {"frame": 11, "wheel": 2},
 //!  {"frame": 12, "screenshot": "shot.png"}, {"frame": 13, "screenshot": "hud.png", "hud": true},
-//!  {"frame": 14, "quit": true}]
+//!  {"frame": 14, "hold": ["alt"]}, {"frame": 15, "hold": []},
+//!  {"frame": 16, "quit": true}]
 //! ```
+//!
+//! `hold` keeps modifier keys down for the events that follow (an Alt+drag), `[]` releases.
 //!
 //! `move_to` aims the cursor at a control point (`"local"` too for ERBS objects), so scripts
 //! keep working when the window size or framing changes.
@@ -135,6 +138,23 @@ fn parse_event(v: &Value, doc: &Document) -> Result<ScriptEvent, String> {
             PathBuf::from(arg.as_str().ok_or("'screenshot' expects a file name")?),
             flag("hud"),
         ),
+        "hold" => {
+            // {"hold": ["alt", "shift"]} keeps modifiers down for the following events
+            // (an Alt+drag); {"hold": []} releases them.
+            let names = arg
+                .as_array()
+                .ok_or("'hold' expects a list of modifier names")?;
+            let mut m = Modifiers::default();
+            for n in names {
+                match n.as_str() {
+                    Some("ctrl") => m.ctrl = true,
+                    Some("shift") => m.shift = true,
+                    Some("alt") => m.alt = true,
+                    _ => return Err(format!("'hold': unknown modifier {n}")),
+                }
+            }
+            Action::Input(InputEvent::Modifiers(m))
+        }
         "quit" => Action::Quit,
         other => return Err(format!("unknown action '{other}'")),
     };

@@ -11,16 +11,23 @@ use super::refine::Refine;
 use super::script::Action;
 use super::tools::{Axis, Drag, Transform, TransformKind, View};
 use super::undo::UndoStack;
+use crate::cli::render::DRAW_USES;
 use crate::gpu::{Frame, GpuResult, Renderer};
 use crate::model::{
     CurveEdit, Edit, Index2, KindEdit, LocalPath, Model, ModelRef, SurfaceEdit, merge_edits,
 };
+use crate::render::analysis::{
+    CurveEval, Osculating, badge_overlay, osculating_lines, osculating_overlay,
+};
 use crate::render::lod::Lod;
+use crate::render::maps::{SurfaceMap, legend};
 use crate::render::overlays::overlay_lines;
 use crate::render::{
     Bounds, Document, GpuScene, Handle, Highlight, NetMode, OrbitCamera, Palette, UploadStats,
     ViewOptions, Wire,
 };
+use crate::sampling::budget::{MemoryBudget, check_scene};
+use crate::sampling::{DirtyRegion, SampleMode};
 use crate::scene::Scene;
 use glam::{DMat4, DVec3};
 use std::path::PathBuf;
@@ -50,6 +57,17 @@ enum Mode {
     },
     /// Aiming a knot insertion (I).
     Refine(Refine),
+    /// Alt+drag on a control point: its weight follows the vertical motion (up: heavier).
+    Weight {
+        handle: Handle,
+        start_y: f64,
+        from: f64,
+    },
+    /// Typing a weight for the selected control point (Shift+W).
+    WeightEntry {
+        handle: Handle,
+        text: String,
+    },
 }
 
 /// Cost of applying one frame's edits.
@@ -94,6 +112,11 @@ pub struct Session {
     autosave: Option<Autosave>,
     /// The transformed object's model when the gesture began.
     transform_origin: Option<Model>,
+    /// Osculating circle, curvature and torsion of the curve under the cursor (O).
+    pub osculating: bool,
+    /// Half range of the analysis map's colour scale (refitted when a map is chosen and after
+    /// each drag).
+    map_range: f64,
 }
 
 impl Session {
@@ -143,6 +166,8 @@ impl Session {
             naive: false,
             autosave: None,
             transform_origin: None,
+            osculating: false,
+            map_range: 1.0,
         })
     }
 
@@ -387,9 +412,36 @@ impl Session {
         let lod = Lod::new(view_proj, self.size, frame.samples());
         let report = self.gpu.draw(frame, &self.doc, &self.options, &hl, &lod)?;
         self.hud.triangles = (report.triangles, report.full_triangles);
-        let lines = overlay_lines(&self.doc, &self.options, self.bounds.radius());
+        let mut lines = overlay_lines(&self.doc, &self.options, self.bounds.radius());
+        let mut analysis = Vec::new();
+        if self.osculating
+            && matches!(
+                self.mode,
+                Mode::Idle | Mode::Drag { .. } | Mode::Weight { .. }
+            )
+            && let Some((object, o)) = self.osculating_at_cursor()
+        {
+            lines.extend(osculating_lines(&o));
+            if let Some(at) = self.view().project(o.point) {
+                let name = &self.doc.objects[object].name;
+                let size = [self.size[0] as f32, self.size[1] as f32];
+                analysis.extend(osculating_overlay(name, &o, at, size));
+            }
+        }
         if !lines.is_empty() {
             frame.draw_lines3d(&lines)?;
+        }
+        if self.options.badges {
+            let view = self.view();
+            analysis.extend(badge_overlay(&self.doc, |p| view.project(p)));
+        }
+        if let Some(map) = self.options.analysis {
+            analysis.extend(legend(
+                map,
+                self.map_range,
+                self.size[0] as f32,
+                self.size[1] as f32,
+            ));
         }
         if let Some(t) = self.status_since
             && t.elapsed().as_secs_f64() > 6.0
@@ -407,8 +459,20 @@ impl Session {
                 }
                 r.describe(&self.doc)
             }
+            Mode::WeightEntry { handle, text } => format!(
+                "weight of {}: [{text}]  (type a positive number, Enter sets it, Esc cancels)",
+                self.handle_name(*handle)
+            ),
+            Mode::Weight { handle, .. } => format!(
+                "weight of {}: {}  (drag up/down, release to keep)",
+                self.handle_name(*handle),
+                self.doc.weight_of(*handle).unwrap_or(1.0)
+            ),
             _ => self.status.clone(),
         };
+        if !analysis.is_empty() {
+            frame.draw_overlay(&analysis)?;
+        }
         if hud {
             let hud = self.hud.build(
                 self.size[0] as f32,
@@ -481,6 +545,23 @@ impl Session {
                 self.mode = Mode::Transform { target, t };
                 self.update_transform();
             }
+            Mode::Weight {
+                handle,
+                start_y,
+                from,
+            } => {
+                // A factor of 2 per 80 pixels, kept within [1e-4, 1e4].
+                let w = (from * 2f64.powf((start_y - y) / 80.0)).clamp(1e-4, 1e4);
+                if let Ok(edit) = self.doc.set_weight(handle, w) {
+                    self.queue(edit);
+                }
+                self.mode = Mode::Weight {
+                    handle,
+                    start_y,
+                    from,
+                };
+            }
+            m @ Mode::WeightEntry { .. } => self.mode = m,
             Mode::Refine(mut r) => {
                 r.aim(&self.doc, &self.view(), self.cursor);
                 self.mode = Mode::Refine(r);
@@ -514,6 +595,25 @@ impl Session {
             (Mode::Idle, MouseButton::Left, true) if !self.mods.shift => {
                 let cursor = self.cursor;
                 match pick(self.projected(), cursor, PICK_RADIUS) {
+                    Some(p) if self.mods.alt => {
+                        self.select(p.handle);
+                        match self.doc.weight_of(p.handle) {
+                            Some(from) => {
+                                self.undo.begin("weight");
+                                Mode::Weight {
+                                    handle: p.handle,
+                                    start_y: self.cursor.1,
+                                    from,
+                                }
+                            }
+                            None => {
+                                let why =
+                                    self.doc.set_weight(p.handle, 1.0).err().unwrap_or_default();
+                                self.set_status(why);
+                                Mode::Idle
+                            }
+                        }
+                    }
                     Some(p) => {
                         self.select(p.handle);
                         let mut drag = Drag::new(p.world);
@@ -540,8 +640,20 @@ impl Session {
             (Mode::Drag { .. }, MouseButton::Left, false) => {
                 self.undo.end();
                 self.refresh_bounds();
+                self.refit_map();
                 Mode::Idle
             }
+            (Mode::Weight { handle, .. }, MouseButton::Left, false) => {
+                self.undo.end();
+                self.refit_map();
+                let w = self.doc.weight_of(handle).unwrap_or(1.0);
+                self.set_status(format!(
+                    "weight of {} is {w} (Ctrl+Z undoes)",
+                    self.handle_name(handle)
+                ));
+                Mode::Idle
+            }
+            (m @ (Mode::Weight { .. } | Mode::WeightEntry { .. }), _, _) => m,
             (Mode::Orbit { moved: false }, MouseButton::Left, false) => {
                 // A click on empty space (no drag) clears the selection.
                 self.selected = None;
@@ -625,6 +737,9 @@ impl Session {
         if let Mode::Refine(_) = self.mode {
             return self.refine_key(key);
         }
+        if let Mode::WeightEntry { .. } = self.mode {
+            return self.weight_key(key);
+        }
         match (key, ctrl) {
             (Key::Char('z'), true) if self.mods.shift => self.redo(),
             (Key::Char('z'), true) => self.undo(),
@@ -668,6 +783,25 @@ impl Session {
                 self.set_status(what);
             }
             (Key::Char('l'), false) => self.options.local_curves = !self.options.local_curves,
+            (Key::Char('w'), false) if self.mods.shift => self.start_weight_entry(),
+            (Key::Char('j'), false) => {
+                self.options.badges = !self.options.badges;
+                self.set_status(if self.options.badges {
+                    "continuity badges at junctions and multiple knots"
+                } else {
+                    "continuity badges off"
+                });
+            }
+            (Key::Char('o'), false) => {
+                self.osculating = !self.osculating;
+                self.set_status(if self.osculating {
+                    "osculating circle, curvature and torsion at the cursor"
+                } else {
+                    "osculating circle off"
+                });
+            }
+            (Key::Char('m'), false) => self.cycle_map(),
+            (Key::Char('b'), false) => self.convert_to_bspline(),
             (Key::Char('w'), false) => {
                 self.options.wire = match self.options.wire {
                     Wire::Off => Wire::Isolines(8),
@@ -774,6 +908,12 @@ impl Session {
                 let mut by = [0, 0];
                 by[dir] = 1;
                 SurfaceEdit::ElevateDegree { by }.into_object()
+            }
+            ModelRef::CatmullRom(_) | ModelRef::BezierSpline(_) => {
+                let ty = model.type_name();
+                return self.set_status(format!(
+                    "a {ty} keeps its segments: B converts it to a bspline_curve first"
+                ));
             }
             _ => return self.set_status("ERBS objects are not refined by degree elevation"),
         };
@@ -974,6 +1114,157 @@ impl Session {
         // Undo edits are applied next frame; the bounds follow then.
         self.apply_pending();
         self.refresh_bounds();
+    }
+
+    /// Shows the next surface analysis map (M): Gaussian, mean, max and min principal
+    /// curvature, zebra stripes, off. Curvature maps re-sample surfaces with second partials.
+    pub fn cycle_map(&mut self) {
+        self.set_map(SurfaceMap::next(self.options.analysis));
+    }
+
+    /// Shows `map` (or none) on every surface.
+    pub fn set_map(&mut self, map: Option<SurfaceMap>) {
+        self.apply_pending();
+        if map.is_some_and(|m| m.needs_curvature())
+            && self.options.analysis.is_none_or(|m| !m.needs_curvature())
+            && let Err(e) = check_scene(
+                &self.doc.to_scene(),
+                SampleMode::Analysis,
+                DRAW_USES,
+                &MemoryBudget::machine_default(),
+            )
+        {
+            return self.set_status(format!("no curvature map: {e}"));
+        }
+        self.options.analysis = map;
+        for i in self.doc.set_analysis(map) {
+            let [rows, cols] = self.doc.objects[i].sampled.grid().dims;
+            self.gpu
+                .note_samples(i, &DirtyRegion::surface(0..rows, 0..cols));
+        }
+        self.refit_map();
+        match map {
+            Some(m) => self.set_status(format!("analysis: {} (M: next map)", m.title())),
+            None => self.set_status("analysis maps off"),
+        }
+    }
+
+    /// Refits the colour scale to the current surfaces.
+    fn refit_map(&mut self) {
+        if let Some(map) = self.options.analysis.filter(|m| m.needs_curvature()) {
+            self.map_range = self.doc.map_range(map);
+        }
+    }
+
+    /// B: the focused Catmull–Rom or Bézier spline becomes its equivalent bspline_curve (one
+    /// undo step).
+    fn convert_to_bspline(&mut self) {
+        let Some(object) = self.focused_object() else {
+            return self.set_status(
+                "select a Catmull–Rom or Bézier spline first (click one of its points)",
+            );
+        };
+        match self.doc.to_bspline(object) {
+            Ok(edit) => {
+                let name = self.doc.objects[object].name.clone();
+                self.structural("convert to B-spline", edit);
+                self.set_status(format!("{name} is now a bspline_curve (Ctrl+Z undoes)"));
+            }
+            Err(e) => self.set_status(e),
+        }
+    }
+
+    /// Shift+W: type a weight for the selected control point.
+    fn start_weight_entry(&mut self) {
+        let Some(handle) = self.selected else {
+            return self.set_status("select a control point first, then Shift+W types its weight");
+        };
+        if let Err(e) = self.doc.set_weight(handle, 1.0) {
+            return self.set_status(e);
+        }
+        self.mode = Mode::WeightEntry {
+            handle,
+            text: String::new(),
+        };
+    }
+
+    fn weight_key(&mut self, key: Key) {
+        let Mode::WeightEntry { handle, text } = &mut self.mode else {
+            return;
+        };
+        let handle = *handle;
+        match key {
+            Key::Char(c @ ('0'..='9' | '.' | 'e' | '-' | '+')) => text.push(c),
+            Key::Backspace => {
+                text.pop();
+            }
+            Key::Enter => {
+                let typed = text.parse::<f64>();
+                self.mode = Mode::Idle;
+                let edit = typed
+                    .map_err(|_| "not a number".to_string())
+                    .and_then(|w| self.doc.set_weight(handle, w));
+                match edit {
+                    Ok(edit) => {
+                        self.undo.begin("weight");
+                        self.queue(edit);
+                        self.undo.end();
+                        self.apply_pending();
+                        self.refit_map();
+                        let w = self.doc.weight_of(handle).unwrap_or(1.0);
+                        self.set_status(format!(
+                            "weight of {} is {w} (Ctrl+Z undoes)",
+                            self.handle_name(handle)
+                        ));
+                    }
+                    Err(e) => self.set_status(format!("weight not set: {e}")),
+                }
+            }
+            Key::Escape => {
+                self.mode = Mode::Idle;
+                self.set_status("weight entry cancelled");
+            }
+            _ => {}
+        }
+    }
+
+    /// "name point 3" for messages.
+    fn handle_name(&self, h: Handle) -> String {
+        let name = &self.doc.objects[h.object()].name;
+        match h {
+            Handle::Point { point, .. } => format!("{name} point {}", index_text(point)),
+            Handle::LocalPoint { local, point, .. } => format!(
+                "{name} local {} point {}",
+                path_text(local),
+                index_text(point)
+            ),
+        }
+    }
+
+    /// The curve sample nearest the cursor (within 40 pixels) and its osculating circle.
+    fn osculating_at_cursor(&self) -> Option<(usize, Osculating)> {
+        let view = self.view();
+        let mut best: Option<(f64, usize, f64)> = None;
+        for (i, o) in self.doc.objects.iter().enumerate() {
+            if o.sampled.model().is_surface() {
+                continue;
+            }
+            let g = o.sampled.grid();
+            let params = o.sampled.params()[0];
+            let step = (g.dims[0] / 2000).max(1);
+            for j in (0..g.dims[0]).step_by(step) {
+                let Some((x, y)) = view.project(g.position(j, 0)) else {
+                    continue;
+                };
+                let d = (x - self.cursor.0).hypot(y - self.cursor.1);
+                if d <= 40.0 && best.is_none_or(|(b, _, _)| d < b) {
+                    best = Some((d, i, params[j]));
+                }
+            }
+        }
+        let (_, i, t) = best?;
+        let curve = CurveEval::of(self.doc.objects[i].sampled.model())?;
+        Osculating::at(&curve, t).map(|o| (i, o))
     }
 
     pub fn frame_all(&mut self) {

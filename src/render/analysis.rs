@@ -1,0 +1,386 @@
+//! Curve analysis shown in the viewer and `prespline render`: what a curve is at its joins
+//! (continuity badges) and the osculating circle with curvature and torsion at a parameter.
+//! Pure f64 computations from the model; drawing them is the overlays' business.
+
+use super::document::Document;
+use crate::geom::continuity::{JoinClass, classify};
+use crate::geom::differential::frenet_frame;
+use crate::geom::{BSplineCurve, ErbsCurve};
+use crate::gpu::font::{push_rect, push_text, text_size};
+use crate::gpu::{LineVertex, OverlayVertex};
+use crate::model::{Model, ModelRef};
+use glam::DVec3;
+
+/// A curve of any kind, evaluable with one-sided limits.
+pub enum CurveEval<'a> {
+    /// B-spline, Bézier and NURBS curves, and the Bézier chains of Catmull–Rom and Bézier
+    /// splines (with the chain's segment boundaries).
+    BSpline {
+        curve: std::borrow::Cow<'a, BSplineCurve>,
+        junctions: Option<Vec<f64>>,
+    },
+    Erbs(&'a ErbsCurve),
+}
+
+impl<'a> CurveEval<'a> {
+    /// The curve of a curve model; `None` for surfaces.
+    pub fn of(model: ModelRef<'a>) -> Option<Self> {
+        use std::borrow::Cow;
+        Some(match model {
+            ModelRef::Curve(c) => CurveEval::BSpline {
+                curve: Cow::Borrowed(c.curve()),
+                junctions: None,
+            },
+            ModelRef::ErbsCurve(c) => CurveEval::Erbs(c.curve()),
+            ModelRef::CatmullRom(_) | ModelRef::BezierSpline(_) => {
+                let junctions = match model {
+                    ModelRef::CatmullRom(c) => c.spline().breakpoints(),
+                    ModelRef::BezierSpline(c) => c.spline().knots().to_vec(),
+                    _ => Vec::new(),
+                };
+                let Some(Model::Curve(chain)) = model.to_bspline_curve() else {
+                    return None;
+                };
+                CurveEval::BSpline {
+                    curve: Cow::Owned(chain.curve().clone()),
+                    junctions: Some(junctions),
+                }
+            }
+            ModelRef::Surface(_) | ModelRef::ErbsSurface(_) => return None,
+        })
+    }
+
+    pub fn domain(&self) -> (f64, f64) {
+        match self {
+            CurveEval::BSpline { curve, .. } => curve.domain(),
+            CurveEval::Erbs(c) => c.domain(),
+        }
+    }
+
+    /// c, c', …, c^(n) at t (the right limit at a knot).
+    pub fn derivatives(&self, t: f64, n: usize) -> Vec<DVec3> {
+        match self {
+            CurveEval::BSpline { curve, .. } => curve.derivatives(t, n),
+            CurveEval::Erbs(c) => c.derivatives(t, n),
+        }
+    }
+
+    /// The parameters a badge goes to: the segment junctions of Catmull–Rom and Bézier
+    /// splines, the interior knots of multiplicity > 1 of B-spline curves (where their
+    /// guaranteed continuity drops below C^(d−1)); none for ERBS curves (C^∞ blends).
+    pub fn join_params(&self) -> Vec<f64> {
+        match self {
+            CurveEval::BSpline {
+                junctions: Some(j), ..
+            } => j[1..j.len() - 1].to_vec(),
+            CurveEval::BSpline { curve, .. } => {
+                let (a, b) = curve.domain();
+                curve
+                    .knots()
+                    .breakpoints(a, b)
+                    .into_iter()
+                    .filter(|&t| t > a && t < b && curve.knots().multiplicity(t) > 1)
+                    .collect()
+            }
+            CurveEval::Erbs(_) => Vec::new(),
+        }
+    }
+
+    /// Left and right limits of c, c', c'' at t.
+    pub fn limits(&self, t: f64) -> Option<([DVec3; 3], [DVec3; 3])> {
+        let CurveEval::BSpline { curve, .. } = self else {
+            return None;
+        };
+        let arr = |v: Vec<DVec3>| [v[0], v[1], v[2]];
+        Some((
+            arr(curve.one_sided_derivatives(t, 2, true)),
+            arr(curve.one_sided_derivatives(t, 2, false)),
+        ))
+    }
+}
+
+/// One continuity badge.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Join {
+    pub t: f64,
+    pub position: DVec3,
+    pub class: JoinClass,
+}
+
+/// The badges of one curve model (none for surfaces and ERBS curves).
+pub fn curve_joins(model: ModelRef<'_>) -> Vec<Join> {
+    let Some(curve) = CurveEval::of(model) else {
+        return Vec::new();
+    };
+    let params = curve.join_params();
+    if params.is_empty() {
+        return Vec::new();
+    }
+    let size = extent(&curve);
+    params
+        .into_iter()
+        .filter_map(|t| {
+            let (l, r) = curve.limits(t)?;
+            Some(Join {
+                t,
+                position: r[0],
+                class: classify(l, r, size),
+            })
+        })
+        .collect()
+}
+
+/// A length scale of the curve: the largest coordinate magnitude of a coarse sampling.
+fn extent(curve: &CurveEval<'_>) -> f64 {
+    let (a, b) = curve.domain();
+    (0..=16)
+        .map(|k| curve.derivatives(a + (b - a) * k as f64 / 16.0, 0)[0])
+        .fold(1e-300f64, |m, p| m.max(p.abs().max_element()))
+}
+
+/// The osculating circle and the Frenet quantities at one curve point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Osculating {
+    pub t: f64,
+    pub point: DVec3,
+    pub tangent: DVec3,
+    pub normal: DVec3,
+    pub binormal: DVec3,
+    /// κ = |c' × c''| / |c'|³; the circle's radius is 1/κ.
+    pub curvature: f64,
+    /// τ = (c' × c'')·c''' / |c' × c''|².
+    pub torsion: f64,
+}
+
+impl Osculating {
+    /// At parameter t of `curve`; `None` where there is no osculating plane (straight pieces,
+    /// inflections, a vanishing derivative).
+    pub fn at(curve: &CurveEval<'_>, t: f64) -> Option<Self> {
+        let d = curve.derivatives(t, 3);
+        let f = frenet_frame(d[1], d[2], d[3])?;
+        Some(Self {
+            t,
+            point: d[0],
+            tangent: f.tangent,
+            normal: f.normal,
+            binormal: f.binormal,
+            curvature: f.curvature,
+            torsion: f.torsion,
+        })
+    }
+
+    pub fn radius(&self) -> f64 {
+        1.0 / self.curvature
+    }
+
+    pub fn center(&self) -> DVec3 {
+        self.point + self.normal * self.radius()
+    }
+
+    /// `segments` + 1 points around the circle in the osculating plane, starting at the curve
+    /// point.
+    pub fn circle(&self, segments: usize) -> Vec<DVec3> {
+        let (c, r) = (self.center(), self.radius());
+        (0..=segments)
+            .map(|k| {
+                let a = std::f64::consts::TAU * k as f64 / segments as f64;
+                c - self.normal * (r * a.cos()) + self.tangent * (r * a.sin())
+            })
+            .collect()
+    }
+
+    /// "t 1.250  curvature 0.8123  radius 1.231  torsion -0.04120" (plain ASCII).
+    pub fn describe(&self) -> String {
+        format!(
+            "t {}  curvature {}  radius {}  torsion {}",
+            short(self.t),
+            short(self.curvature),
+            short(self.radius()),
+            short(self.torsion)
+        )
+    }
+}
+
+/// Four significant digits, plain ASCII (the overlay font).
+pub fn short(x: f64) -> String {
+    if x == 0.0 || (1e-3..1e5).contains(&x.abs()) {
+        let digits = (3 - x.abs().log10().floor() as i32).clamp(0, 6) as usize;
+        format!("{x:.digits$}")
+    } else {
+        format!("{x:.3e}")
+    }
+}
+
+/// The parameter of the sample of a curve object nearest to `target` among `samples` (the
+/// canonical grid), for aiming the osculating circle with the cursor.
+pub fn nearest_sample(
+    params: &[f64],
+    positions: impl Iterator<Item = DVec3>,
+    target: DVec3,
+) -> f64 {
+    let mut best = (f64::INFINITY, params[0]);
+    for (t, p) in params.iter().zip(positions) {
+        let d = (p - target).length_squared();
+        if d < best.0 {
+            best = (d, *t);
+        }
+    }
+    best.1
+}
+
+/// Badge colours (sRGB): C2 green, C1 / G2 teal, G1 yellow, G0 orange, a gap red.
+pub fn badge_color(class: JoinClass) -> [u8; 4] {
+    match class.label() {
+        "C2" => [70, 200, 110, 255],
+        "C1 G2" | "G2" => [60, 190, 200, 255],
+        "C1" => [120, 170, 240, 255],
+        "G1" => [235, 200, 60, 255],
+        "G0" => [240, 140, 50, 255],
+        _ => [235, 70, 60, 255],
+    }
+}
+
+/// Every continuity badge of the document as overlay quads: a dot on the join and its label
+/// beside it, placed by `project` (world → pixel, `None` behind the camera).
+pub fn badge_overlay(
+    doc: &Document,
+    project: impl Fn(DVec3) -> Option<(f64, f64)>,
+) -> Vec<OverlayVertex> {
+    let mut v = Vec::new();
+    let scale = 2.0;
+    for o in &doc.objects {
+        for j in curve_joins(o.sampled.model()) {
+            let Some((x, y)) = project(j.position) else {
+                continue;
+            };
+            let (x, y) = (x as f32, y as f32);
+            let color = badge_color(j.class);
+            push_rect(&mut v, x - 4.0, y - 4.0, 8.0, 8.0, [10, 12, 16, 255]);
+            push_rect(&mut v, x - 3.0, y - 3.0, 6.0, 6.0, color);
+            let label = j.class.label();
+            let [w, h] = text_size(label, scale);
+            let (bx, by) = (x + 8.0, y - h - 10.0);
+            push_rect(&mut v, bx, by, w + 8.0, h + 6.0, [10, 12, 16, 215]);
+            push_rect(&mut v, bx, by + h + 4.0, w + 8.0, 2.0, color);
+            push_text(&mut v, label, bx + 4.0, by + 3.0, scale, color);
+        }
+    }
+    v
+}
+
+/// The osculating circle (magenta), the radius to its centre and the tangent (thin), as lines.
+pub fn osculating_lines(o: &Osculating) -> Vec<LineVertex> {
+    let mut out = Vec::new();
+    let mut line = |a: DVec3, b: DVec3, color: [u8; 4]| {
+        out.push(LineVertex {
+            pos: a.as_vec3().to_array(),
+            color,
+        });
+        out.push(LineVertex {
+            pos: b.as_vec3().to_array(),
+            color,
+        });
+    };
+    let ring = o.circle(96);
+    for w in ring.windows(2) {
+        line(w[0], w[1], [230, 70, 230, 255]);
+    }
+    line(o.point, o.center(), [170, 90, 170, 255]);
+    let r = o.radius();
+    line(
+        o.center() - o.tangent * (0.04 * r),
+        o.center() + o.tangent * (0.04 * r),
+        [230, 70, 230, 255],
+    );
+    line(
+        o.center() - o.normal * (0.04 * r),
+        o.center() + o.normal * (0.04 * r),
+        [230, 70, 230, 255],
+    );
+    out
+}
+
+/// The osculating readout (curvature, radius, torsion) as a label next to the curve point,
+/// kept inside a `size` image.
+pub fn osculating_overlay(
+    name: &str,
+    o: &Osculating,
+    at: (f64, f64),
+    size: [f32; 2],
+) -> Vec<OverlayVertex> {
+    let mut v = Vec::new();
+    let scale = 2.0;
+    let text = format!(
+        "{name}  t = {}\ncurvature {}  radius {}\ntorsion {}",
+        short(o.t),
+        short(o.curvature),
+        short(o.radius()),
+        short(o.torsion)
+    );
+    let [w, h] = text_size(&text, scale);
+    let (px, py) = (at.0 as f32, at.1 as f32);
+    let x = if px + 14.0 + w + 10.0 <= size[0] {
+        px + 14.0
+    } else {
+        (px - 14.0 - w - 10.0).max(0.0)
+    };
+    let y = (py + 10.0).min(size[1] - h - 8.0).max(0.0);
+    push_rect(&mut v, x, y, w + 10.0, h + 8.0, [10, 12, 16, 215]);
+    push_text(&mut v, &text, x + 5.0, y + 4.0, scale, [240, 150, 240, 255]);
+    v
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::parse_scene;
+
+    fn model(text: &str) -> Model {
+        parse_scene(text).unwrap().objects.remove(0).model
+    }
+
+    #[test]
+    fn badges_on_constructed_junctions() {
+        // A cubic B-spline whose interior knots have multiplicity 1, 2 and 3: C2, C1, C0.
+        let m = model(
+            r#"{"objects": [{"name": "c", "type": "bspline_curve", "degree": 3,
+            "knots": [0,0,0,0, 1, 2,2, 3,3,3, 4,4,4,4],
+            "points": [[0,0,0],[1,2,0],[2,3,1],[3,1,0],[4,2,2],[5,0,1],[6,1,0],[7,3,1],[8,0,0],[9,1,1]],
+            "samples": 50}]}"#,
+        );
+        let j = curve_joins(m.as_ref());
+        let labels: Vec<(f64, &str)> = j.iter().map(|j| (j.t, j.class.label())).collect();
+        assert_eq!(labels, vec![(2.0, "C1"), (3.0, "G0")]);
+        // A C1 cubic Bézier spline on unequal intervals is C1 (and not G2 by accident).
+        let text = std::fs::read_to_string(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/bezier_spline.json"),
+        )
+        .unwrap();
+        let scene = parse_scene(&text).unwrap();
+        let expect = ["C1", "C2", "G1"];
+        for (o, want) in scene.objects.iter().zip(expect) {
+            for j in curve_joins(o.model.as_ref()) {
+                assert_eq!(j.class.label(), want, "{} at {}", o.name, j.t);
+            }
+        }
+    }
+
+    #[test]
+    fn osculating_circle_of_a_circle_is_the_circle() {
+        let w = std::f64::consts::FRAC_1_SQRT_2;
+        let m = model(&format!(
+            r#"{{"objects": [{{"name": "q", "type": "bezier_curve", "points": [[2,0,0],[2,2,0],[0,2,0]],
+            "weights": [1, {w}, 1], "samples": 9}}]}}"#
+        ));
+        let c = CurveEval::of(m.as_ref()).unwrap();
+        for t in [0.1, 0.5, 0.9] {
+            let o = Osculating::at(&c, t).unwrap();
+            assert!((o.radius() - 2.0).abs() < 1e-12, "{}", o.radius());
+            assert!(o.center().length() < 1e-12);
+            assert!(o.torsion.abs() < 1e-12);
+            for p in o.circle(12) {
+                assert!((p.length() - 2.0).abs() < 1e-12);
+            }
+        }
+    }
+}

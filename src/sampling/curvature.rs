@@ -1,0 +1,208 @@
+//! Gaussian and mean curvature of surface samples, kept with the samples they come from so a
+//! control point edit updates only the touched samples of a curvature map.
+//!
+//! From the first and second fundamental forms (E, F, G from Su, Sv; L, M, N the second
+//! partials along the unit normal): K = (LN − M²)/(EG − F²), H = (EN − 2FM + GL)/(2(EG − F²)),
+//! with the normal Su × Sv (a sphere with outward normals has H = −1/r). Principal curvatures
+//! are κ = H ± √(H² − K).
+
+use super::axis::HermiteTable;
+use super::grid::SampleGrid;
+use super::normals::NormalSource;
+use super::shading::{LANES, unit_normals};
+use crate::geom::surface::regular_normal;
+use glam::DVec3;
+use std::ops::Range;
+
+/// [K, H] from Su, Sv, Suu, Suv, Svv and the unit normal n.
+#[inline]
+pub fn fundamental_forms(p: &[DVec3; 5], n: DVec3) -> [f64; 2] {
+    let [su, sv, suu, suv, svv] = *p;
+    let (e, f, g) = (su.dot(su), su.dot(sv), sv.dot(sv));
+    let (l, m, nn) = (suu.dot(n), suv.dot(n), svv.dot(n));
+    let det = e * g - f * f;
+    [
+        (l * nn - m * m) / det,
+        (e * nn - 2.0 * f * m + g * l) / (2.0 * det),
+    ]
+}
+
+/// Principal curvatures [κ_max, κ_min] from [K, H] (the discriminant clamped at 0 against
+/// rounding at umbilics).
+#[inline]
+pub fn principal([k, h]: [f64; 2]) -> [f64; 2] {
+    let r = (h * h - k).max(0.0).sqrt();
+    [h + r, h - r]
+}
+
+/// Storage slots of Su, Sv, Suu, Suv, Svv.
+fn slots(grid: &SampleGrid) -> Option<[usize; 5]> {
+    let p = &grid.partials;
+    Some([
+        p.index(1, 0)?,
+        p.index(0, 1)?,
+        p.index(2, 0)?,
+        p.index(1, 1)?,
+        p.index(0, 2)?,
+    ])
+}
+
+/// Recomputes [K, H] of the samples in `rows × cols` (after their partials and normals).
+pub fn update(
+    grid: &mut SampleGrid,
+    rows: Range<usize>,
+    cols: Range<usize>,
+    params: [&[f64]; 2],
+    model: &impl NormalSource,
+) {
+    let Some(idx) = slots(grid) else { return };
+    let (Some(curv), Some(normals)) = (grid.curvatures.as_mut(), grid.normals.as_ref()) else {
+        return;
+    };
+    let stride = grid.partials.len();
+    let mv = grid.dims[1];
+    let mut degenerate = Vec::new();
+    for i in rows {
+        for j in cols.clone() {
+            let s = &grid.data[(i * mv + j) * stride..(i * mv + j + 1) * stride];
+            let p = idx.map(|k| s[k]);
+            if regular_normal(p[0], p[1]).is_some() {
+                curv[i * mv + j] = fundamental_forms(&p, normals[i * mv + j]);
+            } else {
+                degenerate.push((i, j));
+            }
+        }
+    }
+    resolve_degenerate(grid, &degenerate, params, model);
+}
+
+/// [K, H] where the sampled Su × Sv vanishes: the model's limit next to the sample, or NaN
+/// (drawn as undefined) when the model cannot give one.
+pub(crate) fn resolve_degenerate(
+    grid: &mut SampleGrid,
+    samples: &[(usize, usize)],
+    params: [&[f64]; 2],
+    model: &impl NormalSource,
+) {
+    let mv = grid.dims[1];
+    let Some(curv) = grid.curvatures.as_mut() else {
+        return;
+    };
+    for &(i, j) in samples {
+        curv[i * mv + j] = model
+            .curvature_near(params[0][i], params[1][j])
+            .unwrap_or([f64::NAN; 2]);
+    }
+}
+
+/// Moves control point (k, l) of a polynomial surface on a `Curvature` grid by `delta`: the six
+/// partials of the samples in I_k × I_l gain M_u[a][k]·M_v[b][l]·Δ (the generic update's
+/// products in its order), and their normals and [K, H] are recomputed in the same pass.
+/// Samples with a degenerate Su × Sv are appended to `degenerate` (normal and curvature left
+/// for the caller's fallback). Returns the touched rectangle.
+pub(crate) fn translate(
+    tables: [&HermiteTable; 2],
+    point: [usize; 2],
+    delta: DVec3,
+    grid: &mut SampleGrid,
+    degenerate: &mut Vec<(usize, usize)>,
+) -> (Range<usize>, Range<usize>) {
+    let [tu, tv] = tables;
+    let [k, l] = point;
+    let (rows, cols) = (tu.range(k), tv.range(l));
+    // Basis value and first and second derivatives of column k (resp. l) at each sample.
+    let coeffs = |t: &HermiteTable, c: usize, j: usize| {
+        let col = c - t.first(j);
+        [0, 1, 2].map(|r| t.row(j, r).map_or(0.0, |row| row[col]))
+    };
+    let cv: Vec<[f64; 3]> = cols.clone().map(|j| coeffs(tv, l, j)).collect();
+    let mv = grid.dims[1];
+    let (Some(normals), Some(curv)) = (grid.normals.as_mut(), grid.curvatures.as_mut()) else {
+        return (rows, cols);
+    };
+    let d = delta.to_array();
+    for i in rows.clone() {
+        let cu = coeffs(tu, k, i);
+        let (a, b) = (i * mv + cols.start, i * mv + cols.end);
+        let data = grid.data[a * 6..b * 6].as_chunks_mut::<6>().0;
+        for (s, cv) in data.iter_mut().zip(&cv) {
+            // Δ·(M_u[a] M_v[b]) per partial, component by component: 18 independent
+            // multiply-adds the compiler can pair.
+            let c = [
+                cu[0] * cv[0],
+                cu[1] * cv[0],
+                cu[0] * cv[1],
+                cu[2] * cv[0],
+                cu[1] * cv[1],
+                cu[0] * cv[2],
+            ];
+            for (p, &c) in s.iter_mut().zip(&c) {
+                let v: &mut [f64; 3] = p.as_mut();
+                for x in 0..3 {
+                    v[x] += d[x] * c;
+                }
+            }
+        }
+        // The row segment is in L1 now: normals and [K, H] LANES samples at a time.
+        shape_of(data, &mut normals[a..b], &mut curv[a..b], |jj| {
+            degenerate.push((i, cols.start + jj))
+        });
+    }
+    (rows, cols)
+}
+
+/// Unit normals (exactly `regular_normal`'s) and [K, H] of `data`'s samples (S, Su, Sv, Suu,
+/// Suv, Svv each), LANES at a time so that the square roots and divisions vectorise; reports
+/// the index of every sample whose Su × Sv is degenerate (its outputs are left as they were).
+pub(crate) fn shape_of(
+    data: &[[DVec3; 6]],
+    normals: &mut [DVec3],
+    curv: &mut [[f64; 2]],
+    mut degenerate: impl FnMut(usize),
+) {
+    const L: usize = LANES;
+    let (data4, rest) = data.as_chunks::<L>();
+    let (normals4, normals_rest) = normals.as_chunks_mut::<L>();
+    let (curv4, curv_rest) = curv.as_chunks_mut::<L>();
+    for (g, ((d, n), c)) in data4.iter().zip(normals4).zip(curv4).enumerate() {
+        let part = |p: usize| [0, 1, 2].map(|x| std::array::from_fn::<f64, L, _>(|l| d[l][p][x]));
+        let (u, v) = (part(1), part(2));
+        let (nn, ok) = unit_normals::<L>(u, v);
+        let dot = |a: &[[f64; L]; 3], b: &[[f64; L]; 3]| -> [f64; L] {
+            std::array::from_fn(|l| a[0][l] * b[0][l] + a[1][l] * b[1][l] + a[2][l] * b[2][l])
+        };
+        let (e, f, gg) = (dot(&u, &u), dot(&u, &v), dot(&v, &v));
+        let (ll, m, n2) = (dot(&part(3), &nn), dot(&part(4), &nn), dot(&part(5), &nn));
+        // Through memory, so that the stores below do not pull the lanes apart (see
+        // shading::normals_of).
+        let stage: [[f64; L]; 6] = std::hint::black_box([
+            nn[0],
+            nn[1],
+            nn[2],
+            std::array::from_fn(|l| (ll[l] * n2[l] - m[l] * m[l]) / (e[l] * gg[l] - f[l] * f[l])),
+            std::array::from_fn(|l| {
+                (e[l] * n2[l] - 2.0 * f[l] * m[l] + gg[l] * ll[l])
+                    / (2.0 * (e[l] * gg[l] - f[l] * f[l]))
+            }),
+            ok,
+        ]);
+        for l in 0..L {
+            if stage[5][l] == 0.0 {
+                degenerate(g * L + l);
+                continue;
+            }
+            n[l] = DVec3::new(stage[0][l], stage[1][l], stage[2][l]);
+            c[l] = [stage[3][l], stage[4][l]];
+        }
+    }
+    let base = data4.len() * L;
+    for (jj, ((s, n), c)) in rest.iter().zip(normals_rest).zip(curv_rest).enumerate() {
+        match regular_normal(s[1], s[2]) {
+            Some(v) => {
+                *n = v;
+                *c = fundamental_forms(&[s[1], s[2], s[3], s[4], s[5]], v);
+            }
+            None => degenerate(base + jj),
+        }
+    }
+}

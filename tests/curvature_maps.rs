@@ -1,0 +1,228 @@
+//! Surface curvature maps against analytic values (exact NURBS sphere: K = 1/r², |H| = 1/r;
+//! cylinder: K = 0, |H| = 1/(2r)), and the analysis delta path (six partials, normals, K and H)
+//! against exact re-evaluation after long random edit sequences.
+
+use glam::DVec3;
+use prespline::geom::TensorSurface;
+use prespline::model::{KindEdit, Model, PointEdit, SplineForm, SurfaceEdit, SurfaceModel};
+use prespline::sampling::curvature::principal;
+use prespline::sampling::exact::exact_grid;
+use prespline::sampling::{PartialSet, SampleMode, SampledObject};
+
+mod common;
+use common::Rng;
+
+const W: f64 = std::f64::consts::FRAC_1_SQRT_2;
+
+/// The full circle of radius 1 as a degree-2 NURBS: 9 points on the square, weights 1, √2/2.
+fn circle() -> (Vec<f64>, Vec<(f64, f64)>, Vec<f64>) {
+    let knots = vec![
+        0.0, 0.0, 0.0, 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1.0, 1.0, 1.0,
+    ];
+    let pts = vec![
+        (1.0, 0.0),
+        (1.0, 1.0),
+        (0.0, 1.0),
+        (-1.0, 1.0),
+        (-1.0, 0.0),
+        (-1.0, -1.0),
+        (0.0, -1.0),
+        (1.0, -1.0),
+        (1.0, 0.0),
+    ];
+    let w = (0..9).map(|i| if i % 2 == 1 { W } else { 1.0 }).collect();
+    (knots, pts, w)
+}
+
+/// Sphere of radius r: the circle swept along a half circle from the south to the north pole
+/// (rational biquadratic, 9 × 5 points, the poles are collapsed rows).
+fn sphere(r: f64, samples: [usize; 2]) -> Model {
+    let (ku, cu, wu) = circle();
+    let kv = vec![0.0, 0.0, 0.0, 0.5, 0.5, 1.0, 1.0, 1.0];
+    let profile = [(0.0, -1.0), (1.0, -1.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
+    let wv = [1.0, W, 1.0, W, 1.0];
+    let mut pts = Vec::new();
+    let mut w = Vec::new();
+    for (i, &(x, y)) in cu.iter().enumerate() {
+        for (j, &(rho, z)) in profile.iter().enumerate() {
+            pts.push(DVec3::new(x * rho, y * rho, z) * r);
+            w.push(wu[i] * wv[j]);
+        }
+    }
+    let s = TensorSurface::bspline([2, 2], [ku, kv], [9, 5], pts, Some(w)).unwrap();
+    Model::Surface(SurfaceModel::new(SplineForm::BSpline, s, samples).unwrap())
+}
+
+/// Cylinder of radius r and height h: the circle times a line.
+fn cylinder(r: f64, h: f64, samples: [usize; 2]) -> Model {
+    let (ku, cu, wu) = circle();
+    let mut pts = Vec::new();
+    let mut w = Vec::new();
+    for (i, &(x, y)) in cu.iter().enumerate() {
+        for z in [0.0, h] {
+            pts.push(DVec3::new(x * r, y * r, z));
+            w.push(wu[i]);
+        }
+    }
+    let kv = vec![0.0, 0.0, 1.0, 1.0];
+    let s = TensorSurface::bspline([2, 1], [ku, kv], [9, 2], pts, Some(w)).unwrap();
+    Model::Surface(SurfaceModel::new(SplineForm::BSpline, s, samples).unwrap())
+}
+
+fn curvatures(obj: &SampledObject) -> &[[f64; 2]] {
+    obj.grid()
+        .curvatures
+        .as_deref()
+        .expect("analysis grids keep curvatures")
+}
+
+/// Largest deviation of K and |H| from the expected values, and of the principal curvatures
+/// scaled down by `kappa_slack` (κ = H ± √(H² − K) takes a square root of rounding at
+/// umbilics: a sphere's 1e-16 becomes 1e-8), relative to the expected scale; NaN anywhere
+/// counts as infinitely wrong.
+fn worst(obj: &SampledObject, k: f64, h_abs: f64, kappa_abs: [f64; 2]) -> f64 {
+    let kappa_slack = 1e-5;
+    let scale = k.abs().max(h_abs).max(1e-300);
+    curvatures(obj)
+        .iter()
+        .map(|&kh| {
+            let [kmax, kmin] = principal(kh);
+            let mut kappa = [kmax.abs(), kmin.abs()];
+            kappa.sort_by(|a, b| b.total_cmp(a));
+            let e = [
+                (kh[0] - k).abs(),
+                (kh[1].abs() - h_abs).abs(),
+                (kappa[0] - kappa_abs[0]).abs() * kappa_slack,
+                (kappa[1] - kappa_abs[1]).abs() * kappa_slack,
+            ];
+            e.iter()
+                .map(|&x| if x.is_nan() { f64::INFINITY } else { x })
+                .fold(0.0, f64::max)
+                / scale
+        })
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn sphere_and_cylinder_have_their_analytic_curvatures() {
+    for r in [0.5, 1.0, 3.0] {
+        let obj = SampledObject::new(&sphere(r, [41, 23]), SampleMode::Analysis);
+        let e = worst(&obj, 1.0 / (r * r), 1.0 / r, [1.0 / r; 2]);
+        // Poles included: their samples take the curvature next to the collapsed row.
+        assert!(e < 1e-9, "sphere r = {r}: {e:e}");
+        let inner: f64 = {
+            let [mu, mv] = obj.grid().dims;
+            let c = curvatures(&obj);
+            (0..mu)
+                .flat_map(|i| (1..mv - 1).map(move |j| (i, j)))
+                .map(|(i, j)| {
+                    let [k, h] = c[i * mv + j];
+                    ((k * r * r - 1.0).abs()).max((h.abs() * r - 1.0).abs())
+                })
+                .fold(0.0, f64::max)
+        };
+        assert!(inner < 1e-12, "sphere r = {r} off the poles: {inner:e}");
+        let obj = SampledObject::new(&cylinder(r, 2.0, [33, 9]), SampleMode::Analysis);
+        let e = worst(&obj, 0.0, 0.5 / r, [1.0 / r, 0.0]);
+        assert!(e < 1e-13, "cylinder r = {r}: {e:e}");
+    }
+    // The sign of H follows the orientation Su × Sv: outward on this sphere, so H = −1/r.
+    let obj = SampledObject::new(&sphere(2.0, [9, 9]), SampleMode::Analysis);
+    assert!(curvatures(&obj)[4 * 9 + 4][1] < 0.0);
+}
+
+#[test]
+fn the_curvature_check_fails_on_a_wrong_radius() {
+    let obj = SampledObject::new(&sphere(1.0, [21, 11]), SampleMode::Analysis);
+    assert!(worst(&obj, 1.0, 1.0, [1.0; 2]) < 1e-9);
+    assert!(worst(&obj, 1.0 / (1.0 + 1e-7), 1.0, [1.0; 2]) > 5e-8);
+    assert!(worst(&obj, 1.0, 1.0 + 1e-7, [1.0; 2]) > 5e-8);
+    assert!(worst(&obj, 1.0, 1.0, [1.0, 0.99]) > 5e-8);
+    let cyl = SampledObject::new(&cylinder(1.0, 1.0, [9, 9]), SampleMode::Analysis);
+    assert!(worst(&cyl, 0.0, 0.5, [1.0, 0.0]) < 1e-12);
+    assert!(worst(&cyl, 0.0, 0.5, [1.0, 1e-4]) > 1e-10);
+    assert!(worst(&cyl, 1e-9, 0.5, [1.0, 0.0]) > 1e-10);
+}
+
+/// K and H from exact partials (the geometry layer's own evaluator and formula).
+fn exact_curvatures(model: &Model) -> Vec<[f64; 2]> {
+    let Model::Surface(m) = model else { panic!() };
+    let g = exact_grid(model.as_ref(), &PartialSet::Curvature);
+    let [mu, mv] = g.dims;
+    let (pu, pv) = (
+        prespline::geom::knots::uniform_params(0.0, 1.0, mu),
+        prespline::geom::knots::uniform_params(0.0, 1.0, mv),
+    );
+    let mut out = Vec::with_capacity(mu * mv);
+    for &u in &pu {
+        for &v in &pv {
+            let (k, h) = m.surface().curvatures(u, v).unwrap_or((f64::NAN, f64::NAN));
+            out.push([k, h]);
+        }
+    }
+    out
+}
+
+#[test]
+fn analysis_delta_path_equals_full_evaluation_after_random_edits() {
+    let mut rng = Rng::new(2024);
+    for (degree, rational) in [
+        ([3, 3], false),
+        ([2, 3], false),
+        ([1, 2], false),
+        ([3, 2], true),
+    ] {
+        let n = [7, 8];
+        let count = n[0] * n[1];
+        let pts = (0..count)
+            .map(|k| {
+                DVec3::new(
+                    (k / n[1]) as f64,
+                    (k % n[1]) as f64,
+                    rng.f32(-1.0, 1.0) as f64,
+                )
+            })
+            .collect();
+        let weights = rational.then(|| (0..count).map(|_| rng.f32(0.5, 2.0) as f64).collect());
+        let knots = [0, 1].map(|d| {
+            prespline::geom::KnotVector::clamped_uniform(degree[d], n[d], 0.0, 1.0).into_vec()
+        });
+        let s = TensorSurface::bspline(degree, knots, n, pts, weights).unwrap();
+        let model = Model::Surface(SurfaceModel::new(SplineForm::BSpline, s, [37, 29]).unwrap());
+        let mut obj = SampledObject::new(&model, SampleMode::Analysis);
+        obj.set_rebuild_interval(None);
+        let mut reference = model.clone();
+        for _ in 0..2000 {
+            let point = [rng.range(0, n[0]), rng.range(0, n[1])];
+            let delta = DVec3::new(
+                rng.f32(-0.1, 0.1) as f64,
+                rng.f32(-0.1, 0.1) as f64,
+                rng.f32(-0.1, 0.1) as f64,
+            );
+            let e = SurfaceEdit::Point(PointEdit::Move { point, delta }).into_object();
+            obj.apply(&e).unwrap();
+            reference.apply(&e).unwrap();
+        }
+        let exact = exact_grid(reference.as_ref(), &PartialSet::Curvature);
+        let d = obj.grid().max_relative_difference(&exact);
+        assert!(d < 1e-12, "{degree:?} rational {rational}: partials {d:e}");
+        let want = exact_curvatures(&reference);
+        let got = curvatures(&obj);
+        let scale = want
+            .iter()
+            .flat_map(|kh| kh.iter())
+            .filter(|x| x.is_finite())
+            .fold(1e-300f64, |m, x| m.max(x.abs()));
+        for (s, (a, b)) in got.iter().zip(&want).enumerate() {
+            for c in 0..2 {
+                let e = (a[c] - b[c]).abs() / scale;
+                assert!(
+                    e < 1e-9,
+                    "{degree:?}: sample {s} [K, H][{c}] {} vs {}",
+                    a[c],
+                    b[c]
+                );
+            }
+        }
+    }
+}
