@@ -518,6 +518,47 @@ impl Document {
     }
 }
 
+impl Document {
+    /// The edit that turns the polynomial local at `local` into an ERBS local with `count`
+    /// locals per direction of the local's own degree (so its shape stays), with that degree
+    /// for messages. `None` unless the local is a polynomial local of an ERBS object.
+    #[must_use]
+    pub fn local_to_erbs_edit(
+        &self,
+        object: usize,
+        local: LocalPath<Index2>,
+        count: usize,
+    ) -> Option<(ObjectEdit, String)> {
+        match self.objects.get(object)?.sampled.model() {
+            ModelRef::ErbsCurve(m) => {
+                let path = local.to_curve()?;
+                let l = m.curve().local_at(path.steps())?;
+                l.points()?;
+                let degree = l.degree();
+                let edit = ErbsCurveEdit::ToErbs {
+                    local: path,
+                    count,
+                    degree,
+                };
+                Some((edit.into_object(), degree.to_string()))
+            }
+            ModelRef::ErbsSurface(m) => {
+                let path = local.to_surface()?;
+                let p = m.surface().local_at(path.steps())?;
+                p.net()?;
+                let degree = p.degree();
+                let edit = ErbsSurfaceEdit::ToErbs {
+                    local: path,
+                    count: [count; 2],
+                    degree,
+                };
+                Some((edit.into_object(), format!("{degree:?}")))
+            }
+            _ => None,
+        }
+    }
+}
+
 /// Display data of the polynomial locals under one ERBS local.
 #[derive(Debug, Clone, PartialEq)]
 pub enum LocalControls {

@@ -1,6 +1,6 @@
 //! The built-in demo scene of `prespline view` with no file: a B-spline surface with its control
 //! net, an ERBS surface with visible local patches, an ERBS curve with its local curves, an exact
-//! NURBS circle, and the Utah teapot.
+//! NURBS circle, a closed ERBS torus built from a NURBS torus, and the Utah teapot.
 
 use super::{Model, Scene, SceneObject, parse_scene};
 use crate::geom::{
@@ -49,6 +49,11 @@ pub fn demo_scene() -> Scene {
                 .expect(valid),
             ),
             [0.95, 0.85, 0.20],
+        ),
+        object(
+            "erbs_torus",
+            Model::ErbsSurface(ErbsSurfaceModel::new(erbs_torus(), [96, 64]).expect(valid)),
+            [0.45, 0.75, 0.45],
         ),
     ];
     let mut teapot = parse_scene(TEAPOT_JSON).expect("the bundled teapot is valid");
@@ -136,6 +141,41 @@ fn erbs_curve() -> ErbsCurve {
     ErbsCurve::new(knots, local, BFunctionKind::ExpoRational).expect("valid demo ERBS curve")
 }
 
+/// The closed (in u and v) ERBS torus: 8 × 6 bicubic local patches Hermite-interpolating the
+/// exact NURBS torus (major radius 2, minor 0.7) at the knot crossings, in front of the teapot.
+fn erbs_torus() -> ErbsSurface {
+    let torus = nurbs_torus(DVec3::new(9.0, -6.5, 0.7), 2.0, 0.7);
+    ErbsSurface::from_surface(
+        &torus,
+        [8, 6],
+        [3, 3],
+        BFunctionKind::ExpoRational,
+        [true, true],
+    )
+    .expect("valid demo ERBS torus")
+}
+
+/// The exact NURBS torus around the z axis through `centre`: the circle of radius `minor` in
+/// the (radius, z) half-plane at `major`, revolved by the nine-point circle (biquadratic,
+/// weights the products of the circles' 1 and √2/2).
+pub fn nurbs_torus(centre: DVec3, major: f64, minor: f64) -> TensorSurface {
+    let around = nurbs_circle(DVec3::ZERO, 1.0);
+    let tube = nurbs_circle(DVec3::ZERO, 1.0);
+    let (aw, tw) = (around.weights(), tube.weights());
+    let mut points = Vec::with_capacity(81);
+    let mut weights = Vec::with_capacity(81);
+    for (i, a) in around.points().iter().enumerate() {
+        for (j, t) in tube.points().iter().enumerate() {
+            let r = major + minor * t.x;
+            points.push(centre + DVec3::new(r * a.x, r * a.y, minor * t.y));
+            weights.push(aw.map_or(1.0, |w| w[i]) * tw.map_or(1.0, |w| w[j]));
+        }
+    }
+    let k = around.knots().to_vec();
+    TensorSurface::bspline([2, 2], [k.clone(), k], [9, 9], points, Some(weights))
+        .expect("valid torus")
+}
+
 /// The exact NURBS circle: degree 2, nine control points on a square, weights 1 and √2/2.
 pub fn nurbs_circle(centre: DVec3, radius: f64) -> BSplineCurve {
     let w = std::f64::consts::FRAC_1_SQRT_2;
@@ -166,10 +206,37 @@ mod tests {
     #[test]
     fn demo_scene_is_complete_and_round_trips() {
         let scene = demo_scene();
-        assert_eq!(scene.objects.len(), 4 + 32);
+        assert_eq!(scene.objects.len(), 5 + 32);
         let text = super::super::scene_to_json(&scene);
         let back = parse_scene(&text).unwrap();
         assert_eq!(back, scene);
+    }
+
+    #[test]
+    fn torus_is_exact_and_its_erbs_is_close() {
+        let c = DVec3::new(1.0, -2.0, 0.5);
+        let t = nurbs_torus(c, 2.0, 0.7);
+        let e = erbs_torus();
+        let off = DVec3::new(9.0, -6.5, 0.7);
+        for i in 0..=40 {
+            for j in 0..=40 {
+                let (u, v) = (i as f64 / 40.0, j as f64 / 40.0);
+                let p = t.eval(u, v) - c;
+                let ring = DVec3::new(p.x, p.y, 0.0).length() - 2.0;
+                assert!(
+                    (ring.hypot(p.z) - 0.7).abs() < 1e-13,
+                    "NURBS torus at ({u}, {v})"
+                );
+                // The ERBS blends cubic Taylor polynomials: close to the torus, not on it.
+                let q = e.eval(u, v) - off;
+                let ring = DVec3::new(q.x, q.y, 0.0).length() - 2.0;
+                assert!(
+                    (ring.hypot(q.z) - 0.7).abs() < 0.02,
+                    "ERBS torus at ({u}, {v})"
+                );
+            }
+        }
+        assert_eq!(e.closed(), [true, true]);
     }
 
     #[test]

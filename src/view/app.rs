@@ -350,6 +350,9 @@ impl App {
             if let Some(shot) = r.session.perform(action) {
                 shots.push(shot);
             }
+            if let Some(e) = r.session.take_script_error() {
+                return Err(format!("script: {e}"));
+            }
         }
         rec.phase_start(Phase::Delta);
         let applied = r.session.apply_pending();

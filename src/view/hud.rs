@@ -41,6 +41,14 @@ pub const KEY_HELP: &[(&str, &str)] = &[
         "insert a knot at the cursor on the selected curve or surface (U/V direction)",
     ),
     (
+        "  on ERBS",
+        "refine at the cursor: a new local (row/column of patches) in the selected local's level",
+    ),
+    (
+        "X",
+        "turn the selected ERBS local into an ERBS of its own (3 locals per direction, same shape)",
+    ),
+    (
         "E / Shift+E",
         "elevate the degree of the selected curve or surface (in u / in v)",
     ),

@@ -1,10 +1,16 @@
 //! The knot-insertion tool: the parameter under the cursor on one curve or surface (on a
 //! surface, of the u or v isoparametric line through the point under the cursor), previewed as
-//! a marker or an isoline until it is applied.
+//! a marker or an isoline until it is applied. On B-spline objects it inserts a knot
+//! (CurveKnotIns); on ERBS objects it refines one ERBS level, the object's own or an ERBS local's
+//! nested inside it, with a new Hermite local centred at the parameter.
 
 use super::tools::View;
+use crate::geom::erbs::{ErbsKnots, LocalCurve, LocalPatch};
 use crate::gpu::LineVertex;
-use crate::model::{CurveEdit, Edit, KindEdit, ModelRef, SurfaceEdit};
+use crate::model::{
+    CurveEdit, Edit, ErbsCurveEdit, ErbsSurfaceEdit, Index2, KindEdit, LocalPath, ModelRef,
+    SurfaceEdit,
+};
 use crate::render::Document;
 use crate::sampling::SampleGrid;
 use glam::DVec3;
@@ -22,6 +28,8 @@ pub struct Refine {
     pub dir: usize,
     /// The parameter under the cursor, if the cursor is near the object.
     pub at: Option<f64>,
+    /// The ERBS level refined: `None` the object itself, else the ERBS local at this path.
+    pub level: Option<LocalPath<Index2>>,
 }
 
 impl Refine {
@@ -30,6 +38,34 @@ impl Refine {
             object,
             dir: 0,
             at: None,
+            level: None,
+        }
+    }
+
+    /// Refines the ERBS level that owns `selected` (a local of `object`): the local itself when
+    /// it is an ERBS local (a detail made with X), else the level it belongs to — its parent
+    /// ERBS local, or the object for a top-level local.
+    pub fn for_local(object: usize, selected: LocalPath<Index2>, doc: &Document) -> Self {
+        let is_erbs = match doc.objects[object].sampled.model() {
+            ModelRef::ErbsCurve(m) => selected
+                .to_curve()
+                .and_then(|p| m.curve().local_at(p.steps()))
+                .is_some_and(|l| matches!(l, LocalCurve::Erbs(_))),
+            ModelRef::ErbsSurface(m) => selected
+                .to_surface()
+                .and_then(|p| m.surface().local_at(p.steps()))
+                .is_some_and(|l| matches!(l, LocalPatch::Erbs(_))),
+            _ => false,
+        };
+        let level = if is_erbs {
+            Some(selected)
+        } else {
+            let steps = selected.steps();
+            LocalPath::new(&steps[..steps.len() - 1])
+        };
+        Self {
+            level,
+            ..Self::new(object)
         }
     }
 
@@ -84,13 +120,130 @@ impl Refine {
                     model.type_name()
                 ));
             }
-            _ => return Err("ERBS objects are not refined by B-spline knot insertion".into()),
+            ModelRef::ErbsCurve(_) => ErbsCurveEdit::InsertKnot {
+                local: self.level.and_then(|p| p.to_curve()),
+                at: self.level_parameter(doc, t)?,
+                degree: None,
+            }
+            .into_object(),
+            ModelRef::ErbsSurface(_) => ErbsSurfaceEdit::InsertKnot {
+                local: self.level.and_then(|p| p.to_surface()),
+                at: (self.dir, self.level_parameter(doc, t)?),
+                degree: None,
+            }
+            .into_object(),
         };
         edit.validate(model).map_err(|e| e.to_string())?;
         Ok(Edit {
             object: self.object,
             edit,
         })
+    }
+
+    /// The refined level's domain in the chosen direction: the object's, or the nested ERBS
+    /// local's (its support, in the object's parameter).
+    fn level_domain(&self, doc: &Document) -> Option<(f64, f64)> {
+        let dir = self.dir;
+        match doc.objects[self.object].sampled.model() {
+            ModelRef::ErbsCurve(m) => match self.level {
+                None => Some(m.curve().domain()),
+                Some(p) => m
+                    .curve()
+                    .local_at(p.to_curve()?.steps())
+                    .map(LocalCurve::domain),
+            },
+            ModelRef::ErbsSurface(m) => match self.level {
+                None => Some(m.surface().domain()[dir]),
+                Some(p) => m
+                    .surface()
+                    .local_at(p.to_surface()?.steps())
+                    .map(|l| l.domain()[dir]),
+            },
+            _ => None,
+        }
+    }
+
+    /// The knots of the refined level in the chosen direction.
+    fn level_knots<'a>(&self, doc: &'a Document) -> Option<&'a ErbsKnots> {
+        match doc.objects[self.object].sampled.model() {
+            ModelRef::ErbsCurve(m) => match self.level {
+                None => Some(m.curve().knots()),
+                Some(p) => match m.curve().local_at(p.to_curve()?.steps())? {
+                    LocalCurve::Erbs(e) => Some(e.knots()),
+                    LocalCurve::Spline { .. } => None,
+                },
+            },
+            ModelRef::ErbsSurface(m) => match self.level {
+                None => Some(&m.surface().knots()[self.dir]),
+                Some(p) => match m.surface().local_at(p.to_surface()?.steps())? {
+                    LocalPatch::Erbs(e) => Some(&e.knots()[self.dir]),
+                    LocalPatch::Spline { .. } => None,
+                },
+            },
+            _ => None,
+        }
+    }
+
+    /// The object's parameter `t` in the refined level's parameter: the same number, or one
+    /// period off where a closed object's local straddles the seam.
+    fn level_parameter(&self, doc: &Document, t: f64) -> Result<f64, String> {
+        let Some(path) = self.level else {
+            return Ok(t);
+        };
+        let (a, b) = self
+            .level_domain(doc)
+            .ok_or("the selected local is gone: select a local again")?;
+        let period = match doc.objects[self.object].sampled.model() {
+            ModelRef::ErbsCurve(m) => m.curve().knots().period(),
+            ModelRef::ErbsSurface(m) => m.surface().knots()[self.dir].period(),
+            _ => None,
+        };
+        let shifts = period.map_or(vec![0.0], |p| vec![0.0, -p, p]);
+        shifts
+            .into_iter()
+            .map(|s| t + s)
+            .find(|x| *x > a && *x < b)
+            .ok_or_else(|| {
+                format!(
+                    "{} {t:.6} is outside the selected ERBS local {} (its domain is [{a:.6}, {b:.6}]): aim inside it",
+                    self.axis_name(doc),
+                    path_text(path)
+                )
+            })
+    }
+
+    fn axis_name(&self, doc: &Document) -> &'static str {
+        if doc.objects[self.object].sampled.model().is_surface() {
+            ["u", "v"][self.dir]
+        } else {
+            "t"
+        }
+    }
+
+    /// Which local the refinement adds, for the status line after it: "local 3" of the level.
+    pub fn new_local(&self, doc: &Document) -> Option<String> {
+        let t = self.level_parameter(doc, self.at?).ok()?;
+        let i = self.level_knots(doc)?.locate(t) + 1;
+        let what = match (
+            doc.objects[self.object].sampled.model().is_surface(),
+            self.dir,
+        ) {
+            (false, _) => format!("local {i}"),
+            (true, 0) => format!("row {i} of local patches"),
+            (true, _) => format!("column {i} of local patches"),
+        };
+        Some(match self.level {
+            None => what,
+            Some(p) => format!("{what} inside local {}", path_text(p)),
+        })
+    }
+
+    /// Whether the object is an ERBS object (refinement) rather than a B-spline (knot insertion).
+    pub fn is_erbs(&self, doc: &Document) -> bool {
+        matches!(
+            doc.objects[self.object].sampled.model(),
+            ModelRef::ErbsCurve(_) | ModelRef::ErbsSurface(_)
+        )
     }
 
     /// The status line while aiming.
@@ -110,56 +263,91 @@ impl Refine {
         } else {
             "click or Enter inserts, Esc cancels"
         };
-        format!("insert knot in {}: {at} ({keys})", o.name)
+        if !self.is_erbs(doc) {
+            return format!("insert knot in {}: {at} ({keys})", o.name);
+        }
+        let level = self
+            .level
+            .map_or(String::new(), |p| format!(" local {}", path_text(p)));
+        let keys = keys.replace("inserts", "adds a local there");
+        format!("refine {}{level}: {at} ({keys})", o.name)
     }
 
-    /// The preview: the isoline at the parameter (surfaces) or a marker on the curve.
+    /// The preview: the isoline at the parameter (surfaces; across a nested ERBS level only its
+    /// support) or a marker on the curve.
     pub fn preview(&self, doc: &Document, scale: f64) -> Vec<LineVertex> {
         let Some(t) = self.at else {
             return Vec::new();
         };
-        let color = [255, 170, 40, 255];
-        let mut out = Vec::new();
-        let mut line = |a: DVec3, b: DVec3| {
-            for p in [a, b] {
-                out.push(LineVertex {
-                    pos: p.as_vec3().to_array(),
-                    color,
-                });
-            }
-        };
-        match doc.objects[self.object].sampled.model() {
-            ModelRef::Curve(m) => {
-                let d = m.curve().derivatives(t, 1);
-                let tangent = d[1].normalize_or_zero();
-                let across = tangent.any_orthonormal_vector();
-                let r = 0.03 * scale;
-                line(d[0] - across * r, d[0] + across * r);
-                line(
-                    d[0] - across.cross(tangent) * r,
-                    d[0] + across.cross(tangent) * r,
-                );
-            }
+        let polyline: Vec<DVec3> = match doc.objects[self.object].sampled.model() {
+            ModelRef::Curve(m) => return marker(&m.curve().derivatives(t, 1), scale),
+            ModelRef::ErbsCurve(m) => return marker(&m.curve().derivatives(t, 1), scale),
             ModelRef::Surface(m) => {
                 let s = m.surface();
-                let (a, b) = s.domain()[1 - self.dir];
-                let at = |x: f64| {
-                    if self.dir == 0 {
-                        s.eval(t, x)
-                    } else {
-                        s.eval(x, t)
-                    }
-                };
-                let pts: Vec<DVec3> = (0..ISOLINE_POINTS)
-                    .map(|k| at(a + (b - a) * k as f64 / (ISOLINE_POINTS - 1) as f64))
-                    .collect();
-                for w in pts.windows(2) {
-                    line(w[0], w[1]);
-                }
+                isoline(self.dir, t, s.domain()[1 - self.dir], |u, v| s.eval(u, v))
             }
-            _ => {}
-        }
-        out
+            ModelRef::ErbsSurface(m) => {
+                let s = m.surface();
+                let (a, b) = s.domain()[1 - self.dir];
+                let range = match self.level.and_then(|p| p.to_surface()) {
+                    Some(p) => s.local_at(p.steps()).map_or((a, b), |l| {
+                        let (c, d) = l.domain()[1 - self.dir];
+                        (c.max(a), d.min(b))
+                    }),
+                    None => (a, b),
+                };
+                isoline(self.dir, t, range, |u, v| s.eval(u, v))
+            }
+            _ => return Vec::new(),
+        };
+        polyline
+            .windows(2)
+            .flat_map(|w| [vertex(w[0]), vertex(w[1])])
+            .collect()
+    }
+}
+
+const PREVIEW_COLOR: [u8; 4] = [255, 170, 40, 255];
+
+fn vertex(p: DVec3) -> LineVertex {
+    LineVertex {
+        pos: p.as_vec3().to_array(),
+        color: PREVIEW_COLOR,
+    }
+}
+
+/// A cross across the curve at a point, from the point and its first derivative.
+fn marker(d: &[DVec3], scale: f64) -> Vec<LineVertex> {
+    let tangent = d[1].normalize_or_zero();
+    let across = tangent.any_orthonormal_vector();
+    let r = 0.03 * scale;
+    let other = across.cross(tangent);
+    [across, other]
+        .into_iter()
+        .flat_map(|v| [vertex(d[0] - v * r), vertex(d[0] + v * r)])
+        .collect()
+}
+
+/// The isoparametric line `dir` = t over `(a, b)` in the other direction.
+fn isoline(dir: usize, t: f64, (a, b): (f64, f64), eval: impl Fn(f64, f64) -> DVec3) -> Vec<DVec3> {
+    (0..ISOLINE_POINTS)
+        .map(|k| {
+            let x = a + (b - a) * k as f64 / (ISOLINE_POINTS - 1) as f64;
+            if dir == 0 { eval(t, x) } else { eval(x, t) }
+        })
+        .collect()
+}
+
+/// "2 → [1, 0]" for messages.
+pub fn path_text(path: LocalPath<Index2>) -> String {
+    let steps: Vec<String> = path.steps().iter().map(|&i| index_text(i)).collect();
+    steps.join(" → ")
+}
+
+pub fn index_text(i: Index2) -> String {
+    match i {
+        Index2::One(k) => k.to_string(),
+        Index2::Two(a, b) => format!("[{a}, {b}]"),
     }
 }
 

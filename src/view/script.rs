@@ -17,10 +17,12 @@
 //! `hold` keeps modifier keys down for the events that follow (an Alt+drag), `[]` releases.
 //!
 //! `move_to` aims the cursor at a control point (`"local"` too for ERBS objects), so scripts
-//! keep working when the window size or framing changes.
+//! keep working when the window size or framing changes. The point must exist when the event
+//! runs (a refinement earlier in the script may have made it); a missing one ends the replay
+//! with an error.
 
 use super::input::{InputEvent, Key, Modifiers, MouseButton};
-use crate::model::{Index2, LocalPath};
+use crate::model::{Index2, LocalPath, ModelRef};
 use crate::render::{Document, Handle};
 use serde_json::Value;
 use std::path::PathBuf;
@@ -195,7 +197,19 @@ fn handle(v: &Value, doc: &Document) -> Result<Handle, String> {
         },
         None => Handle::Point { object, point },
     };
-    if !doc.handles(object).iter().any(|(x, _)| *x == h) {
+    // A point must fit its object's kind now; whether it exists is checked when the event
+    // runs, since refinements earlier in the script add locals and control points.
+    let model = doc.objects[object].sampled.model();
+    let erbs = matches!(model, ModelRef::ErbsCurve(_) | ModelRef::ErbsSurface(_));
+    let fits = match h {
+        Handle::Point { point, .. } => {
+            matches!(point, Index2::Two(..)) == model.is_surface() && !erbs
+        }
+        Handle::LocalPoint { point, .. } => {
+            matches!(point, Index2::Two(..)) == model.is_surface() && erbs
+        }
+    };
+    if !fits {
         return Err(format!("object '{name}' has no such control point"));
     }
     Ok(h)

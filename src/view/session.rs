@@ -7,7 +7,7 @@ use super::autosave::Autosave;
 use super::hud::Hud;
 use super::input::{InputEvent, Key, Modifiers, MouseButton};
 use super::picking::{PICK_RADIUS, Projected, pick, project_all};
-use super::refine::Refine;
+use super::refine::{Refine, index_text, path_text};
 use super::script::Action;
 use super::tools::{Axis, Drag, Transform, TransformKind, View};
 use super::undo::UndoStack;
@@ -32,6 +32,9 @@ use crate::scene::Scene;
 use glam::{DMat4, DVec3};
 use std::path::PathBuf;
 use std::time::Instant;
+
+/// Locals per direction of an ERBS local made from a polynomial local with X.
+pub const DETAIL_LOCALS: usize = 3;
 
 /// What a transform acts on.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -117,6 +120,8 @@ pub struct Session {
     /// Half range of the analysis map's colour scale (refitted when a map is chosen and after
     /// each drag).
     map_range: f64,
+    /// A scripted action that could not run (see [`Session::take_script_error`]).
+    script_error: Option<String>,
 }
 
 impl Session {
@@ -168,6 +173,7 @@ impl Session {
             transform_origin: None,
             osculating: false,
             map_range: 1.0,
+            script_error: None,
         })
     }
 
@@ -357,6 +363,12 @@ impl Session {
         Ok(stats)
     }
 
+    /// Why the last scripted action could not run (a `move_to` a point that does not exist),
+    /// once: the replay ends with this error.
+    pub fn take_script_error(&mut self) -> Option<String> {
+        self.script_error.take()
+    }
+
     /// Performs a scripted action as if typed; returns a requested screenshot (path, with HUD).
     pub fn perform(&mut self, action: Action) -> Option<(PathBuf, bool)> {
         match action {
@@ -374,6 +386,9 @@ impl Session {
             Action::MoveTo(h) => {
                 if let Some((x, y)) = self.handle_position(h) {
                     self.handle(InputEvent::CursorMoved { x, y });
+                } else if !self.doc.handles(h.object()).iter().any(|(x, _)| *x == h) {
+                    self.script_error =
+                        Some(format!("move_to: there is no {} now", self.handle_name(h)));
                 }
             }
             Action::MoveBy(dx, dy) => {
@@ -746,7 +761,7 @@ impl Session {
             (Key::Char('y'), true) => self.redo(),
             (Key::Char('s'), true) => self.save(),
             (Key::Char('q'), true) => self.quit = true,
-            (Key::Char(c @ ('x' | 'y' | 'z')), false) => {
+            (Key::Char(c @ ('x' | 'y' | 'z')), false) if matches!(self.mode, Mode::Drag { .. }) => {
                 if let Mode::Drag { drag, .. } = &mut self.mode {
                     let axis = match c {
                         'x' => Axis::X,
@@ -766,6 +781,7 @@ impl Session {
                     *drag = fresh;
                 }
             }
+            (Key::Char('x'), false) => self.local_to_erbs(),
             (Key::Char('i'), false) => self.start_refine(),
             (Key::Char('e'), false) => self.elevate(),
             (Key::Char('g'), false) => self.start_transform(TransformKind::Grab),
@@ -849,7 +865,10 @@ impl Session {
         let Some(object) = self.focused_object() else {
             return self.set_status("select a curve or surface first (click one of its points)");
         };
-        let mut r = Refine::new(object);
+        let mut r = match self.selected_local {
+            Some((o, local)) if o == object => Refine::for_local(object, local, &self.doc),
+            _ => Refine::new(object),
+        };
         r.aim(&self.doc, &self.view(), self.cursor);
         self.mode = Mode::Refine(r);
     }
@@ -880,6 +899,9 @@ impl Session {
     }
 
     fn insert_knot(&mut self, r: &Refine) {
+        if r.is_erbs(&self.doc) {
+            return self.refine_erbs(r);
+        }
         match r.edit(&self.doc) {
             Ok(edit) => {
                 let what = r.describe(&self.doc);
@@ -893,6 +915,59 @@ impl Session {
             }
             Err(e) => self.set_status(format!("cannot insert a knot: {e}")),
         }
+    }
+
+    /// ERBS refinement at the aimed parameter: a new Hermite local (a row or column of local
+    /// patches on surfaces) in the refined level, one undo step.
+    fn refine_erbs(&mut self, r: &Refine) {
+        match r.edit(&self.doc) {
+            Ok(edit) => {
+                let added = r.new_local(&self.doc).unwrap_or_else(|| "a local".into());
+                let name = self.doc.objects[r.object].name.clone();
+                let at = r.at.unwrap_or_default();
+                self.structural("refine", edit);
+                self.set_status(format!(
+                    "refined {name} at {at:.6}: new {added}; click one of its points, then G/R/S (Ctrl+Z undoes)"
+                ));
+            }
+            Err(e) => self.set_status(format!("cannot refine: {e}")),
+        }
+    }
+
+    /// X: the selected polynomial local curve or patch becomes an ERBS local of its own, built
+    /// by Hermite interpolation (the same shape: its Taylor polynomials of its own degree are
+    /// itself), with [`DETAIL_LOCALS`] locals per direction. One undo step.
+    fn local_to_erbs(&mut self) {
+        self.apply_pending();
+        let Some((object, local)) = self.selected_local else {
+            return self.set_status(
+                "select a local curve or patch of an ERBS object first (click one of its points), then X",
+            );
+        };
+        let Some((edit, degree)) = self.doc.local_to_erbs_edit(object, local, DETAIL_LOCALS) else {
+            return self.set_status("the selected local is not a polynomial local curve or patch");
+        };
+        if let Err(e) = edit.validate(self.doc.objects[object].sampled.model()) {
+            return self.set_status(format!("cannot make an ERBS local: {e}"));
+        }
+        let name = self.doc.objects[object].name.clone();
+        self.structural(
+            "make ERBS local",
+            Edit {
+                object,
+                edit: edit.clone(),
+            },
+        );
+        self.selected_local = Some((object, local));
+        let what = if self.doc.objects[object].sampled.model().is_surface() {
+            format!("{DETAIL_LOCALS} x {DETAIL_LOCALS} local patches of degree {degree}")
+        } else {
+            format!("{DETAIL_LOCALS} local curves of degree {degree}")
+        };
+        self.set_status(format!(
+            "{name}: local {} is now an ERBS of {what} (same shape); click one of its points to edit it, I refines inside it (Ctrl+Z undoes)",
+            path_text(local)
+        ));
     }
 
     /// Degree elevation of the focused curve or surface by one (surfaces: in u, with Shift in v).
@@ -1298,17 +1373,5 @@ fn default_nets(doc: &Document) -> NetMode {
         NetMode::All
     } else {
         NetMode::Focused
-    }
-}
-
-fn path_text(path: LocalPath<Index2>) -> String {
-    let steps: Vec<String> = path.steps().iter().map(|&i| index_text(i)).collect();
-    steps.join(" → ")
-}
-
-fn index_text(i: Index2) -> String {
-    match i {
-        Index2::One(k) => k.to_string(),
-        Index2::Two(a, b) => format!("[{a}, {b}]"),
     }
 }
