@@ -35,7 +35,7 @@ const SCRIPT: &str = r#"[
  {"frame": 20, "type": "0.8"},
  {"frame": 21, "key": "enter"},
  {"frame": 23, "move_to": {"object": "domes", "local": [[1, 1], [1, 1]], "point": [1, 1]}},
- {"frame": 24, "move_by": [9, 6]},
+ {"frame": 24, "move_by": [4, 90]},
  {"frame": 25, "key": "i"},
  {"frame": 26, "key": "v"},
  {"frame": 27, "key": "enter"},

@@ -205,14 +205,15 @@ impl Refine {
             .find(|x| *x > a && *x < b)
             .ok_or_else(|| {
                 format!(
-                    "{} {t:.6} is outside the selected ERBS local {} (its domain is [{a:.6}, {b:.6}]): aim inside it",
-                    self.axis_name(doc),
-                    path_text(path)
+                    "{axis} = {t:.4} is outside local {} ({axis} in [{a:.4}, {b:.4}]): aim inside it",
+                    path_text(path),
+                    axis = self.axis_name(doc),
                 )
             })
     }
 
-    fn axis_name(&self, doc: &Document) -> &'static str {
+    /// "t" on curves, "u" or "v" on surfaces.
+    pub fn axis_name(&self, doc: &Document) -> &'static str {
         if doc.objects[self.object].sampled.model().is_surface() {
             ["u", "v"][self.dir]
         } else {
@@ -229,12 +230,12 @@ impl Refine {
             self.dir,
         ) {
             (false, _) => format!("local {i}"),
-            (true, 0) => format!("row {i} of local patches"),
-            (true, _) => format!("column {i} of local patches"),
+            (true, 0) => format!("row {i} of patches"),
+            (true, _) => format!("column {i} of patches"),
         };
         Some(match self.level {
             None => what,
-            Some(p) => format!("{what} inside local {}", path_text(p)),
+            Some(p) => format!("{what} in local {}", path_text(p)),
         })
     }
 

@@ -925,9 +925,10 @@ impl Session {
                 let added = r.new_local(&self.doc).unwrap_or_else(|| "a local".into());
                 let name = self.doc.objects[r.object].name.clone();
                 let at = r.at.unwrap_or_default();
+                let axis = r.axis_name(&self.doc);
                 self.structural("refine", edit);
                 self.set_status(format!(
-                    "refined {name} at {at:.6}: new {added}; click one of its points, then G/R/S (Ctrl+Z undoes)"
+                    "refined {name} at {axis} = {at:.4}: new {added} (Ctrl+Z undoes)"
                 ));
             }
             Err(e) => self.set_status(format!("cannot refine: {e}")),
@@ -960,12 +961,12 @@ impl Session {
         );
         self.selected_local = Some((object, local));
         let what = if self.doc.objects[object].sampled.model().is_surface() {
-            format!("{DETAIL_LOCALS} x {DETAIL_LOCALS} local patches of degree {degree}")
+            format!("{DETAIL_LOCALS} x {DETAIL_LOCALS} patches")
         } else {
-            format!("{DETAIL_LOCALS} local curves of degree {degree}")
+            format!("{DETAIL_LOCALS} curves")
         };
         self.set_status(format!(
-            "{name}: local {} is now an ERBS of {what} (same shape); click one of its points to edit it, I refines inside it (Ctrl+Z undoes)",
+            "{name} local {} is an ERBS now: {what} of degree {degree}, same shape (I refines in it)",
             path_text(local)
         ));
     }
