@@ -5,9 +5,13 @@
 
 mod common;
 
-use prespline::geom::erbs::{ErbsSurface, LocalPatch};
-use prespline::model::Model;
+use prespline::geom::erbs::{ErbsCurve, ErbsSurface, LocalCurve, LocalPatch};
+use prespline::model::{Index2, LocalPath, Model};
+use prespline::render::Handle;
 use prespline::scene::Scene;
+use prespline::view::Session;
+use prespline::view::input::{InputEvent, Key, Modifiers, MouseButton};
+use prespline::view::script::Action;
 use std::path::Path;
 use std::process::Command;
 use std::time::Duration;
@@ -162,4 +166,254 @@ fn erbs_refine_nest_transform_and_undo_exactly() {
         Path::new(env!("CARGO_TARGET_TMPDIR")).join("view_erbs.png"),
     )
     .unwrap();
+}
+
+/// An ERBS curve whose local 1 is a straight, evenly parametrised quadratic: its middle control
+/// point is the curve's point at the knot t = 1, which is a sample (121 samples on [0, 2]).
+const CURVE: &str = r#"{"objects": [
+  {"name": "erbs", "type": "erbs_curve", "knots": [0, 0, 1, 2, 2],
+   "local": [{"points": [[-1.2, -0.4, 0], [0.0, 1.6, 0], [1.2, -0.2, 0]]},
+             {"points": [[0.8, -0.4, 0], [2.0, 0.0, 0], [3.2, 0.4, 0]]},
+             {"points": [[2.8, -0.4, 0], [4.0, 1.6, 0], [5.2, -0.2, 0]]}], "samples": 121}
+]}"#;
+
+struct Headless {
+    session: Session,
+    renderer: prespline::gpu::Renderer,
+    sink: prespline::gpu::ValidationSink,
+}
+
+impl Headless {
+    fn new(text: &str) -> Self {
+        Self::with_scene(&prespline::scene::parse_scene(text).unwrap())
+    }
+
+    fn with_scene(scene: &Scene) -> Self {
+        let (mut renderer, sink) = common::renderer();
+        let session = Session::new(
+            &mut renderer,
+            scene,
+            std::env::temp_dir().join("unused.json"),
+            [800, 600],
+        )
+        .unwrap();
+        Self {
+            session,
+            renderer,
+            sink,
+        }
+    }
+
+    fn key(&mut self, key: Key, ctrl: bool) {
+        self.session.perform(Action::Key {
+            key,
+            mods: Modifiers {
+                ctrl,
+                ..Modifiers::default()
+            },
+        });
+    }
+
+    fn select(&mut self, local: &[usize], point: usize) {
+        let path: Vec<Index2> = local.iter().map(|&l| Index2::One(l)).collect();
+        self.click(Handle::LocalPoint {
+            object: 0,
+            local: LocalPath::new(&path).unwrap(),
+            point: Index2::One(point),
+        });
+    }
+
+    fn click(&mut self, handle: Handle) {
+        self.session.perform(Action::MoveTo(handle));
+        for pressed in [true, false] {
+            self.session.perform(Action::Input(InputEvent::Button {
+                button: MouseButton::Left,
+                pressed,
+            }));
+        }
+        assert_eq!(self.session.selected(), Some(handle), "the click missed");
+    }
+
+    /// I, then Enter: refine at the cursor.
+    fn refine(&mut self) {
+        self.key(Key::Char('i'), false);
+        self.key(Key::Enter, false);
+    }
+
+    fn curve(&mut self) -> ErbsCurve {
+        self.session.apply_pending();
+        match self.session.doc.to_scene().objects[0].model.clone() {
+            Model::ErbsCurve(m) => m.curve().clone(),
+            _ => panic!("an erbs_curve"),
+        }
+    }
+
+    fn finish(self) {
+        let Headless {
+            session,
+            mut renderer,
+            sink,
+        } = self;
+        session.destroy(&mut renderer);
+        common::teardown(renderer, sink);
+    }
+}
+
+#[test]
+fn refining_on_a_knot_is_refused_and_refinement_and_x_undo_exactly() {
+    let mut v = Headless::new(CURVE);
+    let original = v.curve();
+
+    // The cursor on the knot t = 1 (local 1's middle point): refused on the status line.
+    v.select(&[1], 1);
+    v.refine();
+    assert!(
+        v.session.status().starts_with("cannot refine:") && v.session.status().contains("knot"),
+        "{}",
+        v.session.status()
+    );
+    assert_eq!(v.curve(), original, "nothing changed");
+    assert_eq!(v.session.undo_depth().0, 0, "no undo step");
+
+    // Off the knot: a new local curve between knots 0 and 1 or 1 and 2.
+    v.session.perform(Action::MoveBy(30.0, 0.0));
+    v.refine();
+    assert!(
+        v.session.status().starts_with("refined erbs at t = "),
+        "{}",
+        v.session.status()
+    );
+    let refined = v.curve();
+    assert_eq!(refined.local_curves().len(), 4);
+    for &t in &[0.0, 1.0, 2.0] {
+        assert_eq!(
+            refined.eval(t),
+            original.eval(t),
+            "old knot {t} keeps its point"
+        );
+    }
+    v.key(Key::Char('z'), true);
+    assert_eq!(v.curve(), original, "Ctrl+Z restores exactly");
+
+    // X: local 1 becomes an ERBS of 3 quadratic local curves with the same shape.
+    v.select(&[1], 0);
+    v.key(Key::Char('x'), false);
+    assert!(
+        v.session
+            .status()
+            .contains("is an ERBS now: 3 curves of degree 2"),
+        "{}",
+        v.session.status()
+    );
+    let nested = v.curve();
+    let LocalCurve::Erbs(detail) = &nested.local_curves()[1] else {
+        panic!("local 1 became an ERBS local")
+    };
+    assert_eq!(detail.local_curves().len(), 3);
+    for k in 0..=40 {
+        let t = k as f64 / 20.0;
+        let (a, b) = (original.eval(t), nested.eval(t));
+        assert!((a - b).length() < 1e-12, "same shape at {t}: {a} vs {b}");
+    }
+    // The detail's own locals are selectable, G moves one (exactly 0.25 along z)…
+    v.select(&[1, 0], 1);
+    for k in [Key::Char('g'), Key::Char('z')] {
+        v.key(k, false);
+    }
+    v.session.perform(Action::Type("0.25".into()));
+    v.key(Key::Enter, false);
+    let moved = v.curve();
+    let (Some(LocalCurve::Spline { curve: a, .. }), Some(LocalCurve::Spline { curve: b, .. })) =
+        (nested.local_at(&[1, 0]), moved.local_at(&[1, 0]))
+    else {
+        panic!("level-2 locals are polynomial")
+    };
+    for (p, q) in a.points().iter().zip(b.points()) {
+        assert_eq!(*q - *p, glam::DVec3::new(0.0, 0.0, 0.25), "G Z 0.25");
+    }
+    // … and I refines inside the detail: the level of the selected level-2 local.
+    v.select(&[1, 0], 1);
+    v.refine();
+    assert!(
+        v.session.status().contains("in local 1"),
+        "{}",
+        v.session.status()
+    );
+    let inner = v.curve();
+    let LocalCurve::Erbs(detail) = &inner.local_curves()[1] else {
+        panic!("still an ERBS local")
+    };
+    assert_eq!(detail.local_curves().len(), 4, "the detail was refined");
+    assert_eq!(inner.local_curves().len(), 3, "the object was not");
+    for _ in 0..3 {
+        v.key(Key::Char('z'), true);
+    }
+    assert_eq!(v.curve(), original, "three undos restore exactly");
+    v.finish();
+}
+
+#[test]
+fn closed_torus_refines_across_its_seam_and_inside_a_detail_there() {
+    let scene = prespline::scene::demo::demo_scene();
+    let object = scene.find("erbs_torus").unwrap();
+    let mut v = Headless::with_scene(&scene);
+    let torus = |v: &mut Headless| {
+        v.session.apply_pending();
+        match v.session.doc.to_scene().objects[object].model.clone() {
+            Model::ErbsSurface(m) => m.surface().clone(),
+            _ => panic!("the torus is an erbs_surface"),
+        }
+    };
+    let original = torus(&mut v);
+    let patch = |path: &[[usize; 2]], point: [usize; 2]| Handle::LocalPoint {
+        object,
+        local: LocalPath::new(
+            &path
+                .iter()
+                .map(|&[a, b]| Index2::Two(a, b))
+                .collect::<Vec<_>>(),
+        )
+        .unwrap(),
+        point: Index2::Two(point[0], point[1]),
+    };
+    // Local patch [0, 0] straddles both seams; X makes it a detail of 3 × 3 bicubic patches.
+    // Zoomed in towards it, so that its points are apart on screen.
+    v.session.perform(Action::MoveTo(patch(&[[0, 0]], [1, 1])));
+    v.session
+        .perform(Action::Input(InputEvent::Wheel { delta: 12.0 }));
+    v.click(patch(&[[0, 0]], [1, 1]));
+    v.key(Key::Char('x'), false);
+    let detail = match torus(&mut v).local_at(&[[0, 0]]) {
+        Some(LocalPatch::Erbs(e)) => (**e).clone(),
+        _ => panic!("local [0, 0] became an ERBS local"),
+    };
+    assert_eq!((detail.count(), detail.closed()), ([3, 3], [false, false]));
+    // I on one of the detail's patches refines the detail, whichever side of the seam the
+    // cursor's parameter is on (the torus's parameter is taken one period off where needed).
+    for dir in ['u', 'v'] {
+        v.click(patch(&[[0, 0], [1, 1]], [1, 1]));
+        v.key(Key::Char('i'), false);
+        v.key(Key::Char(dir), false);
+        v.key(Key::Enter, false);
+        assert!(
+            v.session.status().contains("in local [0, 0]"),
+            "{}",
+            v.session.status()
+        );
+    }
+    let refined = torus(&mut v);
+    match refined.local_at(&[[0, 0]]) {
+        Some(LocalPatch::Erbs(e)) => assert_eq!(e.count(), [4, 4], "refined in u and v"),
+        _ => panic!("still an ERBS local"),
+    }
+    assert_eq!(
+        refined.count(),
+        original.count(),
+        "the torus itself was not refined"
+    );
+    for _ in 0..3 {
+        v.key(Key::Char('z'), true);
+    }
+    assert_eq!(torus(&mut v), original, "undo restores the torus exactly");
+    v.finish();
 }

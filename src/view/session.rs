@@ -263,6 +263,11 @@ impl Session {
         self.undo.depth()
     }
 
+    /// The status line's message (what the last action did or why it could not).
+    pub fn status(&self) -> &str {
+        &self.status
+    }
+
     pub fn set_status(&mut self, s: impl Into<String>) {
         self.status = s.into();
         self.status_since = Some(Instant::now());
