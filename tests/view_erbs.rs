@@ -417,3 +417,47 @@ fn closed_torus_refines_across_its_seam_and_inside_a_detail_there() {
     assert_eq!(torus(&mut v), original, "undo restores the torus exactly");
     v.finish();
 }
+
+/// The README's detail example: the refinements move nothing outside the refined strips
+/// u ∈ (2, 3) and v ∈ (2, 3), X keeps the surface, and the level-2 local patch raised by 0.5 raises the surface by
+/// exactly 0.5 at its centre and nothing outside its support [2.5, 3]².
+#[test]
+fn detail_example_raises_a_bump_only_inside_the_refined_patch() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples");
+    let scene = Scene::load(&dir.join("erbs_detail.json")).unwrap();
+    let text = std::fs::read_to_string(dir.join("erbs_detail_edits.json")).unwrap();
+    let edits = prespline::scene::parse_edits(&text, &scene).unwrap();
+    assert_eq!(edits.len(), 6);
+    // The surface after the first `n` edits.
+    let after = |n: usize| {
+        let mut s = scene.clone();
+        prespline::scene::edit::apply_all(&mut s, &edits[..n]).unwrap();
+        match &s.objects[0].model {
+            Model::ErbsSurface(m) => m.surface().clone(),
+            _ => panic!("the detail is an erbs_surface"),
+        }
+    };
+    let (source, refined, made, raised) = (after(0), after(4), after(5), after(6));
+    assert_eq!(refined.count(), [7, 7], "two knots in u and two in v");
+    assert_eq!(raised.depth(), 3, "a level-2 patch");
+    let grid = (0..=40).flat_map(|i| (0..=40).map(move |j| (i as f64 * 0.1, j as f64 * 0.1)));
+    let within = |t: f64, (a, b): (f64, f64)| t > a && t < b;
+    for (u, v) in grid {
+        let moved = |x: &ErbsSurface, y: &ErbsSurface| (x.eval(u, v) - y.eval(u, v)).length();
+        if !within(u, (2.0, 3.0)) && !within(v, (2.0, 3.0)) {
+            assert!(
+                moved(&source, &refined) < 1e-12,
+                "refinement moved ({u}, {v})"
+            );
+        }
+        assert!(moved(&refined, &made) < 1e-12, "X moved ({u}, {v})");
+        if !(within(u, (2.5, 3.0)) && within(v, (2.5, 3.0))) {
+            assert!(moved(&made, &raised) < 1e-12, "the bump reaches ({u}, {v})");
+        }
+    }
+    let lift = raised.eval(2.75, 2.75) - made.eval(2.75, 2.75);
+    assert!(
+        (lift - glam::DVec3::new(0.0, 0.0, 0.5)).length() < 1e-12,
+        "{lift}"
+    );
+}
