@@ -270,7 +270,14 @@ impl Refine {
         let level = self
             .level
             .map_or(String::new(), |p| format!(" local {}", path_text(p)));
-        let keys = keys.replace("inserts", "adds a local there");
+        let at = self
+            .at
+            .map_or("aim at the object".into(), |t| format!("{dir}{t:.4}"));
+        let keys = if surface {
+            "click/Enter refines, U/V, Esc"
+        } else {
+            "click/Enter refines, Esc"
+        };
         format!("refine {}{level}: {at} ({keys})", o.name)
     }
 
