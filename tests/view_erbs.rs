@@ -461,3 +461,38 @@ fn detail_example_raises_a_bump_only_inside_the_refined_patch() {
         "{lift}"
     );
 }
+
+/// A `move_to` a point that does not exist when the event runs (no X made local [1, 1] an ERBS
+/// local) ends the replay with one error line naming it; parsing accepted it, since an earlier
+/// refinement could have made it.
+#[test]
+fn script_move_to_a_missing_nested_local_fails_with_one_line() {
+    if !common::display() {
+        return;
+    }
+    let dir = common::Scratch::new("view-erbs-missing");
+    let scene = dir.file("scene.json", SCENE);
+    let script = dir.file(
+        "script.json",
+        r#"[{"frame": 2, "move_to": {"object": "domes", "local": [[1, 1], [0, 0]], "point": [1, 1]}},
+            {"frame": 4, "quit": true}]"#,
+    );
+    let icd = prespline::gpu::LAVAPIPE_ICD;
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_prespline"));
+    cmd.env("VK_DRIVER_FILES", icd)
+        .env("VK_ICD_FILENAMES", icd)
+        .args(["view", "--size", "640x400", "--script"])
+        .arg(&script)
+        .arg(&scene);
+    let out = common::output_with_timeout(&mut cmd, Duration::from_secs(120));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "the replay must fail: {err}");
+    let line = err
+        .lines()
+        .find(|l| l.contains("move_to"))
+        .unwrap_or_else(|| panic!("no move_to error in: {err}"));
+    assert!(
+        line.contains("there is no domes local [1, 1] → [0, 0] point [1, 1] now"),
+        "{line}"
+    );
+}
