@@ -27,9 +27,9 @@
 //!
 //! Running (shared target dir and the global build lock on the development machine):
 //! ```text
-//! cargo test --test oracle_selfcheck     # the oracle against lecture numbers, mpmath, FD, …
-//! cargo test --test oracle_agreement     # `prespline sample` against the oracle
-//! PRESPLINE_ORACLE_SEED=1000007 cargo test --test oracle_agreement curves   # one seed
+//! cargo test --test cpu oracle_selfcheck # the oracle against lecture numbers, mpmath, FD, …
+//! cargo test --test cpu oracle_agreement # `prespline sample` against the oracle
+//! PRESPLINE_ORACLE_SEED=1000007 cargo test --test cpu oracle_agreement::curves   # one seed
 //! ```
 #![allow(dead_code)]
 
