@@ -58,6 +58,7 @@ pub(super) fn erbs_curve(
             require(at, obj, "local_degree")?,
         )?;
         check_degree(at, "local_degree", d)?;
+        check_count(at, "local_curves", "", n)?;
         ErbsCurve::from_curve(&c, n, d, bf, closed).map_err(|e| geom(at, e))?
     } else {
         check_fields(at, obj, &with(outer, &CURVE_FIELDS))?;
@@ -173,6 +174,8 @@ pub(super) fn erbs_surface(
             require(at, obj, "local_degree")?,
         )?;
         check_degree(at, "local_degree", degree[0].max(degree[1]))?;
+        check_count(at, "local_patches", "u direction: ", count[0])?;
+        check_count(at, "local_patches", "v direction: ", count[1])?;
         return ErbsSurface::from_surface(&s, count, degree, bf, closed).map_err(|e| geom(at, e));
     }
     check_fields(at, obj, &with(outer, &CURVE_FIELDS))?;
@@ -267,6 +270,17 @@ fn local_patch(at: &At, which: &str, v: &Value) -> Result<LocalPatch, SceneError
             ),
         )),
     }
+}
+
+/// A `from` construction's local count, named by its own field.
+fn check_count(at: &At, field: &str, dir: &str, n: usize) -> Result<(), SceneError> {
+    if n < 2 {
+        return Err(at.err(
+            field,
+            format!("{dir}an ERBS needs at least 2 locals per direction, got {n}"),
+        ));
+    }
+    Ok(())
 }
 
 /// `from` and explicit knots, locals or a narrowed domain exclude each other (a local built
