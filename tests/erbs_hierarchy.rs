@@ -1329,7 +1329,7 @@ fn construction_errors_are_one_line() {
         refused(
             &scene_of(&constructed_curve(&src, n, 3, false, 9)),
             None,
-            &["'e'", "'local", "at least 2"],
+            &["'e'", "'local_curves'", "at least 2"],
         );
         refused(
             &scene_of(&constructed_surface(
@@ -1339,7 +1339,7 @@ fn construction_errors_are_one_line() {
                 [false, false],
             )),
             None,
-            &["'s'", "at least 2", "v direction"],
+            &["'s'", "'local_patches'", "at least 2", "v direction"],
         );
     }
     refused(
