@@ -11,6 +11,7 @@ mod cli_errors;
 mod cli_spline_errors;
 mod curvature_maps;
 mod delta_vs_full;
+mod erbs_hierarchy;
 mod geom_properties;
 mod lints;
 mod obj_errors;
