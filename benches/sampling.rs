@@ -238,6 +238,83 @@ fn bench(c: &mut Criterion) {
     g.finish();
 }
 
+/// ERBS structure, on the DESIGN.md surface: building an ERBS surface of 10 × 10 bicubic
+/// local patches from the 100 × 100 B-spline surface (Taylor patches at the knot crossings),
+/// alone and with its 512² pre-evaluation; and a local refinement (a u knot in the middle of
+/// an interval of the bench's ERBS surface), timed alone with its undo run untimed.
+fn erbs_structure(c: &mut Criterion) {
+    let mut g = c.benchmark_group("erbs");
+    g.sample_size(20).measurement_time(Duration::from_secs(4));
+    let Model::Surface(source) = surface() else {
+        unreachable!("the surface workload is a B-spline surface")
+    };
+    let build = || {
+        ErbsSurface::from_surface(
+            source.surface(),
+            [10, 10],
+            [3, 3],
+            BFunctionKind::ExpoRational,
+            [false, false],
+        )
+        .expect("a valid construction")
+    };
+    g.bench_function(ERBS_STRUCTURE[0], |b| b.iter(|| black_box(build())));
+    g.bench_function(ERBS_STRUCTURE[1], |b| {
+        b.iter(|| {
+            let model = ErbsSurfaceModel::new(build(), [SURFACE_SAMPLES; 2]).unwrap();
+            black_box(SampledObject::new(
+                &Model::ErbsSurface(model),
+                SampleMode::Render,
+            ))
+        })
+    });
+    let erbs = erbs_surface();
+    let Model::ErbsSurface(model) = &erbs else {
+        unreachable!("the ERBS workload is an ERBS surface")
+    };
+    let edit = ErbsSurfaceEdit::InsertKnot {
+        local: None,
+        at: (0, 4.37),
+        degree: None,
+    };
+    let undo = edit.inverse(model).into_object();
+    let edit = edit.into_object();
+    let mut obj = SampledObject::new(&erbs, SampleMode::Render);
+    g.bench_function(ERBS_STRUCTURE[2], |b| {
+        b.iter_custom(|iters| {
+            let mut timed = Duration::ZERO;
+            for _ in 0..iters {
+                let start = Instant::now();
+                black_box(obj.apply(&edit).expect("valid refinement"));
+                timed += start.elapsed();
+                obj.apply(&undo).expect("valid undo");
+            }
+            timed
+        })
+    });
+    g.finish();
+}
+
+const ERBS_STRUCTURE: [&str; 3] = [
+    "construct 10x10 from 100x100",
+    "construct and pre-evaluate 512x512",
+    "refine u knot",
+];
+
+fn erbs_summary() {
+    println!(
+        "
+| ERBS structure (512² samples) | ms |"
+    );
+    println!("|---|---:|");
+    for id in ERBS_STRUCTURE {
+        match mean_ns("erbs", id) {
+            Some(ns) => println!("| {id} | {:.3} |", ns / 1e6),
+            None => println!("| {id} | not measured |"),
+        }
+    }
+}
+
 /// Reads criterion's mean estimate (ns) for a benchmark id. Criterion keeps spaces in its
 /// directory names (`criterion/edit/interior point/`), so the id is used as it is.
 fn mean_ns(group: &str, id: &str) -> Option<f64> {
@@ -325,6 +402,7 @@ fn structural_summary() {
 fn main() {
     let mut c = Criterion::default().configure_from_args();
     bench(&mut c);
+    erbs_structure(&mut c);
     c.final_summary();
     // `cargo test` runs benches once as smoke tests; only `cargo bench` (which passes --bench)
     // leaves fresh estimates to summarise.
@@ -332,5 +410,6 @@ fn main() {
         summary();
         analysis_summary();
         structural_summary();
+        erbs_summary();
     }
 }

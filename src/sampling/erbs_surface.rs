@@ -65,9 +65,13 @@ impl PatchLevel {
                     samples,
                 }
             }
-            LocalPatch::Erbs(e) => {
-                PatchLevel::Erbs(Box::new(SurfaceLevel::new(e, params, set.clone(), false)))
-            }
+            LocalPatch::Erbs(e) => PatchLevel::Erbs(Box::new(SurfaceLevel::new(
+                e,
+                params,
+                set.clone(),
+                false,
+                true,
+            ))),
         }
     }
 
@@ -78,10 +82,18 @@ impl PatchLevel {
         }
     }
 
-    fn transform(&mut self, a: &DMat4, stride: usize) -> Vec<DVec3> {
+    fn samples_mut(&mut self) -> &mut Vec<DVec3> {
         match self {
-            PatchLevel::Spline { samples, .. } => transform_samples(samples, a, stride),
-            PatchLevel::Erbs(s) => s.transform_all(a),
+            PatchLevel::Spline { samples, .. } => samples,
+            PatchLevel::Erbs(s) => &mut s.grid.data,
+        }
+    }
+
+    /// Applies A to the samples, writing their change into `delta` (resized to fit).
+    fn transform(&mut self, a: &DMat4, stride: usize, delta: &mut Vec<DVec3>) {
+        match self {
+            PatchLevel::Spline { samples, .. } => transform_samples(samples, a, stride, delta),
+            PatchLevel::Erbs(s) => s.transform_all(a, delta),
         }
     }
 }
@@ -116,9 +128,11 @@ fn sample_spline(
     two_pass(tu, tv, points, nv, &set.list(), &rect, out);
 }
 
-/// Applies A to every sample (slot 0 as a point, the partials as vectors); returns the change.
-fn transform_samples(samples: &mut [DVec3], a: &DMat4, stride: usize) -> Vec<DVec3> {
-    let mut delta = vec![DVec3::ZERO; samples.len()];
+/// Applies A to every sample (slot 0 as a point, the partials as vectors), writing the change
+/// into `delta` (a buffer kept between edits: a fresh one would be page-faulted in every time).
+fn transform_samples(samples: &mut [DVec3], a: &DMat4, stride: usize, delta: &mut Vec<DVec3>) {
+    delta.clear();
+    delta.resize(samples.len(), DVec3::ZERO);
     for (d, s) in delta
         .chunks_exact_mut(stride)
         .zip(samples.chunks_exact_mut(stride))
@@ -133,7 +147,15 @@ fn transform_samples(samples: &mut [DVec3], a: &DMat4, stride: usize) -> Vec<DVe
             *s = moved;
         }
     }
-    delta
+}
+
+/// Where a blend takes a patch's change from.
+enum Delta<'a> {
+    /// The change, local rows × cols.
+    Values(&'a [DVec3]),
+    /// The patch's samples, to be transformed by A as they are blended (each exactly once:
+    /// the pieces of a support partition its local samples).
+    Transform(&'a mut [DVec3], &'a DMat4),
 }
 
 /// For output partial (a, b): Σ over (a', b') ≤ (a, b) of C(a,a')C(b,b') Wu^(a−a') Wv^(b−b') s^(a'b').
@@ -148,6 +170,13 @@ pub(crate) struct SurfaceLevel {
     /// Row-major [nu][nv].
     patches: Vec<PatchLevel>,
     pub grid: SampleGrid,
+    /// Whether a change is returned with its values: a parent level blends them in; the top
+    /// level only needs where it changed.
+    record: bool,
+    /// The partials are S, Su, Sv (drawing): the blend runs a fixed kernel.
+    shading: bool,
+    /// The change of the edited patch's samples, kept between edits.
+    scratch: Vec<DVec3>,
 }
 
 impl SurfaceLevel {
@@ -156,6 +185,7 @@ impl SurfaceLevel {
         params: [Vec<f64>; 2],
         set: PartialSet,
         normals: bool,
+        record: bool,
     ) -> Self {
         let g = set.max_order();
         let [ku, kv] = surface.knots();
@@ -166,6 +196,7 @@ impl SurfaceLevel {
             ErbsAxis::new(kv, surface.bfunction(), pv, g),
         ];
         let partials = set.list();
+        let shading = partials == [(0, 0), (1, 0), (0, 1)];
         let slot = |a: usize, b: usize| {
             partials
                 .iter()
@@ -206,13 +237,30 @@ impl SurfaceLevel {
             terms,
             patches,
             grid: SampleGrid::new(dims, set, normals),
+            record: false,
+            shading,
+            scratch: Vec::new(),
         };
         for idx in 0..level.patches.len() {
-            let values = level.patches[idx].samples().to_vec();
-            let all = level.local_dims(idx);
-            level.blend(idx, &values, [0..all[0], 0..all[1]], None);
+            level.blend_patch(idx, None);
         }
+        level.record = record;
         level
+    }
+
+    /// Blends patch idx's own samples in whole (restricted to level rows `only` if given).
+    fn blend_patch(&mut self, idx: usize, only: Option<&[Range<usize>; 2]>) {
+        let values = std::mem::take(self.patches[idx].samples_mut());
+        let all = self.local_dims(idx);
+        let record = std::mem::replace(&mut self.record, false);
+        self.blend(
+            idx,
+            &mut Delta::Values(&values),
+            [0..all[0], 0..all[1]],
+            only,
+        );
+        self.record = record;
+        *self.patches[idx].samples_mut() = values;
     }
 
     fn nv(&self) -> usize {
@@ -234,7 +282,7 @@ impl SurfaceLevel {
     fn blend(
         &mut self,
         idx: usize,
-        delta: &[DVec3],
+        source: &mut Delta,
         local: [Range<usize>; 2],
         only: Option<&[Range<usize>; 2]>,
     ) -> Vec<Patch> {
@@ -244,6 +292,7 @@ impl SurfaceLevel {
         let width = local[1].len();
         let mv = self.grid.dims[1];
         let mut out = Vec::new();
+        let mut row = Vec::new();
         let upieces: Vec<Piece> = self.axes[0].pieces(k).to_vec();
         let vpieces: Vec<Piece> = self.axes[1].pieces(l).to_vec();
         for pu in &upieces {
@@ -264,23 +313,46 @@ impl SurfaceLevel {
                     continue;
                 }
                 let rows = rows.clone();
-                let rows = rows.clone();
-                let mut values = Vec::with_capacity(rows.len() * cols.len() * stride);
+                let n = if self.record {
+                    rows.len() * cols.len() * stride
+                } else {
+                    0
+                };
+                let mut values = Vec::with_capacity(n);
                 let wv: Vec<&[f64]> = cols.clone().map(|j| self.axes[1].weights(j, l)).collect();
+                let lj0 = cols.start - pv.samples.start + pv.offset - local[1].start;
                 for i in rows.clone() {
                     let wu = self.axes[0].weights(i, k);
                     let li = i - pu.samples.start + pu.offset - local[0].start;
-                    for (j, wv) in cols.clone().zip(&wv) {
-                        let lj = j - pv.samples.start + pv.offset - local[1].start;
-                        let d = &delta[(li * width + lj) * stride..][..stride];
-                        let o = &mut self.grid.data[(i * mv + j) * stride..][..stride];
+                    let span =
+                        (li * width + lj0) * stride..(li * width + lj0 + cols.len()) * stride;
+                    let d = match source {
+                        Delta::Values(delta) => &delta[span],
+                        Delta::Transform(samples, a) => {
+                            transform_samples(&mut samples[span], a, stride, &mut row);
+                            &row
+                        }
+                    };
+                    let o = &mut self.grid.data[(i * mv + cols.start) * stride..]
+                        [..cols.len() * stride];
+                    if self.shading {
+                        blend_shading_row(wu, &wv, d, o, self.record.then_some(&mut values));
+                        continue;
+                    }
+                    for ((d, o), wv) in d
+                        .chunks_exact(stride)
+                        .zip(o.chunks_exact_mut(stride))
+                        .zip(&wv)
+                    {
                         for (slot, terms) in self.terms.iter().enumerate() {
                             let mut acc = DVec3::ZERO;
                             for &(c, ia, ib, s) in terms {
                                 acc += d[s] * (c * wu[ia] * wv[ib]);
                             }
                             o[slot] += acc;
-                            values.push(acc);
+                            if self.record {
+                                values.push(acc);
+                            }
                         }
                     }
                 }
@@ -290,12 +362,12 @@ impl SurfaceLevel {
         out
     }
 
-    fn transform_all(&mut self, a: &DMat4) -> Vec<DVec3> {
+    fn transform_all(&mut self, a: &DMat4, delta: &mut Vec<DVec3>) {
         let stride = self.partials.len();
         for p in &mut self.patches {
-            p.transform(a, stride);
+            p.transform(a, stride, delta);
         }
-        transform_samples(&mut self.grid.data, a, stride)
+        transform_samples(&mut self.grid.data, a, stride, delta);
     }
 
     /// Applies `op` to the patch at `path` and returns this level's change.
@@ -312,15 +384,29 @@ impl SurfaceLevel {
             let changes = child.apply(rest, op);
             return changes
                 .into_iter()
-                .flat_map(|c| self.blend(idx, &c.values, [c.rows, c.cols], None))
+                .flat_map(|c| {
+                    self.blend(idx, &mut Delta::Values(&c.values), [c.rows, c.cols], None)
+                })
                 .collect();
         }
         let dims = self.local_dims(idx);
         let all = [0..dims[0], 0..dims[1]];
         match *op {
             PatchOp::Transform(a) => {
-                let delta = self.patches[idx].transform(a, stride);
-                self.blend(idx, &delta, all, None)
+                if let PatchLevel::Spline { samples, .. } = &mut self.patches[idx] {
+                    // A row at a time, straight into the blend: the patch's change never
+                    // goes through memory as a whole.
+                    let mut samples = std::mem::take(samples);
+                    let changes =
+                        self.blend(idx, &mut Delta::Transform(&mut samples, a), all, None);
+                    *self.patches[idx].samples_mut() = samples;
+                    return changes;
+                }
+                let mut delta = std::mem::take(&mut self.scratch);
+                self.patches[idx].transform(a, stride, &mut delta);
+                let changes = self.blend(idx, &mut Delta::Values(&delta), all, None);
+                self.scratch = delta;
+                changes
             }
             PatchOp::MovePoint([qa, qb], d) => {
                 let PatchLevel::Spline {
@@ -343,7 +429,7 @@ impl SurfaceLevel {
                         }
                     }
                 }
-                self.blend(idx, &delta, [rows, cols], None)
+                self.blend(idx, &mut Delta::Values(&delta), [rows, cols], None)
             }
             PatchOp::Replace(patch) => {
                 let nv = self.nv();
@@ -359,7 +445,7 @@ impl SurfaceLevel {
                     .map(|(a, b)| *a - *b)
                     .collect();
                 self.patches[idx] = fresh;
-                self.blend(idx, &delta, all, None)
+                self.blend(idx, &mut Delta::Values(&delta), all, None)
             }
         }
     }
@@ -419,11 +505,35 @@ impl SurfaceLevel {
                 .fill(DVec3::ZERO);
         }
         for idx in 0..self.patches.len() {
-            let dims = self.local_dims(idx);
-            let values = self.patches[idx].samples().to_vec();
-            self.blend(idx, &values, [0..dims[0], 0..dims[1]], Some(&region));
+            self.blend_patch(idx, Some(&region));
         }
         region
+    }
+}
+
+/// One level row of the blend for S, Su, Sv (Leibniz in each direction with W, W'):
+/// ΔS = Wu Wv Δs, ΔSu = Wu' Wv Δs + Wu Wv Δsu, ΔSv = Wu Wv' Δs + Wu Wv Δsv.
+#[inline]
+fn blend_shading_row(
+    wu: &[f64],
+    wv: &[&[f64]],
+    delta: &[DVec3],
+    out: &mut [DVec3],
+    mut values: Option<&mut Vec<DVec3>>,
+) {
+    let (u0, u1) = (wu[0], wu[1]);
+    for ((d, o), wv) in delta.chunks_exact(3).zip(out.chunks_exact_mut(3)).zip(wv) {
+        let (v0, v1) = (wv[0], wv[1]);
+        let w = u0 * v0;
+        let s = d[0] * w;
+        let su = d[0] * (u1 * v0) + d[1] * w;
+        let sv = d[0] * (u0 * v1) + d[2] * w;
+        o[0] += s;
+        o[1] += su;
+        o[2] += sv;
+        if let Some(v) = values.as_deref_mut() {
+            v.extend_from_slice(&[s, su, sv]);
+        }
     }
 }
 
@@ -458,7 +568,7 @@ impl ErbsSurfaceSampler {
         let [(u0, u1), (v0, v1)] = model.surface().domain();
         let [mu, mv] = model.samples();
         let params = [uniform_params(u0, u1, mu), uniform_params(v0, v1, mv)];
-        SurfaceLevel::new(model.surface(), params, set, normals)
+        SurfaceLevel::new(model.surface(), params, set, normals, false)
     }
 
     fn finish(&mut self, changes: &[Patch]) -> DirtyRegion {

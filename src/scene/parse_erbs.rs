@@ -41,8 +41,8 @@ pub(super) fn erbs_curve(
     let bf = bfunction(at, obj)?;
     let closed = flag(at, obj, "closed")?;
     let c = if let Some(src) = obj.get("from") {
-        check_fields(at, obj, &with(outer, &FROM_FIELDS))?;
         only_from(at, obj)?;
+        check_fields(at, obj, &with(outer, &FROM_FIELDS))?;
         let source = source_body(at, src, &["bezier_curve", "bspline_curve"])?;
         let (_, c) = spline_curve(&source.0, source.1, source.2, &LOCAL_FIELDS)?;
         let n = as_usize(
@@ -58,6 +58,7 @@ pub(super) fn erbs_curve(
             require(at, obj, "local_degree")?,
         )?;
         check_degree(at, "local_degree", d)?;
+        check_count(at, "local_curves", "", n)?;
         ErbsCurve::from_curve(&c, n, d, bf, closed).map_err(|e| geom(at, e))?
     } else {
         check_fields(at, obj, &with(outer, &CURVE_FIELDS))?;
@@ -156,8 +157,8 @@ pub(super) fn erbs_surface(
         },
     };
     if let Some(src) = obj.get("from") {
-        check_fields(at, obj, &with(outer, &SURFACE_FROM_FIELDS))?;
         only_from(at, obj)?;
+        check_fields(at, obj, &with(outer, &SURFACE_FROM_FIELDS))?;
         let source = source_body(at, src, &["bezier_surface", "bspline_surface"])?;
         let (_, s) = spline_surface(&source.0, source.1, source.2, &LOCAL_FIELDS)?;
         let count = usize_pair(
@@ -173,6 +174,8 @@ pub(super) fn erbs_surface(
             require(at, obj, "local_degree")?,
         )?;
         check_degree(at, "local_degree", degree[0].max(degree[1]))?;
+        check_count(at, "local_patches", "u direction: ", count[0])?;
+        check_count(at, "local_patches", "v direction: ", count[1])?;
         return ErbsSurface::from_surface(&s, count, degree, bf, closed).map_err(|e| geom(at, e));
     }
     check_fields(at, obj, &with(outer, &CURVE_FIELDS))?;
@@ -269,13 +272,25 @@ fn local_patch(at: &At, which: &str, v: &Value) -> Result<LocalPatch, SceneError
     }
 }
 
-/// `from` and explicit knots or locals exclude each other.
+/// A `from` construction's local count, named by its own field.
+fn check_count(at: &At, field: &str, dir: &str, n: usize) -> Result<(), SceneError> {
+    if n < 2 {
+        return Err(at.err(
+            field,
+            format!("{dir}an ERBS needs at least 2 locals per direction, got {n}"),
+        ));
+    }
+    Ok(())
+}
+
+/// `from` and explicit knots, locals or a narrowed domain exclude each other (a local built
+/// `from` a source covers its whole support).
 fn only_from(at: &At, obj: &Map<String, Value>) -> Result<(), SceneError> {
-    for f in ["knots", "local"] {
+    for f in ["knots", "local", "domain"] {
         if obj.contains_key(f) {
             return Err(at.err(
                 "from",
-                format!("`from` builds the knots and locals: give `from` or `knots`/`local`, not both (found '{f}')"),
+                format!("`from` builds the knots and locals: give `from` or `knots`/`local`/`domain`, not both (found '{f}')"),
             ));
         }
     }

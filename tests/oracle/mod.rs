@@ -15,6 +15,9 @@
 //! * Expo-rational B-function: graded composite Gauss–Legendre quadrature for B, Taylor
 //!   arithmetic (series exponential) for the derivatives.
 //!
+//! * Hierarchical ERBS ([`erbs_tree`]: constructed, nested, closed, refined): locals reached
+//!   through affine maps from the parent's parameter, never split; Hermite locals from the polar
+//!   form of the Taylor polynomial.
 //! * Structural edits (knot insertion, degree elevation): blossoms (polar forms) evaluated by a
 //!   de Boor triangle with one argument per level, not Böhm's insertion or Bézier decomposition.
 //!
@@ -27,9 +30,9 @@
 //!
 //! Running (shared target dir and the global build lock on the development machine):
 //! ```text
-//! cargo test --test oracle_selfcheck     # the oracle against lecture numbers, mpmath, FD, …
-//! cargo test --test oracle_agreement     # `prespline sample` against the oracle
-//! PRESPLINE_ORACLE_SEED=1000007 cargo test --test oracle_agreement curves   # one seed
+//! cargo test --test cpu oracle_selfcheck # the oracle against lecture numbers, mpmath, FD, …
+//! cargo test --test cpu oracle_agreement # `prespline sample` against the oracle
+//! PRESPLINE_ORACLE_SEED=1000007 cargo test --test cpu oracle_agreement::curves   # one seed
 //! ```
 #![allow(dead_code)]
 
@@ -37,6 +40,7 @@ pub mod bfunction;
 pub mod blossom;
 pub mod compare;
 pub mod condition;
+pub mod erbs_tree;
 pub mod eval;
 pub mod random;
 pub mod rng;

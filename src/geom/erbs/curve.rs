@@ -66,7 +66,7 @@ impl LocalCurve {
     pub fn depth(&self) -> usize {
         match self {
             LocalCurve::Spline { .. } => 0,
-            LocalCurve::Erbs(e) => 1 + e.depth(),
+            LocalCurve::Erbs(e) => e.depth(),
         }
     }
 

@@ -24,8 +24,9 @@ pub use taylor::{taylor_bezier, taylor_patch};
 
 use super::bfunction::BFunction;
 
-/// Deepest nesting of ERBS local curves inside ERBS local curves. Each level is pre-sampled at
-/// its parent's sample parameters, so memory grows with the depth.
+/// Deepest nesting of ERBS local curves inside ERBS local curves: at most this many ERBS levels,
+/// the object itself included, so a local path has at most this many steps. Each level is
+/// pre-sampled at its parent's sample parameters, so memory grows with the depth.
 pub const MAX_NESTING: usize = 6;
 
 /// Blend weights on the interval [a, b] and their derivatives with respect to the parameter:

@@ -72,7 +72,7 @@ impl LocalPatch {
     pub fn depth(&self) -> usize {
         match self {
             LocalPatch::Spline { .. } => 0,
-            LocalPatch::Erbs(e) => 1 + e.depth(),
+            LocalPatch::Erbs(e) => e.depth(),
         }
     }
 

@@ -1,6 +1,6 @@
 //! `prespline render` run the way a user runs it (on lavapipe).
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 use std::process::Command;

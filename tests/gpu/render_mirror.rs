@@ -2,7 +2,7 @@
 //! frames with two frames in flight (each slot receives only the rows dirtied since it was last
 //! written) must end with exactly the pixels of a fresh upload of the same document.
 
-mod common;
+use crate::common;
 
 use glam::{DMat4, DVec3};
 use prespline::gpu::{OffscreenDesc, OffscreenTarget, Pixels, Renderer};

@@ -5,7 +5,7 @@
 //! the golden in `tests/golden/`; `PRESPLINE_BLESS=1` re-blesses. Negative controls show that
 //! the comparator fails a rendering with a thin curve or a few control-point markers missing.
 
-mod common;
+use crate::common;
 
 use prespline::gpu::Pixels;
 use prespline::render::offscreen::{Shot, render_document};

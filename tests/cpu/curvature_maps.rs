@@ -9,7 +9,7 @@ use prespline::sampling::curvature::principal;
 use prespline::sampling::exact::exact_grid;
 use prespline::sampling::{PartialSet, SampleMode, SampledObject};
 
-mod common;
+use crate::common;
 use common::Rng;
 
 const W: f64 = std::f64::consts::FRAC_1_SQRT_2;

@@ -1,7 +1,7 @@
 //! Behaviour of the GPU API on lavapipe: colour handling, viewports, strided point runs,
 //! transient growth, timestamps, argument checking and leak-free teardown.
 
-mod common;
+use crate::common;
 
 use glam::Vec3;
 use prespline::gpu::font::push_rect;

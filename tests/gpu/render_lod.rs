@@ -4,7 +4,7 @@
 //! full-resolution rows; and the default interactive picture (the device's default MSAA, level
 //! of detail on) matches its golden.
 
-mod common;
+use crate::common;
 
 use glam::DVec3;
 use prespline::gpu::{OffscreenDesc, Pixels, Renderer};

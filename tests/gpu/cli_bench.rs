@@ -1,7 +1,7 @@
 //! `prespline bench` produces every report in one run (structure only — timings are never
 //! asserted in tests).
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 use std::process::Command;

@@ -8,7 +8,7 @@
 // Index loops over derivative orders and coordinates read best as they are written in the books.
 #![allow(clippy::needless_range_loop)]
 
-mod oracle;
+use crate::oracle;
 
 use oracle::bfunction::{self, BFunction, EXPO_SCALE};
 use oracle::blossom::Spline;
@@ -168,7 +168,7 @@ fn expo_scale_constant() {
     assert!(close(printed_in_design, EXPO_SCALE, 2.3e-16));
 }
 
-const REFERENCE: &str = include_str!("data/expo_bfunction_reference.json");
+const REFERENCE: &str = include_str!("../data/expo_bfunction_reference.json");
 
 /// (t, [B, B', …, B^(6)]) from the mpmath table.
 fn reference_table() -> Vec<(f64, Vec<f64>)> {

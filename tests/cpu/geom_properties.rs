@@ -85,7 +85,7 @@ fn property_tests_are_seeded_and_replay_committed_regressions() {
         "unseeded: every run would try different cases"
     );
     let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/geom_properties.proptest-regressions");
+        .join("tests/cpu/geom_properties.proptest-regressions");
     let text = std::fs::read_to_string(&file)
         .unwrap_or_else(|e| panic!("{}: {e} (commit the regression file)", file.display()));
     assert!(

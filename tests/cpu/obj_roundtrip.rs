@@ -3,7 +3,7 @@
 //! form and for hand-written files (control data unchanged), and the exact B-spline export of
 //! ERBS objects against the ERBS evaluator.
 
-mod common;
+use crate::common;
 
 use common::Rng;
 use glam::DVec3;

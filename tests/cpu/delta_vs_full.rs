@@ -1,7 +1,7 @@
 //! The incremental (delta) path equals full re-sampling after long random edit sequences, for
 //! every object kind and edit kind, with and without the periodic exact rebuild.
 
-mod oracle;
+use crate::oracle;
 
 use glam::DVec3;
 use oracle::random::{Kind, Options, random_edits, random_scene};

@@ -2,7 +2,7 @@
 //! hand-written vase, the teapot as OBJ rendering and sampling identically to teapot.json, and
 //! the viewer under Xvfb editing an OBJ model and saving it back as OBJ.
 
-mod common;
+use crate::common;
 
 use prespline::model::Model;
 use prespline::render::offscreen::{Shot, render_document};

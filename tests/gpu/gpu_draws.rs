@@ -2,7 +2,7 @@
 //! run and batch of same-shaped surfaces is one draw call; a pipeline already bound is not
 //! bound again; an offscreen frame copies its image out only when captured.
 
-mod common;
+use crate::common;
 
 use glam::Vec3;
 use prespline::gpu::{

@@ -1,7 +1,7 @@
 //! Bad input never panics: every class of malformed scene or edit file exits non-zero with one
 //! line naming the object, field and index, and prints nothing on stdout.
 
-mod common;
+use crate::common;
 
 use common::Scratch;
 use std::process::Command;

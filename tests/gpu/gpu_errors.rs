@@ -4,7 +4,7 @@
 //! and the validation layer sees nothing wrong (no reset of pending work, no fence that can
 //! never signal).
 
-mod common;
+use crate::common;
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};

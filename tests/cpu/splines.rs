@@ -10,7 +10,7 @@ use prespline::sampling::exact::exact_grid;
 use prespline::sampling::{PartialSet, SampleMode, SampledObject};
 use prespline::scene::{Scene, parse_scene};
 
-mod common;
+use crate::common;
 use common::Rng;
 
 // ---------------------------------------------------------------------------------------------

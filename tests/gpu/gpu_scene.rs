@@ -1,7 +1,7 @@
 //! Offscreen rendering of a synthetic scene through real Vulkan (lavapipe), compared with a
 //! golden image, with the validation layer watching.
 
-mod common;
+use crate::common;
 
 use glam::Vec3;
 use prespline::gpu::font::{push_rect, push_text, text_size};

@@ -3,7 +3,7 @@
 //! non-zero and write nothing); a fuzz-style test mutating valid files with fixed seeds, where
 //! every outcome must be a usable scene or one such line, never a panic.
 
-mod common;
+use crate::common;
 
 use common::Rng;
 use prespline::cli::files::SampleOverride;

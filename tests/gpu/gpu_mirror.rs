@@ -2,7 +2,7 @@
 //! each frame slot receiving exactly the ranges it has not seen yet, must render the same
 //! pixels as a fresh mirror holding the final data.
 
-mod common;
+use crate::common;
 
 use std::ops::Range;
 
