@@ -124,7 +124,11 @@ fn erbs_refine_nest_transform_and_undo_exactly() {
         [3, 4],
         "the detail was refined in v"
     );
-    assert_eq!(edited.depth(), 3, "the object, the detail, its patches");
+    assert_eq!(
+        edited.depth(),
+        2,
+        "two ERBS levels: the object and the detail"
+    );
 
     // One undo takes back the refinement inside the detail, two the G of its local patch too.
     let moved = detail(&domes(&run(dir.path(), 1)));
@@ -439,7 +443,7 @@ fn detail_example_raises_a_bump_only_inside_the_refined_patch() {
     };
     let (source, refined, made, raised) = (after(0), after(4), after(5), after(6));
     assert_eq!(refined.count(), [7, 7], "two knots in u and two in v");
-    assert_eq!(raised.depth(), 3, "a level-2 patch");
+    assert_eq!(raised.depth(), 2, "two ERBS levels: a level-2 patch");
     let grid = (0..=40).flat_map(|i| (0..=40).map(move |j| (i as f64 * 0.1, j as f64 * 0.1)));
     let within = |t: f64, (a, b): (f64, f64)| t > a && t < b;
     for (u, v) in grid {
