@@ -94,9 +94,14 @@ pub(super) fn erbs_curve(
     Ok(c)
 }
 
-/// One `local` entry of an ERBS curve: `{"points": …}` (a Bézier curve, the original form), or
-/// a typed body: `bezier_curve`, `bspline_curve` (polynomial), or `erbs_curve`.
-fn local_curve(at: &At, which: &str, v: &Value) -> Result<LocalCurve, SceneError> {
+/// A `local` entry's object, where errors inside it are reported, and its `type` (`untyped`
+/// when absent: the original form, a Bézier body).
+fn typed_local<'v>(
+    at: &At,
+    which: &str,
+    v: &'v Value,
+    untyped: &'static str,
+) -> Result<(At, &'v Map<String, Value>, &'v str), SceneError> {
     let la = At(format!("{}: {which}", at.0));
     let obj = as_object(at, "local", v).map_err(|_| {
         at.err(
@@ -108,9 +113,16 @@ fn local_curve(at: &At, which: &str, v: &Value) -> Result<LocalCurve, SceneError
         )
     })?;
     let ty = match obj.get("type") {
-        None => "bezier_curve",
+        None => untyped,
         Some(t) => as_str(&la, "type", t)?,
     };
+    Ok((la, obj, ty))
+}
+
+/// One `local` entry of an ERBS curve: `{"points": …}` (a Bézier curve, the original form), or
+/// a typed body: `bezier_curve`, `bspline_curve` (polynomial), or `erbs_curve`.
+fn local_curve(at: &At, which: &str, v: &Value) -> Result<LocalCurve, SceneError> {
+    let (la, obj, ty) = typed_local(at, which, v, "bezier_curve")?;
     match ty {
         "bezier_curve" | "bspline_curve" => {
             let (form, c) = spline_curve(&la, obj, ty, &LOCAL_FIELDS)?;
@@ -230,20 +242,7 @@ pub(super) fn erbs_surface(
 /// One `local` entry of an ERBS surface: `{"points": [a][b][3]}` (a Bézier patch), or a typed
 /// body: `bezier_surface`, `bspline_surface` (polynomial), or `erbs_surface`.
 fn local_patch(at: &At, which: &str, v: &Value) -> Result<LocalPatch, SceneError> {
-    let la = At(format!("{}: {which}", at.0));
-    let obj = as_object(at, "local", v).map_err(|_| {
-        at.err(
-            "local",
-            format!(
-                "{which}: expected {{\"points\": [...]}} or a typed local, found {}",
-                kind(v)
-            ),
-        )
-    })?;
-    let ty = match obj.get("type") {
-        None => "bezier_surface",
-        Some(t) => as_str(&la, "type", t)?,
-    };
+    let (la, obj, ty) = typed_local(at, which, v, "bezier_surface")?;
     match ty {
         "bezier_surface" | "bspline_surface" => {
             let (form, s) = spline_surface(&la, obj, ty, &LOCAL_FIELDS)?;
