@@ -284,6 +284,14 @@ pub fn estimate(extent: &Extent, mode: SampleMode, uses: Uses) -> Estimate {
             (MIRROR_SLOTS + 1) * n * floats * F32,
             format!("{} × {samples_text} × {} B", MIRROR_SLOTS + 1, floats * F32),
         );
+        if surface && mode == SampleMode::Analysis {
+            // The curvature map's scalar per vertex, mirrored like the vertices.
+            e.add(
+                "GPU map mirrors",
+                (MIRROR_SLOTS + 1) * n * F32,
+                format!("{} × {samples_text} × 4 B", MIRROR_SLOTS + 1),
+            );
+        }
         if surface {
             e.add(
                 "GPU index buffers",
