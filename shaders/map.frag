@@ -1,8 +1,8 @@
 #version 450
-// Analysis maps: the scalar through the diverging scale of src/render/maps.rs (SCALE, blue
-// below zero, white at zero, red above, over ±R; undefined values grey), or zebra stripes —
-// a striped environment (bands of constant elevation of the reflected view ray) reflected in
-// the surface. Both keep a little diffuse light so the shape stays readable.
+// Analysis maps: the interpolated scalar through the diverging scale, lit by a
+// headlight, or zebra stripes — a striped environment (bands of constant height z of the
+// reflected view ray's direction) reflected in the surface, whose stripes bend smoothly across
+// G2 joins and kink at G1 ones. Both keep some diffuse light so the shape stays readable.
 layout(location = 0) in vec3 v_pos;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) in float v_value;
@@ -15,21 +15,24 @@ layout(push_constant) uniform Push {
 
 layout(location = 0) out vec4 out_color;
 
-const vec3 STOPS[5] = vec3[5](
-    vec3(0.02, 0.10, 0.60),
-    vec3(0.25, 0.50, 0.95),
-    vec3(0.92, 0.92, 0.92),
-    vec3(0.95, 0.45, 0.25),
-    vec3(0.60, 0.02, 0.02)
-);
+// The diverging scale of src/render/maps.rs (SCALE): blue below zero, white at zero, red
+// above, over s in [-1, 1] (clamped), linear between the stops; undefined values (NaN) mid
+// grey. Selects instead of an indexed table: cheaper per fragment in software rasterisers.
+const vec3 ZERO = vec3(0.92, 0.92, 0.92);
+const vec3 NEG_HALF = vec3(0.25, 0.50, 0.95);
+const vec3 NEG_ONE = vec3(0.02, 0.10, 0.60);
+const vec3 POS_HALF = vec3(0.95, 0.45, 0.25);
+const vec3 POS_ONE = vec3(0.60, 0.02, 0.02);
 
 vec3 scale_color(float s) {
     if (isnan(s)) {
         return vec3(0.3);
     }
-    float x = (clamp(s, -1.0, 1.0) + 1.0) * 2.0;
-    int i = min(int(floor(x)), 3);
-    return mix(STOPS[i], STOPS[i + 1], x - float(i));
+    float t = min(abs(s), 1.0) * 2.0;
+    bool negative = s < 0.0;
+    vec3 half_stop = negative ? NEG_HALF : POS_HALF;
+    vec3 end_stop = negative ? NEG_ONE : POS_ONE;
+    return t < 1.0 ? mix(ZERO, half_stop, t) : mix(half_stop, end_stop, t - 1.0);
 }
 
 void main() {
@@ -39,18 +42,22 @@ void main() {
         N = -N;
     }
     float diffuse = max(dot(N, V), 0.0);
-    float ambient = pc.params.w;
-    vec3 base;
     if (pc.params.x > 0.5) {
         vec3 R = reflect(-V, N);
-        float band = sin(pc.params.z * asin(clamp(R.z, -1.0, 1.0)));
-        // Antialiased edge: about one pixel wide.
-        float w = max(fwidth(band), 1e-4);
-        base = vec3(mix(0.12, 0.96, smoothstep(-w, w, band)));
-        out_color = vec4(base * (0.55 + 0.45 * diffuse), 1.0);
+        // A triangle wave in R.z: params.z bands over z in [-1, 1], edges about a pixel wide.
+        float x = R.z * pc.params.z * 0.5;
+        float band = abs(fract(x) - 0.5) - 0.25;
+        float w = max(fwidth(x), 1e-4);
+        float shade = mix(0.12, 0.96, smoothstep(-w, w, band));
+        out_color = vec4(vec3(shade) * (0.55 + 0.45 * diffuse), 1.0);
         return;
     }
-    base = scale_color(v_value * pc.params.y);
-    float specular = pow(diffuse, pc.eye.w);
+    // x^24 by squaring (pow is exp2(24 log2 x), slow in software rasterisers).
+    float d3 = diffuse * diffuse * diffuse;
+    float d6 = d3 * d3;
+    float d12 = d6 * d6;
+    float specular = d12 * d12;
+    float ambient = pc.params.w;
+    vec3 base = scale_color(v_value * pc.params.y);
     out_color = vec4(base * (ambient + (1.0 - ambient) * diffuse) + vec3(0.08) * specular, 1.0);
 }

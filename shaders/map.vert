@@ -7,7 +7,7 @@ layout(location = 2) in float in_value;
 
 layout(push_constant) uniform Push {
     mat4 view_proj;
-    vec4 eye;     // xyz: camera position, w: specular exponent
+    vec4 eye;     // xyz: camera position, w: unused
     vec4 params;  // x: 0 colour scale, 1 zebra; y: 1/R of the scale ±R; z: zebra stripes; w: ambient
 } pc;
 

@@ -8,12 +8,12 @@ use crate::gpu::{FRAMES_IN_FLIGHT, OffscreenDesc, Renderer, RendererDesc};
 use crate::profile::{
     FrameRecord, Phase, Progress, Recorder, RunInfo, Summary, compare, write_all,
 };
+use crate::render::maps::SurfaceMap;
 use crate::sampling::budget::MemoryBudget;
 use crate::scene::Scene;
 use crate::scene::demo::demo_scene;
 use crate::view::app::{self, ViewArgs};
 use crate::view::scenario::{Scenario, ScenarioDriver};
-use crate::render::maps::SurfaceMap;
 use crate::view::session::Session;
 use std::path::{Path, PathBuf};
 

@@ -70,7 +70,7 @@ impl Default for SurfaceStyle {
 pub enum MapStyle {
     /// Each vertex's scalar through the diverging colour scale over ±`range` (NaN grey).
     Scale { range: f32 },
-    /// Reflection lines: `stripes` bands per half turn of the reflected view ray's elevation.
+    /// Reflection lines: `stripes` bands over the height (z from −1 to 1) of the reflected view ray.
     Zebra { stripes: f32 },
 }
 
@@ -515,7 +515,7 @@ impl Frame<'_> {
         };
         let push = MapPush {
             view_proj: self.view_proj(),
-            eye: [eye.x, eye.y, eye.z, 24.0],
+            eye: [eye.x, eye.y, eye.z, 0.0],
             params,
         };
         self.stats.surface_triangles += u64::from(count / 3) * batch.offsets.len() as u64;

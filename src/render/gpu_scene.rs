@@ -139,8 +139,8 @@ pub struct GpuScene {
     scratch: Vec<f32>,
 }
 
-/// Reflection-line bands of the zebra map (per half turn of the reflected ray's elevation).
-const ZEBRA_STRIPES: f32 = 24.0;
+/// Reflection-line bands of the zebra map over the height of the reflected view ray.
+const ZEBRA_STRIPES: f32 = 16.0;
 
 impl GpuScene {
     /// Creates and fills every mirror (all slots).
