@@ -549,6 +549,34 @@ mod tests {
     }
 
     #[test]
+    fn analysis_mode_surfaces_count_the_map_mirror() {
+        let s = Extent {
+            samples: vec![512, 512],
+            degree: vec![3, 3],
+            rational: false,
+            erbs_locals: None,
+        };
+        let uses = Uses {
+            gpu: true,
+            json_text: false,
+        };
+        let n = 512 * 512;
+        let part = |mode, w: &str| {
+            estimate(&s, mode, uses)
+                .parts
+                .iter()
+                .find(|p| p.what == w)
+                .map(|p| p.bytes)
+        };
+        assert_eq!(
+            part(SampleMode::Analysis, "GPU map mirrors"),
+            Some(3 * n * 4)
+        );
+        assert_eq!(part(SampleMode::Analysis, "curvatures"), Some(n * 16));
+        assert_eq!(part(SampleMode::Render, "GPU map mirrors"), None);
+    }
+
+    #[test]
     fn sizes_parse_with_binary_units() {
         assert_eq!(parse_size("512M"), Ok(512 << 20));
         assert_eq!(parse_size("4G"), Ok(4 << 30));
