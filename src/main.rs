@@ -107,6 +107,9 @@ enum Command {
         /// Draw every sample of every surface (no display level of detail), for comparison.
         #[arg(long)]
         no_lod: bool,
+        /// Show a surface analysis map throughout: gaussian, mean, kmax, kmin or zebra.
+        #[arg(long, value_name = "MAP", value_parser = SurfaceMap::parse)]
+        analysis: Option<SurfaceMap>,
     },
     /// Render a scene headless (no display needed) into a PNG image.
     Render {
@@ -291,6 +294,7 @@ fn main() -> ExitCode {
             msaa,
             memory,
             no_lod,
+            analysis,
         } => {
             let args = cli::bench::BenchArgs {
                 scene,
@@ -304,6 +308,7 @@ fn main() -> ExitCode {
                 msaa,
                 memory: memory.budget(),
                 lod: !no_lod,
+                analysis,
             };
             cli::bench::run(&args).map(|line| eprintln!("{line}"))
         }

@@ -8,6 +8,7 @@ use crate::gpu::{FRAMES_IN_FLIGHT, OffscreenDesc, Renderer, RendererDesc};
 use crate::profile::{
     FrameRecord, Phase, Progress, Recorder, RunInfo, Summary, compare, write_all,
 };
+use crate::render::maps::SurfaceMap;
 use crate::sampling::budget::MemoryBudget;
 use crate::scene::Scene;
 use crate::scene::demo::demo_scene;
@@ -32,6 +33,8 @@ pub struct BenchArgs {
     pub memory: MemoryBudget,
     /// Display level of detail (off: every sample of every surface is drawn).
     pub lod: bool,
+    /// A surface analysis map shown throughout (`--analysis`).
+    pub analysis: Option<SurfaceMap>,
 }
 
 /// Runs the benchmark, writes the reports and returns the closing line.
@@ -47,6 +50,7 @@ pub fn run(args: &BenchArgs) -> Result<String, CliError> {
         None => (demo_scene(), "demo".to_string()),
     };
     super::render::check_drawable(&scene, Path::new(&scene_name), &args.memory)?;
+    super::render::check_analysis(&scene, args.analysis, &args.memory)?;
     let modes: &[bool] = if args.naive { &[false, true] } else { &[false] };
     let mut summaries = Vec::new();
     let mut written = Vec::new();
@@ -139,6 +143,7 @@ fn run_headless(
         Session::new(&mut renderer, scene, dir.join("scene.json"), [w, h]).map_err(gpu)?;
     session.naive = naive;
     session.options.lod = args.lod;
+    session.set_map(args.analysis);
     let total = args.warmup + args.frames;
     let result = (|| -> Result<Recorder, CliError> {
         let mut driver = ScenarioDriver::new(args.scenario, &session, args.warmup, args.frames)
@@ -224,6 +229,7 @@ fn run_window(
         autosave: None,
         msaa: args.msaa,
         lod: args.lod,
+        analysis: args.analysis,
     })
     .map_err(CliError)?;
     Ok((run.frames, run.device))

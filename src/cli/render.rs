@@ -96,11 +96,22 @@ pub fn show_analysis(
     map: Option<SurfaceMap>,
     budget: &MemoryBudget,
 ) -> Result<(), CliError> {
+    check_analysis(&doc.to_scene(), map, budget)?;
+    doc.set_analysis(map);
+    Ok(())
+}
+
+/// Budgets `scene` for `map` (`--analysis`): a curvature map keeps second partials, K and H
+/// per sample and a scalar mirror; one line naming the object when that does not fit.
+pub fn check_analysis(
+    scene: &Scene,
+    map: Option<SurfaceMap>,
+    budget: &MemoryBudget,
+) -> Result<(), CliError> {
     if let Some(m) = map.filter(|m| m.needs_curvature()) {
-        check_scene(&doc.to_scene(), SampleMode::Analysis, DRAW_USES, budget)
+        check_scene(scene, SampleMode::Analysis, DRAW_USES, budget)
             .map_err(|e| CliError(format!("--analysis {}: {e}", m.name())))?;
     }
-    doc.set_analysis(map);
     Ok(())
 }
 

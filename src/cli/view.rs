@@ -104,6 +104,7 @@ pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
         autosave: Some(autosave),
         msaa: 0,
         lod: true,
+        analysis: None,
     };
     let title = args.title.clone();
     let run = app::run(args).map_err(CliError)?;

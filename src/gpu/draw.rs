@@ -11,7 +11,7 @@ use super::frame::Frame;
 use super::grid::{GridShape, GridStride};
 use super::mirror::Mirror;
 use super::pipeline::{
-    Lines3dPush, OverlayPush, PUSH_STAGES, PointsPush, PolylinePush, SurfacePush, WirePush,
+    Lines3dPush, MapPush, OverlayPush, PUSH_STAGES, PointsPush, PolylinePush, SurfacePush, WirePush,
 };
 use super::pod::{Pod, bytes_of};
 use super::transient::TransientAlloc;
@@ -63,6 +63,15 @@ impl Default for SurfaceStyle {
             shininess: 48.0,
         }
     }
+}
+
+/// How an analysis map colours surfaces ([`Frame::draw_surface_map_batch`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MapStyle {
+    /// Each vertex's scalar through the diverging colour scale over ±`range` (NaN grey).
+    Scale { range: f32 },
+    /// Reflection lines: `stripes` bands over the height (z from −1 to 1) of the reflected view ray.
+    Zebra { stripes: f32 },
 }
 
 /// A surface's vertices inside a mirror: `shape.rows × shape.cols` vertices of 6 floats
@@ -449,6 +458,78 @@ impl Frame<'_> {
         };
         self.stats.surface_triangles += u64::from(count / 3) * batch.offsets.len() as u64;
         self.bind_and_push(self.pipelines.surface, &push);
+        self.draw_indexed(mirror, base, index_buffer, count, &runs);
+        Ok(())
+    }
+
+    /// Draws a batch like [`Frame::draw_surface_batch`], coloured by an analysis map.
+    ///
+    /// The vertex at floats `r + 6v` of `mirror` (`r` the batch's common offset residue, see
+    /// [`SurfaceBatch`]) takes its scalar from float `v` of `scalars` (binding 1), so a batch
+    /// of surfaces shares one scalar buffer indexed like the vertex buffer. Zebra stripes read
+    /// no scalar: with `scalars` `None` the vertex mirror itself is bound there.
+    pub fn draw_surface_map_batch(
+        &mut self,
+        mirror: &Mirror,
+        scalars: Option<&Mirror>,
+        batch: &SurfaceBatch,
+        style: MapStyle,
+    ) -> GpuResult<()> {
+        let (base, runs) = Self::batch_runs(mirror, batch)?;
+        let Some(longest) = runs.iter().map(|r| r.1).max() else {
+            return Ok(());
+        };
+        let scalars = match (scalars, style) {
+            (Some(s), _) => s,
+            (None, MapStyle::Zebra { .. }) => mirror,
+            (None, MapStyle::Scale { .. }) => {
+                return Err(GpuError::InvalidArgument(
+                    "a colour-scale map needs a scalar mirror".into(),
+                ));
+            }
+        };
+        // The last vertex any run reads, against the scalars there are.
+        let vertices = batch.shape.vertices() as usize;
+        let needed = runs
+            .iter()
+            .map(|&(first, surfaces)| first as usize + surfaces as usize * vertices)
+            .max()
+            .unwrap_or(0);
+        if scalars.len() < needed {
+            return Err(GpuError::InvalidArgument(format!(
+                "an analysis map needs a scalar per vertex: {} scalars for {needed} vertices",
+                scalars.len()
+            )));
+        }
+        let r = &mut *self.renderer;
+        let release = &mut r.frames[self.slot].release;
+        let key = (batch.shape, batch.stride, longest);
+        let ib = r
+            .grids
+            .triangles(&r.device, &mut r.uploader, key, release)?;
+        let (index_buffer, count) = (ib.buffer.raw, ib.count);
+        let eye = self.camera.eye;
+        let params = match style {
+            MapStyle::Scale { range } => [0.0, 1.0 / range, 0.0, 0.25],
+            MapStyle::Zebra { stripes } => [1.0, 0.0, stripes, 0.25],
+        };
+        let push = MapPush {
+            view_proj: self.view_proj(),
+            eye: [eye.x, eye.y, eye.z, 0.0],
+            params,
+        };
+        self.stats.surface_triangles += u64::from(count / 3) * batch.offsets.len() as u64;
+        self.bind_and_push(self.pipelines.surface_map, &push);
+        let scalar_buffer = scalars.slot(self.slot).raw();
+        // SAFETY: recording inside a rendering scope; the scalar mirror has VERTEX_BUFFER
+        // usage, lives until this slot's fence signals (mirrors are released through the
+        // frame), and holds a float for every vertex index the draw reads (checked above).
+        unsafe {
+            self.renderer
+                .device
+                .raw
+                .cmd_bind_vertex_buffers(self.cmd, 1, &[scalar_buffer], &[0])
+        };
         self.draw_indexed(mirror, base, index_buffer, count, &runs);
         Ok(())
     }

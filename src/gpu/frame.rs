@@ -245,15 +245,23 @@ impl<'a> Frame<'a> {
     }
 
     /// Replaces `mirror` by a new one holding `data` in every slot (a layout change, such as
-    /// a refined control net). Never waits: the new buffers have never been used by the GPU,
-    /// so all their slots may be written now, and each old buffer is released when its slot's
-    /// fence next signals.
+    /// a refined control net). Never waits: see [`Frame::create_mirror`] and
+    /// [`Frame::destroy_mirror`].
     pub fn replace_mirror(
         &mut self,
         mirror: &mut Mirror,
         name: &str,
         data: &[f32],
     ) -> GpuResult<()> {
+        let fresh = self.create_mirror(name, data)?;
+        let old = std::mem::replace(mirror, fresh);
+        self.destroy_mirror(old);
+        Ok(())
+    }
+
+    /// A new mirror holding `data` (at least one float) in every slot. Never waits: the new
+    /// buffers have never been used by the GPU, so all their slots may be written now.
+    pub fn create_mirror(&mut self, name: &str, data: &[f32]) -> GpuResult<Mirror> {
         let len = data.len().max(1);
         let mut fresh = Mirror::new(&self.renderer.device, name, len)?;
         let atom = self.renderer.device.caps.non_coherent_atom_size;
@@ -266,10 +274,17 @@ impl<'a> Frame<'a> {
                 return Err(e);
             }
         }
-        self.renderer.device.flush_ranges(&flushes)?;
-        let old = std::mem::replace(mirror, fresh);
-        self.renderer.destroy_mirror(old);
-        Ok(())
+        if let Err(e) = self.renderer.device.flush_ranges(&flushes) {
+            self.renderer.destroy_mirror(fresh);
+            return Err(e);
+        }
+        Ok(fresh)
+    }
+
+    /// Gives a mirror back; each slot's buffer is released when that slot's fence next
+    /// signals (this frame's included), so this never waits.
+    pub fn destroy_mirror(&mut self, mirror: Mirror) {
+        self.renderer.destroy_mirror(mirror);
     }
 
     /// Offscreen frames: also copy the finished image into the target's readback buffer, for

@@ -92,7 +92,7 @@ pub const WAIT_LIMIT: std::time::Duration = std::time::Duration::from_secs(30);
 pub use ash::vk;
 pub use device::{Device, DeviceCaps, GPU_ENV};
 pub use draw::{
-    Camera, DrawStats, LineVertex, OverlayVertex, PointRun, PointStyle, PolylineStyle,
+    Camera, DrawStats, LineVertex, MapStyle, OverlayVertex, PointRun, PointStyle, PolylineStyle,
     SurfaceBatch, SurfaceGrid, SurfaceStyle,
 };
 pub use error::{GpuError, GpuResult};

@@ -34,6 +34,15 @@ pub(crate) struct SurfacePush {
     pub back: [f32; 4],
 }
 
+/// Push constants of `map.vert`/`map.frag` (analysis maps on surfaces).
+#[repr(C)]
+#[derive(Clone, Copy)]
+pub(crate) struct MapPush {
+    pub view_proj: [f32; 16],
+    pub eye: [f32; 4],
+    pub params: [f32; 4],
+}
+
 /// Push constants of `wire.vert` + `flat.frag`.
 #[repr(C)]
 #[derive(Clone, Copy)]
@@ -100,6 +109,8 @@ pub(crate) struct OverlayPush {
 // offset assertions below, which are also the std430 offsets of the GLSL blocks).
 unsafe impl Pod for SurfacePush {}
 // SAFETY: see above.
+unsafe impl Pod for MapPush {}
+// SAFETY: see above.
 unsafe impl Pod for WirePush {}
 // SAFETY: see above.
 unsafe impl Pod for PolylinePush {}
@@ -112,6 +123,8 @@ unsafe impl Pod for OverlayPush {}
 
 const _: () = {
     assert!(size_of::<SurfacePush>() == 128);
+    assert!(size_of::<MapPush>() == 96);
+    assert!(offset_of!(MapPush, params) == 80);
     assert!(size_of::<WirePush>() == 80);
     assert!(size_of::<PolylinePush>() == 120);
     assert!(size_of::<PointsPush>() == 120);
@@ -152,6 +165,8 @@ pub(crate) struct PipelineSet {
     pub points: vk::Pipeline,
     pub lines3d: vk::Pipeline,
     pub overlay: vk::Pipeline,
+    /// Surfaces coloured by an analysis map (a second vertex stream of one scalar each).
+    pub surface_map: vk::Pipeline,
 }
 
 /// The shared layout and the pipeline sets built so far.
@@ -248,6 +263,7 @@ impl Pipelines {
                 set.points,
                 set.lines3d,
                 set.overlay,
+                set.surface_map,
             ] {
                 // SAFETY: the renderer waited for the GPU before destroying pipelines.
                 unsafe { device.raw.destroy_pipeline(p, None) };
@@ -269,6 +285,25 @@ fn build_set(
     let surface_attrs = [
         attribute(0, F::R32G32B32_SFLOAT, 0),
         attribute(1, F::R32G32B32_SFLOAT, 12),
+    ];
+    // Analysis maps: the surface vertices plus one f32 per vertex from a second buffer.
+    let map_bindings = [
+        surface_binding[0],
+        vk::VertexInputBindingDescription {
+            binding: 1,
+            stride: 4,
+            input_rate: vk::VertexInputRate::VERTEX,
+        },
+    ];
+    let map_attrs = [
+        surface_attrs[0],
+        surface_attrs[1],
+        vk::VertexInputAttributeDescription {
+            location: 2,
+            binding: 1,
+            format: F::R32_SFLOAT,
+            offset: 0,
+        },
     ];
     let lines_binding = binding(16);
     let lines_attrs = [
@@ -351,6 +386,15 @@ fn build_set(
             depth: Depth::Off,
             blend: true,
         },
+        Spec {
+            vs: ShaderId::MapVert,
+            fs: ShaderId::MapFrag,
+            bindings: &map_bindings,
+            attributes: &map_attrs,
+            topology: tri,
+            depth: Depth::Biased,
+            blend: false,
+        },
     ];
     let mut pipelines = Vec::with_capacity(specs.len());
     for spec in &specs {
@@ -373,6 +417,7 @@ fn build_set(
         lines3d: pipelines[5],
         overlay: pipelines[6],
         thin_lines: pipelines[4],
+        surface_map: pipelines[7],
     })
 }
 

@@ -27,9 +27,11 @@ pub(crate) enum ShaderId {
     OverlayVert,
     ColorFrag,
     OverlayFrag,
+    MapVert,
+    MapFrag,
 }
 
-const SOURCES: [(ShaderId, &str, &[u8]); 11] = [
+const SOURCES: [(ShaderId, &str, &[u8]); 13] = [
     (
         ShaderId::SurfaceVert,
         "surface.vert",
@@ -65,6 +67,8 @@ const SOURCES: [(ShaderId, &str, &[u8]); 11] = [
         "overlay.frag",
         spirv!("overlay.frag"),
     ),
+    (ShaderId::MapVert, "map.vert", spirv!("map.vert")),
+    (ShaderId::MapFrag, "map.frag", spirv!("map.frag")),
 ];
 
 /// The shader modules, created once; pipelines for new target formats are built from them.

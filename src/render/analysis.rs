@@ -203,7 +203,10 @@ impl Osculating {
 
 /// Four significant digits, plain ASCII (the overlay font).
 pub fn short(x: f64) -> String {
-    if x == 0.0 || (1e-3..1e5).contains(&x.abs()) {
+    if x == 0.0 {
+        // log10(0) is −∞: a planar curve's torsion would overflow the digit count.
+        "0".to_string()
+    } else if (1e-3..1e5).contains(&x.abs()) {
         let digits = (3 - x.abs().log10().floor() as i32).clamp(0, 6) as usize;
         format!("{x:.digits$}")
     } else {
@@ -333,6 +336,16 @@ pub fn osculating_overlay(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn short_numbers_include_zero() {
+        // A planar curve's torsion is exactly 0 (this overflowed the digit count once).
+        assert_eq!(short(0.0), "0");
+        assert_eq!(short(-0.0), "0");
+        assert_eq!(short(1.25), "1.250");
+        assert_eq!(short(-0.04120), "-0.04120");
+        assert_eq!(short(1e-7), "1.000e-7");
+    }
     use crate::scene::parse_scene;
 
     fn model(text: &str) -> Model {

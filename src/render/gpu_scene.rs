@@ -6,10 +6,11 @@ use super::document::{
     Controls, Document, Handle, LOCAL_CURVE_SAMPLES, LOCAL_PATCH_SAMPLES, LocalControls,
 };
 use super::lod::{GridMetrics, Lod};
+use super::map_mirror::{MapScalars, MapView, SurfaceSlot};
 use super::style::{NetMode, Palette, ViewOptions, Wire};
 use crate::gpu::{
-    FRAMES_IN_FLIGHT, Frame, GpuResult, GridShape, GridStride, Mirror, PointRun, PointStyle,
-    PolylineStyle, Renderer, SurfaceBatch, SurfaceStyle,
+    FRAMES_IN_FLIGHT, Frame, GpuResult, GridShape, GridStride, MapStyle, Mirror, PointRun,
+    PointStyle, PolylineStyle, Renderer, SurfaceBatch, SurfaceStyle,
 };
 use crate::model::{Edit, Index2, LocalPath, ModelRef, Target};
 use crate::sampling::{DirtyRegion, DirtySet};
@@ -131,8 +132,15 @@ pub struct GpuScene {
     groups: Vec<SurfaceGroup>,
     /// The view the objects' cached strides were chosen for.
     lod_view: Option<Lod>,
+    /// The analysis map on surfaces ([`GpuScene::set_map`]).
+    map: Option<MapView>,
+    /// The curvature map's scalars, built by the first upload after the map changed.
+    scalars: Option<MapScalars>,
     scratch: Vec<f32>,
 }
+
+/// Reflection-line bands of the zebra map over the height of the reflected view ray.
+const ZEBRA_STRIPES: f32 = 16.0;
 
 impl GpuScene {
     /// Creates and fills every mirror (all slots).
@@ -143,6 +151,8 @@ impl GpuScene {
             objects: Vec::with_capacity(doc.objects.len()),
             groups: surface_groups(doc, &places),
             lod_view: None,
+            map: None,
+            scalars: None,
             scratch: Vec::new(),
         };
         // On failure, give back what was created.
@@ -312,12 +322,53 @@ impl GpuScene {
         }
     }
 
+    /// Colours the surfaces by `map` from the next frame on (`None`: plain shading). A new
+    /// curvature map computes its scalars at the next [`GpuScene::upload`]; a new range
+    /// costs nothing (it is a shader constant).
+    pub fn set_map(&mut self, map: Option<MapView>) {
+        self.map = map;
+    }
+
+    /// The map colouring the surfaces.
+    pub fn map(&self) -> Option<MapView> {
+        self.map
+    }
+
+    /// Builds the scalar mirrors when the curvature map changed, drops them when none is
+    /// shown; returns the bytes written.
+    fn sync_scalars(&mut self, frame: &mut Frame<'_>, doc: &Document) -> GpuResult<usize> {
+        let wanted = self.map.map(|m| m.map).filter(|m| m.needs_curvature());
+        if self.scalars.as_ref().map(|s| s.map) == wanted {
+            return Ok(0);
+        }
+        if let Some(old) = self.scalars.take() {
+            old.destroy_with(|m| frame.destroy_mirror(m));
+        }
+        let Some(map) = wanted else { return Ok(0) };
+        let slots: Vec<Option<SurfaceSlot>> = (0..self.objects.len())
+            .map(|i| {
+                doc.objects[i].sampled.grid().normals.as_ref().map(|_| {
+                    let p = self.objects[i].samples;
+                    SurfaceSlot {
+                        arena: p.arena,
+                        offset: p.offset,
+                    }
+                })
+            })
+            .collect();
+        let scalars = MapScalars::build(frame, doc, &slots, self.arenas.len(), map)?;
+        let bytes = scalars.mirrors.iter().map(|m| m.len() * 4).sum::<usize>();
+        self.scalars = Some(scalars);
+        Ok(bytes * FRAMES_IN_FLIGHT)
+    }
+
     /// Copies into this frame's slot exactly what changed since the slot was last written:
     /// whole sample rows of touched rectangles (surfaces), touched spans (curves), and the control
     /// structures of edited objects.
     pub fn upload(&mut self, frame: &mut Frame<'_>, doc: &Document) -> GpuResult<UploadStats> {
         let slot = frame.slot();
         let mut stats = UploadStats::default();
+        stats.bytes += self.sync_scalars(frame, doc)?;
         for (i, o) in self.objects.iter_mut().enumerate() {
             let ranges = o.dirty[slot].take();
             if !ranges.is_empty() {
@@ -327,11 +378,25 @@ impl GpuScene {
                 let cols = doc.objects[i].sampled.grid().dims[1];
                 let per = floats_per_sample(doc, i);
                 let mut w = frame.write_mirror(&mut self.arenas[o.samples.arena]);
-                for r in ranges {
+                for r in &ranges {
                     stats.rows += r.len();
                     sample_floats(doc, i, r.clone(), &mut self.scratch);
                     w.write(o.samples.offset + r.start * cols * per, &self.scratch)?;
                     stats.bytes += self.scratch.len() * 4;
+                }
+                drop(w);
+                // The map's scalars of the same rows (surfaces only).
+                if let Some(scalars) = &mut self.scalars
+                    && per == 6
+                {
+                    let place = SurfaceSlot {
+                        arena: o.samples.arena,
+                        offset: o.samples.offset,
+                    };
+                    for r in ranges {
+                        stats.bytes +=
+                            scalars.write_rows(frame, doc, i, place, r, &mut self.scratch)?;
+                    }
                 }
             }
             if std::mem::take(&mut o.controls_resized) {
@@ -391,7 +456,6 @@ impl GpuScene {
                     .or_default()
                     .push(o.samples.offset);
             }
-            let arena = &self.arenas[group.arena];
             for ((rows, cols), offsets) in &by_stride {
                 let stride = GridStride {
                     rows: *rows,
@@ -405,13 +469,13 @@ impl GpuScene {
                     stride,
                     offsets,
                 };
-                frame.draw_surface_batch(arena, &batch, &style)?;
+                self.draw_surfaces(frame, group.arena, &batch, &style)?;
                 let every = match opts.wire {
                     Wire::Off => continue,
                     Wire::Isolines(every) => every.max(1),
                     Wire::Full => 1,
                 };
-                frame.draw_wire_batch(arena, &batch, every, palette.wire)?;
+                frame.draw_wire_batch(&self.arenas[group.arena], &batch, every, palette.wire)?;
             }
         }
         for (i, o) in self.objects.iter().enumerate() {
@@ -433,6 +497,36 @@ impl GpuScene {
             self.draw_controls(frame, i, o, opts, hl, &palette)?;
         }
         Ok(report)
+    }
+
+    /// A batch of surfaces, shaded or coloured by the map. Until the first upload after a
+    /// map change has built its scalars, curvature maps draw plain shading.
+    fn draw_surfaces(
+        &self,
+        frame: &mut Frame<'_>,
+        arena: usize,
+        batch: &SurfaceBatch,
+        style: &SurfaceStyle,
+    ) -> GpuResult<()> {
+        let mirror = &self.arenas[arena];
+        let Some(view) = self.map else {
+            return frame.draw_surface_batch(mirror, batch, style);
+        };
+        if !view.map.needs_curvature() {
+            let zebra = MapStyle::Zebra {
+                stripes: ZEBRA_STRIPES,
+            };
+            return frame.draw_surface_map_batch(mirror, None, batch, zebra);
+        }
+        match &self.scalars {
+            Some(s) if s.map == view.map => {
+                let scale = MapStyle::Scale {
+                    range: view.range as f32,
+                };
+                frame.draw_surface_map_batch(mirror, Some(&s.mirrors[arena]), batch, scale)
+            }
+            _ => frame.draw_surface_batch(mirror, batch, style),
+        }
     }
 
     fn draw_controls(
@@ -610,6 +704,9 @@ impl GpuScene {
 
     /// Gives every mirror back to the renderer.
     pub fn destroy(self, renderer: &mut Renderer) {
+        if let Some(s) = self.scalars {
+            s.destroy_with(|m| renderer.destroy_mirror(m));
+        }
         for a in self.arenas {
             renderer.destroy_mirror(a);
         }

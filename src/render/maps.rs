@@ -114,7 +114,7 @@ pub fn symmetric_range(values: impl Iterator<Item = f64>) -> f64 {
 }
 
 /// The diverging scale at s ∈ [−1, 1] (clamped): (position, linear RGB) stops, interpolated
-/// linearly. Shared with the shader (shaders/analysis.frag).
+/// linearly. Shared with the shader (shaders/map.frag).
 pub const SCALE: [(f32, [f32; 3]); 5] = [
     (-1.0, [0.02, 0.10, 0.60]),
     (-0.5, [0.25, 0.50, 0.95]),

@@ -5,6 +5,7 @@ use super::camera::OrbitCamera;
 use super::document::Document;
 use super::gpu_scene::{GpuScene, Highlight};
 use super::lod::Lod;
+use super::map_mirror::MapView;
 use super::maps::legend;
 use super::overlays::overlay_lines;
 use super::style::{Palette, ViewOptions};
@@ -64,6 +65,12 @@ fn record(
     let camera = shot_camera(doc, shot);
     let aspect = shot.width as f64 / shot.height as f64;
     let mut frame = renderer.begin_offscreen(target)?;
+    let map = shot.options.analysis.map(|map| MapView {
+        map,
+        range: doc.map_range(map),
+    });
+    scene.set_map(map);
+    scene.upload(&mut frame, doc)?;
     frame.set_clear_color(Palette::default().background);
     frame.set_camera(camera.gpu(aspect, &bounds));
     let viewport = [shot.width as f64, shot.height as f64];
@@ -95,8 +102,8 @@ fn record(
     if shot.options.badges {
         overlay.extend(badge_overlay(doc, project));
     }
-    if let Some(map) = shot.options.analysis {
-        overlay.extend(legend(map, doc.map_range(map), w as f32, h as f32));
+    if let Some(m) = map {
+        overlay.extend(legend(m.map, m.range, w as f32, h as f32));
     }
     if !overlay.is_empty() {
         frame.draw_overlay(&overlay)?;

@@ -284,6 +284,14 @@ pub fn estimate(extent: &Extent, mode: SampleMode, uses: Uses) -> Estimate {
             (MIRROR_SLOTS + 1) * n * floats * F32,
             format!("{} × {samples_text} × {} B", MIRROR_SLOTS + 1, floats * F32),
         );
+        if surface && mode == SampleMode::Analysis {
+            // The curvature map's scalar per vertex, mirrored like the vertices.
+            e.add(
+                "GPU map mirrors",
+                (MIRROR_SLOTS + 1) * n * F32,
+                format!("{} × {samples_text} × 4 B", MIRROR_SLOTS + 1),
+            );
+        }
         if surface {
             e.add(
                 "GPU index buffers",
@@ -538,6 +546,34 @@ mod tests {
         assert_eq!(part("homogeneous samples"), n * 3 * 32);
         assert_eq!(part("normals"), n * 24);
         assert_eq!(part("GPU mirrors"), 3 * n * 24);
+    }
+
+    #[test]
+    fn analysis_mode_surfaces_count_the_map_mirror() {
+        let s = Extent {
+            samples: vec![512, 512],
+            degree: vec![3, 3],
+            rational: false,
+            erbs_locals: None,
+        };
+        let uses = Uses {
+            gpu: true,
+            json_text: false,
+        };
+        let n = 512 * 512;
+        let part = |mode, w: &str| {
+            estimate(&s, mode, uses)
+                .parts
+                .iter()
+                .find(|p| p.what == w)
+                .map(|p| p.bytes)
+        };
+        assert_eq!(
+            part(SampleMode::Analysis, "GPU map mirrors"),
+            Some(3 * n * 4)
+        );
+        assert_eq!(part(SampleMode::Analysis, "curvatures"), Some(n * 16));
+        assert_eq!(part(SampleMode::Render, "GPU map mirrors"), None);
     }
 
     #[test]

@@ -55,6 +55,8 @@ pub struct ViewArgs {
     pub msaa: u32,
     /// Display level of detail.
     pub lod: bool,
+    /// A surface analysis map shown from the start.
+    pub analysis: Option<crate::render::maps::SurfaceMap>,
 }
 
 /// What a viewer run measured.
@@ -227,6 +229,9 @@ impl App {
         session.set_autosave(self.args.autosave.clone());
         session.naive = self.args.naive;
         session.options.lod = self.args.lod;
+        if self.args.analysis.is_some() {
+            session.set_map(self.args.analysis);
+        }
         if let Some(scenario) = self.args.scenario {
             let frames = self
                 .args

@@ -20,6 +20,7 @@ use crate::render::analysis::{
     CurveEval, Osculating, badge_overlay, osculating_lines, osculating_overlay,
 };
 use crate::render::lod::Lod;
+use crate::render::map_mirror::MapView;
 use crate::render::maps::{SurfaceMap, legend};
 use crate::render::overlays::overlay_lines;
 use crate::render::{
@@ -1235,6 +1236,10 @@ impl Session {
         if let Some(map) = self.options.analysis.filter(|m| m.needs_curvature()) {
             self.map_range = self.doc.map_range(map);
         }
+        self.gpu.set_map(self.options.analysis.map(|map| MapView {
+            map,
+            range: self.map_range,
+        }));
     }
 
     /// B: the focused Catmull–Rom or Bézier spline becomes its equivalent bspline_curve (one

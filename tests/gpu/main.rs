@@ -13,6 +13,7 @@ mod gpu_errors;
 mod gpu_mirror;
 mod gpu_scene;
 mod obj_render;
+mod render_analysis;
 mod render_golden;
 mod render_lod;
 mod render_mirror;

@@ -1,0 +1,339 @@
+//! Analysis views rendered on lavapipe (validation layer required): a golden image of every
+//! surface map (Gaussian, mean, max and min principal curvature, zebra) on the B-spline surface
+//! example, the curvature maps on an exact sphere and cylinder, and continuity badges with an
+//! osculating circle on curves. The map's scalar mirrors follow the delta path: after random
+//! drags over many frames with two frames in flight (and map changes on the way) the picture
+//! equals a fresh upload, and one interior drag copies only its touched rows of the map.
+//! `PRESPLINE_BLESS=1` re-blesses the goldens.
+
+use crate::common;
+
+use glam::DVec3;
+use prespline::gpu::{OffscreenDesc, OffscreenTarget, Pixels, Renderer};
+use prespline::model::{Edit, KindEdit, PointEdit, SurfaceEdit};
+use prespline::render::maps::SurfaceMap;
+use prespline::render::offscreen::{Shot, render_document, shot_camera};
+use prespline::render::{Document, GpuScene, Highlight, Lod, MapView, ViewOptions};
+use prespline::scene::Scene;
+use std::path::Path;
+
+fn load(path: &str) -> Scene {
+    Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(path)).unwrap()
+}
+
+/// `scene` rendered as `prespline render --analysis` does: curvature maps re-sample the
+/// surfaces with second partials first.
+fn render_with(scene: &Scene, options: ViewOptions) -> Pixels {
+    let (mut renderer, sink) = common::renderer();
+    let mut doc = Document::new(scene);
+    doc.set_analysis(options.analysis);
+    let shot = Shot {
+        width: 640,
+        height: 400,
+        camera: None,
+        options,
+        msaa: 4,
+    };
+    let pixels = render_document(&mut renderer, &doc, &shot).unwrap();
+    common::teardown(renderer, sink);
+    pixels
+}
+
+fn map_options(map: SurfaceMap) -> ViewOptions {
+    ViewOptions {
+        analysis: Some(map),
+        ..ViewOptions::default()
+    }
+}
+
+fn golden_map(scene: &str, label: &str, map: SurfaceMap) -> Pixels {
+    let px = render_with(&load(scene), map_options(map));
+    common::assert_golden(&format!("analysis_{label}_{}", map.name()), &px);
+    px
+}
+
+#[test]
+fn gaussian_curvature_golden() {
+    golden_map(
+        "examples/bspline_surface.json",
+        "bspline",
+        SurfaceMap::Gaussian,
+    );
+}
+
+#[test]
+fn mean_curvature_golden() {
+    golden_map("examples/bspline_surface.json", "bspline", SurfaceMap::Mean);
+}
+
+#[test]
+fn max_principal_curvature_golden() {
+    golden_map(
+        "examples/bspline_surface.json",
+        "bspline",
+        SurfaceMap::MaxPrincipal,
+    );
+}
+
+#[test]
+fn min_principal_curvature_golden() {
+    golden_map(
+        "examples/bspline_surface.json",
+        "bspline",
+        SurfaceMap::MinPrincipal,
+    );
+}
+
+#[test]
+fn zebra_golden() {
+    golden_map(
+        "examples/bspline_surface.json",
+        "bspline",
+        SurfaceMap::Zebra,
+    );
+}
+
+#[test]
+fn sphere_and_cylinder_gaussian_goldens() {
+    golden_map("tests/data/sphere.json", "sphere", SurfaceMap::Gaussian);
+    golden_map("tests/data/cylinder.json", "cylinder", SurfaceMap::Gaussian);
+}
+
+/// Linear value of an sRGB byte.
+fn linear(c: u8) -> f32 {
+    let x = c as f32 / 255.0;
+    if x <= 0.04045 {
+        x / 12.92
+    } else {
+        ((x + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// The centre pixel's hue class: which of red and blue dominates, or neither (white/grey).
+fn centre_tint(px: &Pixels) -> (f32, f32) {
+    let (w, h) = (px.width as usize, px.height as usize);
+    let i = ((h / 2) * w + w / 2) * 4;
+    let [r, _, b] = [0, 1, 2].map(|k| linear(px.rgba[i + k]));
+    (r, b)
+}
+
+/// The colours mean what the legend says: the sphere's K = 1/r² > 0 is red, its H = −1/r
+/// (outward normals) blue, and the cylinder's K = 0 is neutral (red and blue equal).
+#[test]
+fn map_colours_follow_the_sign() {
+    let (r, b) = centre_tint(&render_with(
+        &load("tests/data/sphere.json"),
+        map_options(SurfaceMap::Gaussian),
+    ));
+    assert!(r > 2.0 * b, "sphere K should be red: r {r} b {b}");
+    let (r, b) = centre_tint(&render_with(
+        &load("tests/data/sphere.json"),
+        map_options(SurfaceMap::Mean),
+    ));
+    assert!(b > 2.0 * r, "sphere H should be blue: r {r} b {b}");
+    let (r, b) = centre_tint(&render_with(
+        &load("tests/data/cylinder.json"),
+        map_options(SurfaceMap::Gaussian),
+    ));
+    assert!(
+        (r - b).abs() < 0.02 && r > 0.1,
+        "cylinder K should be white: r {r} b {b}"
+    );
+}
+
+/// Negative control: the same surface under two different maps fails the golden comparator
+/// (the scalars reach the picture).
+#[test]
+fn comparator_tells_the_maps_apart() {
+    let scene = load("examples/bspline_surface.json");
+    let k = render_with(&scene, map_options(SurfaceMap::Gaussian));
+    let h = render_with(&scene, map_options(SurfaceMap::Mean));
+    let plain = render_with(&scene, ViewOptions::default());
+    for (what, other) in [("mean", &h), ("plain shading", &plain)] {
+        let diff = common::compare_images(&k, other, common::GOLDEN.channel).unwrap();
+        assert!(
+            diff.check(&common::GOLDEN).is_err(),
+            "Gaussian map and {what} passed the comparator"
+        );
+    }
+}
+
+#[test]
+fn badges_and_osculating_circle_golden() {
+    let scene = load("tests/data/badges.json");
+    let px = render_with(
+        &scene,
+        ViewOptions {
+            badges: true,
+            osculating_at: Some((0, 2.5)),
+            ..ViewOptions::default()
+        },
+    );
+    common::assert_golden("analysis_badges", &px);
+}
+
+#[test]
+fn bezier_spline_and_catmull_rom_badges_golden() {
+    for (file, name) in [
+        (
+            "examples/bezier_spline.json",
+            "analysis_badges_bezier_spline",
+        ),
+        ("examples/catmull_rom.json", "analysis_badges_catmull_rom"),
+    ] {
+        let px = render_with(
+            &load(file),
+            ViewOptions {
+                badges: true,
+                ..ViewOptions::default()
+            },
+        );
+        common::assert_golden(name, &px);
+    }
+}
+
+/// A fixed-camera shot with `map` on.
+fn shot(doc: &Document, map: SurfaceMap) -> Shot {
+    let base = Shot {
+        width: 400,
+        height: 280,
+        camera: None,
+        options: map_options(map),
+        msaa: 1,
+    };
+    Shot {
+        camera: Some(shot_camera(doc, &base)),
+        ..base
+    }
+}
+
+/// Uploads what changed and draws one frame; returns the upload's bytes.
+fn frame(
+    renderer: &mut Renderer,
+    target: &mut OffscreenTarget,
+    gs: &mut GpuScene,
+    doc: &Document,
+    shot: &Shot,
+) -> usize {
+    let camera = shot_camera(doc, shot);
+    let aspect = shot.width as f64 / shot.height as f64;
+    let mut frame = renderer.begin_offscreen(target).unwrap();
+    let bytes = gs.upload(&mut frame, doc).unwrap().bytes;
+    frame.set_camera(camera.gpu(aspect, &doc.bounds()));
+    let lod = Lod::new(
+        camera.view_proj(aspect, &doc.bounds()),
+        [shot.width as f64, shot.height as f64],
+        frame.samples(),
+    );
+    gs.draw(&mut frame, doc, &shot.options, &Highlight::default(), &lod)
+        .unwrap();
+    frame.capture();
+    frame.finish().unwrap();
+    bytes
+}
+
+fn view(map: SurfaceMap) -> Option<MapView> {
+    Some(MapView { map, range: 0.5 })
+}
+
+fn offscreen(renderer: &mut Renderer, shot: &Shot) -> OffscreenTarget {
+    renderer
+        .create_offscreen(&OffscreenDesc {
+            width: shot.width,
+            height: shot.height,
+            samples: shot.msaa,
+        })
+        .unwrap()
+}
+
+fn surface_move(point: [usize; 2], delta: DVec3) -> Edit {
+    Edit {
+        object: 0,
+        edit: SurfaceEdit::Point(PointEdit::Move { point, delta }).into_object(),
+    }
+}
+
+#[test]
+fn dragging_with_a_map_ends_identical_to_a_fresh_upload() {
+    let (mut renderer, sink) = common::renderer();
+    let mut doc = Document::new(&load("examples/bspline_surface.json"));
+    doc.set_analysis(Some(SurfaceMap::Gaussian));
+    let [nu, nv] = match doc.objects[0].sampled.model() {
+        prespline::model::ModelRef::Surface(s) => s.surface().count(),
+        _ => unreachable!("the example is a surface"),
+    };
+    let s = shot(&doc, SurfaceMap::Mean);
+    let mut target = offscreen(&mut renderer, &s);
+    let mut gs = GpuScene::new(&mut renderer, &doc).unwrap();
+    gs.set_map(view(SurfaceMap::Gaussian));
+    let mut rng = common::Rng::new(11);
+    for f in 0..40 {
+        if f == 20 {
+            // A map change mid-way: the scalars are rebuilt, later drags keep them.
+            gs.set_map(view(SurfaceMap::Mean));
+        }
+        for _ in 0..1 + rng.range(0, 3) {
+            let p = [rng.range(0, nu), rng.range(0, nv)];
+            let d = DVec3::new(0.0, 0.0, 0.6 * f64::from(rng.f32(-1.0, 1.0)));
+            let e = surface_move(p, d);
+            let region = doc.apply(&e).unwrap();
+            gs.note(&doc, &e, &region);
+        }
+        frame(&mut renderer, &mut target, &mut gs, &doc, &s);
+    }
+    let incremental = renderer.read_pixels(&target).unwrap();
+    gs.destroy(&mut renderer);
+
+    let mut fresh_gs = GpuScene::new(&mut renderer, &doc).unwrap();
+    fresh_gs.set_map(view(SurfaceMap::Mean));
+    frame(&mut renderer, &mut target, &mut fresh_gs, &doc, &s);
+    let fresh = renderer.read_pixels(&target).unwrap();
+    fresh_gs.destroy(&mut renderer);
+
+    renderer.destroy_offscreen(target).unwrap();
+    common::teardown(renderer, sink);
+    let differing = incremental
+        .rgba
+        .chunks(4)
+        .zip(fresh.rgba.chunks(4))
+        .filter(|(a, b)| a != b)
+        .count();
+    assert_eq!(
+        differing, 0,
+        "{differing} pixels differ between the dragged map and a fresh one"
+    );
+}
+
+/// One interior drag with the map on copies the touched sample rows of the vertices and of the
+/// map, nothing more: 24 + 4 bytes per touched sample row entry, against 24 with the map off.
+#[test]
+fn a_drag_copies_only_its_rows_of_the_map() {
+    let (mut renderer, sink) = common::renderer();
+    let mut bytes = Vec::new();
+    for map in [None, Some(SurfaceMap::Gaussian)] {
+        let mut doc = Document::new(&load("examples/bspline_surface.json"));
+        doc.set_analysis(map);
+        let s = shot(&doc, SurfaceMap::Gaussian);
+        let mut target = offscreen(&mut renderer, &s);
+        let mut gs = GpuScene::new(&mut renderer, &doc).unwrap();
+        gs.set_map(map.and_then(view));
+        // The first frame builds the scalars; then both slots are up to date.
+        frame(&mut renderer, &mut target, &mut gs, &doc, &s);
+        frame(&mut renderer, &mut target, &mut gs, &doc, &s);
+        let e = surface_move([1, 1], DVec3::new(0.0, 0.0, 0.4));
+        let region = doc.apply(&e).unwrap();
+        gs.note(&doc, &e, &region);
+        let copied = frame(&mut renderer, &mut target, &mut gs, &doc, &s);
+        let cols = doc.objects[0].sampled.grid().dims[1];
+        let rows = region.rows.len();
+        assert!(rows > 0 && rows < doc.objects[0].sampled.grid().dims[0]);
+        // The moved control point itself: 3 floats of the control mirror.
+        let per_vertex = if map.is_some() { 28 } else { 24 };
+        assert_eq!(copied, rows * cols * per_vertex + 12, "map {map:?}");
+        bytes.push(copied);
+        gs.destroy(&mut renderer);
+        renderer.destroy_offscreen(target).unwrap();
+    }
+    common::teardown(renderer, sink);
+    assert!(bytes[1] > bytes[0]);
+}
