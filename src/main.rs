@@ -71,6 +71,9 @@ enum Command {
         recover: bool,
         #[command(flatten)]
         memory: MemoryArgs,
+        /// Open with a surface analysis map on: gaussian, mean, kmax, kmin or zebra (M cycles).
+        #[arg(long, value_name = "MAP", value_parser = SurfaceMap::parse)]
+        analysis: Option<SurfaceMap>,
     },
     /// Run a scripted, reproducible editing session and report where every millisecond goes.
     Bench {
@@ -271,6 +274,7 @@ fn main() -> ExitCode {
             samples,
             recover,
             memory,
+            analysis,
         } => cli::view::run(&cli::view::ViewOptions {
             scene: scene.as_deref(),
             size,
@@ -281,6 +285,7 @@ fn main() -> ExitCode {
             samples: samples.counts(),
             memory: memory.budget(),
             recover,
+            analysis,
         }),
         Command::Bench {
             scene,

@@ -150,3 +150,76 @@ fn toolbox_edits_keep_their_constructions_and_undo_exactly() {
     let shot = prespline::gpu::Pixels::read_png(&dir.join("shot-0.png")).unwrap();
     assert!(shot.width == 960 && shot.height == 600);
 }
+
+/// Pixels whose colour leans clearly to red (`red`) or to blue (`!red`).
+fn leaning(p: &prespline::gpu::Pixels, red: bool) -> usize {
+    p.rgba
+        .chunks_exact(4)
+        .filter(|c| {
+            let (r, b) = (i32::from(c[0]), i32::from(c[2]));
+            if red { r > b + 60 } else { b > r + 60 }
+        })
+        .count()
+}
+
+/// `view --analysis gaussian` opens with the map on (the exact sphere: K = 1 > 0, red), M moves
+/// on to the mean curvature (H = −1 with outward normals, blue), and a bad map name is refused
+/// before any window opens.
+#[test]
+fn view_opens_with_an_analysis_map_and_m_cycles_it() {
+    if std::env::var_os("DISPLAY").is_none_or(|d| d.is_empty()) {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "DISPLAY is not set under CI: run through make test (Xvfb)"
+        );
+        eprintln!("skipped: DISPLAY is not set (make test runs this under Xvfb)");
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("prespline-view-map-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (k, h) = (dir.join("k.png"), dir.join("h.png"));
+    let script = dir.join("script.json");
+    std::fs::write(
+        &script,
+        format!(
+            r#"[{{"frame": 4, "screenshot": {k:?}}}, {{"frame": 5, "key": "m"}},
+               {{"frame": 8, "screenshot": {h:?}}}, {{"frame": 9, "quit": true}}]"#
+        ),
+    )
+    .unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/sphere.json");
+    let icd = prespline::gpu::LAVAPIPE_ICD;
+    let view = |extra: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_prespline"))
+            .env("VK_DRIVER_FILES", icd)
+            .env("VK_ICD_FILENAMES", icd)
+            .env("PRESPLINE_VALIDATION", "1")
+            .args(["view", "--size", "640x480"])
+            .args(extra)
+            .arg(&scene)
+            .output()
+            .unwrap()
+    };
+    let out = view(&[
+        "--analysis",
+        "gaussian",
+        "--script",
+        script.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "viewer failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let k = prespline::gpu::Pixels::read_png(&k).unwrap();
+    let h = prespline::gpu::Pixels::read_png(&h).unwrap();
+    let area = (k.width * k.height) as usize;
+    assert!(leaning(&k, true) > area / 20, "K = 1 is not shown red");
+    assert!(leaning(&k, false) < area / 200, "K = 1 shows blue");
+    assert!(leaning(&h, false) > area / 20, "H = −1 is not shown blue");
+    assert!(leaning(&h, true) < area / 200, "H = −1 shows red");
+    let bad = view(&["--analysis", "curly"]);
+    assert!(!bad.status.success());
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(err.contains("--analysis") && err.contains("curly"), "{err}");
+}

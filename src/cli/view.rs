@@ -29,6 +29,8 @@ pub struct ViewOptions<'a> {
     pub memory: MemoryBudget,
     /// Open the scene's autosave (unsaved edits of an earlier session) instead of the scene.
     pub recover: bool,
+    /// A surface analysis map shown from the start (`--analysis`; M cycles it later).
+    pub analysis: Option<crate::render::maps::SurfaceMap>,
 }
 
 pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
@@ -76,6 +78,7 @@ pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
         Autosave::new(autosave_file)
     };
     super::render::check_drawable(&scene, Path::new(&title), &opts.memory)?;
+    super::render::check_analysis(&scene, opts.analysis, &opts.memory)?;
     if !app::display_available() {
         return Err(CliError(
             "no display: DISPLAY is not set (prespline view needs X11 or XWayland; headless: `prespline render` or `prespline bench`, or `make run` which falls back to a headless demo)".into(),
@@ -104,7 +107,7 @@ pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
         autosave: Some(autosave),
         msaa: 0,
         lod: true,
-        analysis: None,
+        analysis: opts.analysis,
     };
     let title = args.title.clone();
     let run = app::run(args).map_err(CliError)?;
