@@ -1,4 +1,4 @@
-//! Pre-evaluation benchmarks on the DESIGN.md "Performance model" workload:
+//! Pre-evaluation benchmarks on the reference workload (README "Performance"):
 //! a bicubic clamped uniform surface with 100×100 control points sampled 512×512 with S, Su, Sv
 //! and normals; a cubic curve with 1000 control points sampled 100 000 times with C, C'; edits of
 //! one interior point, one boundary point, ten random points, and an ERBS local-patch rotation;
@@ -238,7 +238,7 @@ fn bench(c: &mut Criterion) {
     g.finish();
 }
 
-/// ERBS structure, on the DESIGN.md surface: building an ERBS surface of 10 × 10 bicubic
+/// ERBS structure, on the reference surface: building an ERBS surface of 10 × 10 bicubic
 /// local patches from the 100 × 100 B-spline surface (Taylor patches at the knot crossings),
 /// alone and with its 512² pre-evaluation; and a local refinement (a u knot in the middle of
 /// an interval of the bench's ERBS surface), timed alone with its undo run untimed.

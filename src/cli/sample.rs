@@ -1,5 +1,5 @@
 //! `prespline sample`: samples every object of a scene (optionally after edits) and prints the
-//! DESIGN.md JSON contract on stdout.
+//! JSON contract of docs/scene-format.md on stdout.
 
 use super::CliError;
 use crate::sampling::budget::{MemoryBudget, Uses, check_scene};

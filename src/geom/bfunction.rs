@@ -133,7 +133,8 @@ fn polynomial(coeffs: &[f64], t: f64, out: &mut [f64]) {
 }
 
 /// S_F = 1 / ∫_0^1 exp(−(s−½)²/(s(1−s))) ds, to f64 precision. (Computed with 50-digit
-/// quadrature: 1.657137679738210303328…; DESIGN.md prints the 16th digit as …105.)
+/// quadrature: 1.657137679738210303328…; the original design notes printed the 16th digit as
+/// …105.)
 pub const EXPO_RATIONAL_SCALE: f64 = 1.657_137_679_738_210_3;
 
 /// φ(s) = exp(g(s)), g(s) = −(s−½)²/(s(1−s)) = 1 − ¼(1/s + 1/(1−s)).

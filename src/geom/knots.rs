@@ -1,7 +1,7 @@
 //! Knot vectors: validation, standard constructors, span search and multiplicity.
 //!
-//! Conventions (DESIGN.md): a degree-d B-spline with n control points has n+d+1 non-decreasing
-//! knots and domain [t_d, t_n]; the parameter t_n belongs to the last non-empty span.
+//! Conventions (docs/scene-format.md): a degree-d B-spline with n control points has n+d+1
+//! non-decreasing knots and domain [t_d, t_n]; the parameter t_n belongs to the last non-empty span.
 
 use super::error::{GeomError, GeomResult};
 use std::ops::Deref;
@@ -192,7 +192,8 @@ impl KnotVector {
     }
 }
 
-/// `m` sample parameters uniformly over [a, b], both ends included exactly (DESIGN.md: samples).
+/// `m` sample parameters uniformly over [a, b], both ends included exactly
+/// (docs/scene-format.md: samples).
 pub fn uniform_params(a: f64, b: f64, m: usize) -> Vec<f64> {
     assert!(
         m >= 2,

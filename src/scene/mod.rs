@@ -1,5 +1,5 @@
 //! Scenes: named objects with sample counts and display style, the JSON scene file format
-//! (DESIGN.md contract), edits, and the built-in demo.
+//! (the contract in docs/scene-format.md), edits, and the built-in demo.
 
 pub mod demo;
 pub mod edit;

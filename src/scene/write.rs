@@ -8,7 +8,7 @@ use crate::model::{Model, SplineForm};
 use glam::DVec3;
 use std::fmt::Write;
 
-/// Serialises a scene in the DESIGN.md format, one object per line.
+/// Serialises a scene in the format of docs/scene-format.md, one object per line.
 pub fn scene_to_json(scene: &Scene) -> String {
     let mut s = String::from("{\"objects\": [\n");
     for (i, o) in scene.objects.iter().enumerate() {

@@ -1,5 +1,5 @@
 //! Hierarchical ERBS, independently: constructed (`from`), nested, closed and refined ERBS curves
-//! and surfaces, written from the definitions and DESIGN.md only.
+//! and surfaces, written from the definitions and docs/scene-format.md only.
 //!
 //! Differences from the product on purpose:
 //!

@@ -1,8 +1,8 @@
 //! Independent reference evaluator ("oracle") for `prespline sample`.
 //!
-//! This module is shared by several integration-test binaries (`mod oracle;`). It is written
-//! from the contract in `DESIGN.md` only and deliberately uses algorithms different from the
-//! product's B-spline-Hermite matrices:
+//! This module is shared by the CPU test binary's modules (`tests/cpu`). It is written from
+//! the contract in `docs/scene-format.md` only and deliberately uses algorithms different
+//! from the product's B-spline-Hermite matrices:
 //!
 //! * Bézier curves: derivative control points (hodographs) evaluated by de Casteljau.
 //! * B-splines: local derivative control points (NURBS Book eq. 3.8 / A3.3 `CurveDerivCpts`)

@@ -1,5 +1,5 @@
-//! Scene model (parsed from `serde_json::Value` per the DESIGN.md scene contract), edits applied
-//! to the model, and the `prespline sample` output shape.
+//! Scene model (parsed from `serde_json::Value` per the scene contract of
+//! docs/scene-format.md), edits applied to the model, and the `prespline sample` output shape.
 
 use serde_json::{Map, Value, json};
 
