@@ -5,20 +5,15 @@
 //! a session that quits after 6.5 s without input draws exactly as many frames as one that
 //! quits after 1.5 s, so none were drawn in the 5 s between.
 
+mod common;
+
+use common::display;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+use std::time::Duration;
 
-fn display() -> bool {
-    let ok = std::env::var_os("DISPLAY").is_some_and(|d| !d.is_empty());
-    if !ok {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "CI is set but DISPLAY is not: run under Xvfb (make test does)"
-        );
-        eprintln!("skipped: DISPLAY is not set (make test runs this under Xvfb)");
-    }
-    ok
-}
+/// Longer than any session here (the longest quits after 6.5 s), short of a hung suite.
+const LIMIT: Duration = Duration::from_secs(120);
 
 fn prespline() -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_prespline"));
@@ -46,15 +41,16 @@ fn frame_starts(dir: &Path, quit_s: f64) -> Vec<f64> {
     let script = dir.join(format!("quit-{quit_s}.json"));
     std::fs::write(&script, format!(r#"[{{"t": {quit_s}, "quit": true}}]"#)).unwrap();
     let profile = dir.join(format!("profile-{quit_s}"));
-    let out = prespline()
-        .arg("view")
-        .arg(example())
-        .args(["--size", "320x240", "--script"])
-        .arg(&script)
-        .arg("--profile")
-        .arg(&profile)
-        .output()
-        .unwrap();
+    let out = common::output_with_timeout(
+        prespline()
+            .arg("view")
+            .arg(example())
+            .args(["--size", "320x240", "--script"])
+            .arg(&script)
+            .arg("--profile")
+            .arg(&profile),
+        LIMIT,
+    );
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "viewer failed: {err}");
     let csv = std::fs::read_to_string(profile.join("frames.csv")).unwrap();
@@ -95,14 +91,15 @@ fn run_with_lost_device(dir: &Path) -> Output {
             {"frame": 8, "move": [140, 120]}, {"frame": 40, "quit": true}]"#,
     )
     .unwrap();
-    prespline()
-        .arg("view")
-        .arg(example())
-        .args(["--size", "320x240", "--script"])
-        .arg(&script)
-        .env("PRESPLINE_FAULT", "device-lost@6")
-        .output()
-        .unwrap()
+    common::output_with_timeout(
+        prespline()
+            .arg("view")
+            .arg(example())
+            .args(["--size", "320x240", "--script"])
+            .arg(&script)
+            .env("PRESPLINE_FAULT", "device-lost@6"),
+        LIMIT,
+    )
 }
 
 #[test]

@@ -86,7 +86,7 @@ fn run(dir: &Path, undos: usize) -> Scene {
         .arg("--save-as")
         .arg(&saved)
         .arg(&scene);
-    let out = cmd.output().unwrap();
+    let out = common::output_with_timeout(&mut cmd, std::time::Duration::from_secs(300));
     assert!(
         out.status.success(),
         "viewer failed: {}",
@@ -97,19 +97,14 @@ fn run(dir: &Path, undos: usize) -> Scene {
 
 #[test]
 fn toolbox_edits_keep_their_constructions_and_undo_exactly() {
-    if std::env::var_os("DISPLAY").is_none_or(|d| d.is_empty()) {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "DISPLAY is not set under CI: run through make test (Xvfb)"
-        );
-        eprintln!("skipped: DISPLAY is not set (make test runs this under Xvfb)");
+    if !common::display() {
         return;
     }
-    let dir = std::env::temp_dir().join(format!("prespline-view-toolbox-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch = common::Scratch::new("view-toolbox");
+    let dir = scratch.path();
     let original = prespline::scene::parse_scene(SCENE).unwrap();
 
-    let edited = run(&dir, 0);
+    let edited = run(dir, 0);
     let by = |s: &Scene, n: &str| s.objects[s.find(n).unwrap()].model.clone();
     // The spline: handle 4 moved, its mirror 2 followed, the junction stayed; still C1.
     let (Model::BezierSpline(a), Model::BezierSpline(b)) =
@@ -143,7 +138,7 @@ fn toolbox_edits_keep_their_constructions_and_undo_exactly() {
     assert_eq!(w[4], 2.5);
 
     // Six steps (drag, drag, weight drag, typed weight, conversion, …) undone: bit for bit.
-    let undone = run(&dir, 5);
+    let undone = run(dir, 5);
     assert!(undone == original, "undo must restore the scene exactly");
     let text = prespline::scene::scene_to_json(&undone);
     assert_eq!(text, prespline::scene::scene_to_json(&original));
@@ -167,16 +162,10 @@ fn leaning(p: &prespline::gpu::Pixels, red: bool) -> usize {
 /// before any window opens.
 #[test]
 fn view_opens_with_an_analysis_map_and_m_cycles_it() {
-    if std::env::var_os("DISPLAY").is_none_or(|d| d.is_empty()) {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "DISPLAY is not set under CI: run through make test (Xvfb)"
-        );
-        eprintln!("skipped: DISPLAY is not set (make test runs this under Xvfb)");
+    if !common::display() {
         return;
     }
-    let dir = std::env::temp_dir().join(format!("prespline-view-map-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::Scratch::new("view-map");
     let (k, h) = (dir.join("k.png"), dir.join("h.png"));
     let script = dir.join("script.json");
     std::fs::write(
@@ -190,15 +179,14 @@ fn view_opens_with_an_analysis_map_and_m_cycles_it() {
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/sphere.json");
     let icd = prespline::gpu::LAVAPIPE_ICD;
     let view = |extra: &[&str]| {
-        Command::new(env!("CARGO_BIN_EXE_prespline"))
-            .env("VK_DRIVER_FILES", icd)
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_prespline"));
+        cmd.env("VK_DRIVER_FILES", icd)
             .env("VK_ICD_FILENAMES", icd)
             .env("PRESPLINE_VALIDATION", "1")
             .args(["view", "--size", "640x480"])
             .args(extra)
-            .arg(&scene)
-            .output()
-            .unwrap()
+            .arg(&scene);
+        common::output_with_timeout(&mut cmd, std::time::Duration::from_secs(300))
     };
     let out = view(&[
         "--analysis",
