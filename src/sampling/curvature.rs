@@ -20,10 +20,11 @@ pub fn fundamental_forms(p: &[DVec3; 5], n: DVec3) -> [f64; 2] {
     let [su, sv, suu, suv, svv] = *p;
     let (e, f, g) = (su.dot(su), su.dot(sv), sv.dot(sv));
     let (l, m, nn) = (suu.dot(n), suv.dot(n), svv.dot(n));
-    let det = e * g - f * f;
+    // One division for both (the lane kernel in `shape_of` computes exactly this).
+    let r = 1.0 / (e * g - f * f);
     [
-        (l * nn - m * m) / det,
-        (e * nn - 2.0 * f * m + g * l) / (2.0 * det),
+        (l * nn - m * m) * r,
+        (e * nn - 2.0 * f * m + g * l) * (0.5 * r),
     ]
 }
 
@@ -113,7 +114,8 @@ pub(crate) fn translate(
     // Basis value and first and second derivatives of column k (resp. l) at each sample.
     let coeffs = |t: &HermiteTable, c: usize, j: usize| {
         let col = c - t.first(j);
-        [0, 1, 2].map(|r| t.row(j, r).map_or(0.0, |row| row[col]))
+        let at = |r: usize| t.row(j, r).map_or(0.0, |row| row[col]);
+        [at(0), at(1), at(2)]
     };
     let cv: Vec<[f64; 3]> = cols.clone().map(|j| coeffs(tv, l, j)).collect();
     let mv = grid.dims[1];
@@ -165,7 +167,16 @@ pub(crate) fn shape_of(
     let (normals4, normals_rest) = normals.as_chunks_mut::<L>();
     let (curv4, curv_rest) = curv.as_chunks_mut::<L>();
     for (g, ((d, n), c)) in data4.iter().zip(normals4).zip(curv4).enumerate() {
-        let part = |p: usize| [0, 1, 2].map(|x| std::array::from_fn::<f64, L, _>(|l| d[l][p][x]));
+        // Plain loops, not `array::map`: the map was left as an out-of-line call per partial.
+        let part = |p: usize| {
+            let mut out = [[0.0; L]; 3];
+            for (x, o) in out.iter_mut().enumerate() {
+                for (l, o) in o.iter_mut().enumerate() {
+                    *o = d[l][p][x];
+                }
+            }
+            out
+        };
         let (u, v) = (part(1), part(2));
         let (nn, ok) = unit_normals::<L>(u, v);
         let dot = |a: &[[f64; L]; 3], b: &[[f64; L]; 3]| -> [f64; L] {
@@ -173,16 +184,16 @@ pub(crate) fn shape_of(
         };
         let (e, f, gg) = (dot(&u, &u), dot(&u, &v), dot(&v, &v));
         let (ll, m, n2) = (dot(&part(3), &nn), dot(&part(4), &nn), dot(&part(5), &nn));
+        let r: [f64; L] = std::array::from_fn(|l| 1.0 / (e[l] * gg[l] - f[l] * f[l]));
         // Through memory, so that the stores below do not pull the lanes apart (see
         // shading::normals_of).
         let stage: [[f64; L]; 6] = std::hint::black_box([
             nn[0],
             nn[1],
             nn[2],
-            std::array::from_fn(|l| (ll[l] * n2[l] - m[l] * m[l]) / (e[l] * gg[l] - f[l] * f[l])),
+            std::array::from_fn(|l| (ll[l] * n2[l] - m[l] * m[l]) * r[l]),
             std::array::from_fn(|l| {
-                (e[l] * n2[l] - 2.0 * f[l] * m[l] + gg[l] * ll[l])
-                    / (2.0 * (e[l] * gg[l] - f[l] * f[l]))
+                (e[l] * n2[l] - 2.0 * f[l] * m[l] + gg[l] * ll[l]) * (0.5 * r[l])
             }),
             ok,
         ]);
