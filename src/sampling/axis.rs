@@ -2,6 +2,7 @@
 
 use crate::geom::basis::hermite_rows_into;
 use crate::geom::knots::{KnotVector, uniform_params};
+use crate::geom::point::binomial;
 use std::ops::Range;
 
 /// Pre-evaluated basis data for one direction: sample parameters S, the span of each sample,
@@ -103,6 +104,48 @@ impl HermiteTable {
             ranges,
             knots: knots.clone(),
         }
+    }
+
+    /// The table of W·N_k at the same samples for a weight W given per sample with its
+    /// derivatives W^(0..=g), g this table's order: row r is Σ_{s ≤ r} C(r,s) W^(r−s) N^(s)
+    /// (Leibniz), kept for every order up to g, above the degree too. This is an ERBS local's
+    /// basis blended with its weight, so a local patch blends in by the tensor-product kernels.
+    #[must_use]
+    pub fn blended<'w>(&self, weight: impl Fn(usize) -> &'w [f64]) -> Self {
+        let w = self.degree + 1;
+        let rows = self.order + 1;
+        let mut m = vec![0.0; self.params.len() * rows * w];
+        for (j, out) in m.chunks_exact_mut(rows * w).enumerate() {
+            let wj = weight(j);
+            for (r, out) in out.chunks_exact_mut(w).enumerate() {
+                for s in 0..=r.min(self.rows - 1) {
+                    let c = binomial(r, s) * wj[r - s];
+                    let src = &self.m[(j * self.rows + s) * w..][..w];
+                    for (o, &x) in out.iter_mut().zip(src) {
+                        *o += c * x;
+                    }
+                }
+            }
+        }
+        Self {
+            params: self.params.clone(),
+            spans: self.spans.clone(),
+            degree: self.degree,
+            rows,
+            order: self.order,
+            m,
+            ranges: self.ranges.clone(),
+            knots: self.knots.clone(),
+        }
+    }
+
+    /// Whether both tables tabulate the same basis (degree, knots, control count) at the same
+    /// parameters.
+    pub fn same_basis(&self, other: &Self) -> bool {
+        self.degree == other.degree
+            && self.ranges.len() == other.ranges.len()
+            && self.knots == other.knots
+            && self.params == other.params
     }
 
     /// Whether this table is the pre-evaluation of a degree-`degree` B-spline with `n` control

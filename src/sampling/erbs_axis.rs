@@ -37,6 +37,15 @@ pub struct ErbsAxis {
     blend: Vec<f64>,
     /// Per local: the samples it covers.
     pieces: Vec<Vec<Piece>>,
+    /// The samples of each knot interval met, in order.
+    cells: Vec<Cell>,
+}
+
+/// The samples of one knot interval and its two active locals (left, then right).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cell {
+    pub samples: Range<usize>,
+    pub locals: [usize; 2],
 }
 
 impl ErbsAxis {
@@ -49,12 +58,14 @@ impl ErbsAxis {
             blend.extend_from_slice(&right);
         }
         let pieces = pieces(knots, &params, &spans);
+        let cells = cells(knots, &spans);
         Self {
             params,
             spans,
             order,
             blend,
             pieces,
+            cells,
         }
     }
 
@@ -79,12 +90,14 @@ impl ErbsAxis {
             }
         }
         let pieces = pieces(knots, &self.params, &spans);
+        let cells = cells(knots, &spans);
         Self {
             params: self.params.clone(),
             spans,
             order: self.order,
             blend,
             pieces,
+            cells,
         }
     }
 
@@ -126,6 +139,27 @@ impl ErbsAxis {
             .collect()
     }
 
+    /// The level sample of each of local l's samples, in its own order.
+    pub fn local_rows(&self, l: usize) -> Vec<usize> {
+        self.pieces[l]
+            .iter()
+            .flat_map(|p| p.samples.clone())
+            .collect()
+    }
+
+    /// Local l's own index of level sample j (which it must cover).
+    pub fn local_index(&self, l: usize, j: usize) -> usize {
+        let p = self.pieces[l]
+            .iter()
+            .find(|p| p.samples.contains(&j))
+            .expect("the local covers the sample");
+        j - p.samples.start + p.offset
+    }
+
+    pub fn cells(&self) -> &[Cell] {
+        &self.cells
+    }
+
     /// How many samples local l covers.
     pub fn local_len(&self, l: usize) -> usize {
         self.pieces[l].iter().map(|p| p.samples.len()).sum()
@@ -159,6 +193,21 @@ impl ErbsAxis {
         };
         lo..hi.max(lo)
     }
+}
+
+/// The runs of samples with one interval, with the interval's two locals.
+fn cells(knots: &ErbsKnots, spans: &[usize]) -> Vec<Cell> {
+    let mut cells: Vec<Cell> = Vec::new();
+    for (j, &i) in spans.iter().enumerate() {
+        match cells.last_mut() {
+            Some(c) if c.locals[0] == i => c.samples.end = j + 1,
+            _ => cells.push(Cell {
+                samples: j..j + 1,
+                locals: [i, knots.right(i).0],
+            }),
+        }
+    }
+    cells
 }
 
 /// For every local, the runs of consecutive samples where it is active with one shift, ordered

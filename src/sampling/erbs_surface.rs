@@ -1,131 +1,76 @@
-//! Pre-evaluated ERBS surfaces, hierarchically: every local patch is pre-sampled on its support
-//! sub-grid at its parent's parameters (a polynomial patch in two passes, an ERBS patch as a
-//! level of its own), and blended by the Leibniz rule in both directions. An edit at any depth
-//! returns the change of that level's samples over the edited patch's support; each parent
-//! blends it in over the same samples.
+//! Pre-evaluated ERBS surfaces, hierarchically. A polynomial local patch keeps its net and its
+//! blended Hermite tables (`erbs_patch`), so over one knot cell the surface is a tensor product
+//! of the 2 × 2 active patches' bases on an 8 × 8 net, sampled in one pass, and an edit of a
+//! patch is a net delta through its tables over its support. An ERBS local patch is a level of
+//! its own, pre-sampled at its parent's parameters: an edit at any depth returns the change of
+//! that level's samples over the edited patch's support, and each parent blends it in by the
+//! Leibniz rule over the same samples.
 
-use super::axis::HermiteTable;
+use super::dense::{self, DenseRow, Target};
 use super::dirty::DirtyRegion;
-use super::erbs_axis::{ErbsAxis, Piece};
+use super::erbs_axis::ErbsAxis;
+use super::erbs_patch::{BlendTerm, DENSE, Out, SplinePatch, add_share, clip};
 use super::grid::{PartialSet, SampleGrid};
 use super::normals::NormalSource;
 use super::object::Sampler;
-use super::shading::{self, ShadingGrid};
-use super::spline_surface::{Rect, two_pass};
-use crate::geom::erbs::{ErbsSurface, LocalPatch};
+use crate::geom::erbs::{ErbsKnots, ErbsSurface, LocalPatch};
 use crate::geom::knots::uniform_params;
 use crate::geom::point::binomial;
 use crate::model::{ErbsEdit, ErbsSurfaceEdit, ErbsSurfaceModel, KindEdit, LocalEdit};
 use glam::{DMat4, DVec3};
 use std::ops::Range;
 
-/// A change of a level's samples over `rows × cols`, `stride` vectors per sample, row-major.
+/// A change of a level's samples over `rows × cols`, `stride` vectors per sample, row-major
+/// (`values` empty at the top level, which only needs where).
 #[derive(Debug, Clone)]
 pub(crate) struct Patch {
     pub rows: Range<usize>,
     pub cols: Range<usize>,
     pub values: Vec<DVec3>,
+    /// Whether a kernel already wrote these samples' unit normals.
+    pub normals: bool,
 }
 
-/// What reaches a local patch at the end of a path.
+/// What reaches the local patch at the end of a path, after the model changed.
 pub(crate) enum PatchOp<'a> {
-    Transform(&'a DMat4),
-    MovePoint([usize; 2], DVec3),
-    Replace(&'a LocalPatch),
+    /// The local was mapped by A (an ERBS local's samples follow A directly); its new state.
+    Transform(&'a DMat4, &'a LocalPatch),
+    /// The local's new state (points moved, replaced, refined, nested).
+    Update(&'a LocalPatch),
 }
 
-/// One local patch's pre-evaluation on its support sub-grid (local rows × local cols).
 #[derive(Debug, Clone)]
 enum PatchLevel {
-    Spline {
-        tables: Box<[HermiteTable; 2]>,
-        samples: Vec<DVec3>,
-    },
+    Spline(SplinePatch),
     Erbs(Box<SurfaceLevel>),
 }
 
 impl PatchLevel {
-    fn new(patch: &LocalPatch, params: [Vec<f64>; 2], set: &PartialSet) -> Self {
-        let g = set.max_order();
+    fn new(patch: &LocalPatch, axes: &[ErbsAxis; 2], kl: [usize; 2], set: &PartialSet) -> Self {
         match patch {
             LocalPatch::Spline { surface, .. } => {
-                let [ku, kv] = surface.knots();
-                let [du, dv] = surface.degree();
-                let [nu, nv] = surface.count();
-                let [pu, pv] = params;
-                let tables = [
-                    HermiteTable::at_params(ku, du, nu, pu, g),
-                    HermiteTable::at_params(kv, dv, nv, pv, g),
-                ];
-                let (rows, cols) = (tables[0].len(), tables[1].len());
-                let mut samples = vec![DVec3::ZERO; rows * cols * set.len()];
-                sample_spline(&tables, surface.points(), nv, set, &mut samples);
-                PatchLevel::Spline {
-                    tables: Box::new(tables),
-                    samples,
-                }
+                PatchLevel::Spline(SplinePatch::new(surface, axes, kl, set))
             }
-            LocalPatch::Erbs(e) => PatchLevel::Erbs(Box::new(SurfaceLevel::new(
-                e,
-                params,
-                set.clone(),
-                false,
-                true,
-            ))),
+            LocalPatch::Erbs(e) => {
+                let params = [axes[0].local_params(kl[0]), axes[1].local_params(kl[1])];
+                PatchLevel::Erbs(Box::new(SurfaceLevel::new(
+                    e,
+                    params,
+                    set.clone(),
+                    false,
+                    true,
+                )))
+            }
         }
     }
 
-    fn samples(&self) -> &[DVec3] {
+    /// Maps the patch by A; an ERBS patch writes the change of its samples into `delta`.
+    fn transform(&mut self, a: &DMat4, delta: &mut Vec<DVec3>) {
         match self {
-            PatchLevel::Spline { samples, .. } => samples,
-            PatchLevel::Erbs(s) => &s.grid.data,
-        }
-    }
-
-    fn samples_mut(&mut self) -> &mut Vec<DVec3> {
-        match self {
-            PatchLevel::Spline { samples, .. } => samples,
-            PatchLevel::Erbs(s) => &mut s.grid.data,
-        }
-    }
-
-    /// Applies A to the samples, writing their change into `delta` (resized to fit).
-    fn transform(&mut self, a: &DMat4, stride: usize, delta: &mut Vec<DVec3>) {
-        match self {
-            PatchLevel::Spline { samples, .. } => transform_samples(samples, a, stride, delta),
+            PatchLevel::Spline(p) => p.map_points(|x| a.transform_point3(x)),
             PatchLevel::Erbs(s) => s.transform_all(a, delta),
         }
     }
-}
-
-/// Samples a polynomial patch on its tables' sub-grid: the shading kernel for S, Su, Sv of
-/// degrees 1..=3, the generic two passes otherwise.
-fn sample_spline(
-    tables: &[HermiteTable; 2],
-    points: &[DVec3],
-    nv: usize,
-    set: &PartialSet,
-    out: &mut [DVec3],
-) {
-    let [tu, tv] = tables;
-    let (rows, cols) = (tu.len(), tv.len());
-    if *set == PartialSet::Shading && shading::surface_supported([tu.degree(), tv.degree()]) {
-        let grid = ShadingGrid {
-            data: out,
-            normals: None,
-            width: cols,
-        };
-        shading::sample_surface(tu, tv, points, nv, 0..rows, 0..cols, grid, &mut Vec::new());
-        return;
-    }
-    let rect = Rect {
-        rows: 0..rows,
-        cols: 0..cols,
-        origin: (0, 0),
-        width: cols,
-        stride: set.len(),
-    };
-    two_pass(tu, tv, points, nv, &set.list(), &rect, out);
 }
 
 /// Applies A to every sample (slot 0 as a point, the partials as vectors), writing the change
@@ -149,22 +94,19 @@ fn transform_samples(samples: &mut [DVec3], a: &DMat4, stride: usize, delta: &mu
     }
 }
 
-/// Where a blend takes a patch's change from.
-enum Delta<'a> {
-    /// The change, local rows × cols.
-    Values(&'a [DVec3]),
-    /// The patch's samples, to be transformed by A as they are blended (each exactly once:
-    /// the pieces of a support partition its local samples).
-    Transform(&'a mut [DVec3], &'a DMat4),
+/// One knot cell's 2 × 2 patches side by side: width-8 bases and the 8 × 8 net.
+struct DenseCell {
+    cu: Vec<DenseRow<{ 2 * DENSE }>>,
+    cv: Vec<DenseRow<{ 2 * DENSE }>>,
+    net: [[DVec3; 2 * DENSE]; 2 * DENSE],
 }
-
-/// For output partial (a, b): Σ over (a', b') ≤ (a, b) of C(a,a')C(b,b') Wu^(a−a') Wv^(b−b') s^(a'b').
-type BlendTerm = (f64, usize, usize, usize);
 
 /// An ERBS surface pre-evaluated at given parameters per direction.
 #[derive(Debug, Clone)]
 pub(crate) struct SurfaceLevel {
     axes: [ErbsAxis; 2],
+    /// The knots the axes tabulate, so a refresh can tell whether the structure changed.
+    knots: [ErbsKnots; 2],
     partials: Vec<(usize, usize)>,
     terms: Vec<Vec<BlendTerm>>,
     /// Row-major [nu][nv].
@@ -173,14 +115,31 @@ pub(crate) struct SurfaceLevel {
     /// Whether a change is returned with its values: a parent level blends them in; the top
     /// level only needs where it changed.
     record: bool,
-    /// The partials are S, Su, Sv (drawing): the blend runs a fixed kernel.
+    /// The partials are S, Su, Sv (drawing): dense patches go through the dense kernels.
     shading: bool,
-    /// The change of the edited patch's samples, kept between edits.
+    /// The change of an ERBS patch's samples, kept between edits.
     scratch: Vec<DVec3>,
+    /// Samples whose normal degenerated in a kernel, for the sampler's model fallback.
+    pub degenerate: Vec<(usize, usize)>,
 }
 
 impl SurfaceLevel {
+    /// The level, sampled.
     pub fn new(
+        surface: &ErbsSurface,
+        params: [Vec<f64>; 2],
+        set: PartialSet,
+        normals: bool,
+        record: bool,
+    ) -> Self {
+        let mut level = Self::tabulated(surface, params, set, normals, record);
+        let [mu, mv] = level.grid.dims;
+        level.fill(&[0..mu, 0..mv]);
+        level
+    }
+
+    /// The level's tables and nets, not sampled yet.
+    fn tabulated(
         surface: &ErbsSurface,
         params: [Vec<f64>; 2],
         set: PartialSet,
@@ -220,69 +179,200 @@ impl SurfaceLevel {
                 t
             })
             .collect();
-        let [nu, nv] = surface.count();
-        let patches = (0..nu * nv)
-            .map(|idx| {
-                let (k, l) = (idx / nv, idx % nv);
-                PatchLevel::new(
-                    surface.local_patch(k, l),
-                    [axes[0].local_params(k), axes[1].local_params(l)],
-                    &set,
-                )
-            })
+        let nv = surface.count()[1];
+        let patches = surface
+            .local_patches()
+            .iter()
+            .enumerate()
+            .map(|(idx, p)| PatchLevel::new(p, &axes, [idx / nv, idx % nv], &set))
             .collect();
-        let mut level = Self {
+        Self {
             axes,
+            knots: surface.knots().clone(),
             partials,
             terms,
             patches,
             grid: SampleGrid::new(dims, set, normals),
-            record: false,
+            record,
             shading,
             scratch: Vec::new(),
-        };
-        for idx in 0..level.patches.len() {
-            level.blend_patch(idx, None);
+            degenerate: Vec::new(),
         }
-        level.record = record;
-        level
-    }
-
-    /// Blends patch idx's own samples in whole (restricted to level rows `only` if given).
-    fn blend_patch(&mut self, idx: usize, only: Option<&[Range<usize>; 2]>) {
-        let values = std::mem::take(self.patches[idx].samples_mut());
-        let all = self.local_dims(idx);
-        let record = std::mem::replace(&mut self.record, false);
-        self.blend(
-            idx,
-            &mut Delta::Values(&values),
-            [0..all[0], 0..all[1]],
-            only,
-        );
-        self.record = record;
-        *self.patches[idx].samples_mut() = values;
     }
 
     fn nv(&self) -> usize {
         self.axes[1].locals()
     }
 
-    /// Local sub-grid size of patch idx: [local rows, local cols].
-    fn local_dims(&self, idx: usize) -> [usize; 2] {
-        let nv = self.nv();
-        [
-            self.axes[0].local_len(idx / nv),
-            self.axes[1].local_len(idx % nv),
-        ]
+    fn all(&self) -> [Range<usize>; 2] {
+        [0..self.grid.dims[0], 0..self.grid.dims[1]]
     }
 
-    /// ∂^{ab}P += Σ C(a,a')C(b,b') Wu_k^(a−a') Wv_l^(b−b') Δs^(a'b') for the patch's local
-    /// samples `local` (rows × cols; `delta` covers exactly them), restricted to level rows
+    /// Whether every local patch is polynomial (no deeper level can drift on its own).
+    pub fn is_flat(&self) -> bool {
+        self.patches
+            .iter()
+            .all(|p| matches!(p, PatchLevel::Spline(_)))
+    }
+
+    /// Samples `region` again from the patches, knot cell by knot cell.
+    pub fn fill(&mut self, region: &[Range<usize>; 2]) -> Patch {
+        let mut normals = true;
+        let ucells = self.axes[0].cells().to_vec();
+        let vcells = self.axes[1].cells().to_vec();
+        for cu in &ucells {
+            let rows = clip(&cu.samples, &region[0]);
+            if rows.is_empty() {
+                continue;
+            }
+            for cv in &vcells {
+                let cols = clip(&cv.samples, &region[1]);
+                if !cols.is_empty() {
+                    normals &= self.fill_cell(cu.locals, cv.locals, [rows.clone(), cols]);
+                }
+            }
+        }
+        Patch {
+            rows: region[0].clone(),
+            cols: region[1].clone(),
+            values: Vec::new(),
+            normals: normals && self.grid.normals.is_some(),
+        }
+    }
+
+    /// One knot cell's samples in `rect`: in one dense pass when its four patches allow,
+    /// otherwise as the sum of the four shares. Returns whether the normals were written.
+    fn fill_cell(&mut self, ku: [usize; 2], kv: [usize; 2], rect: [Range<usize>; 2]) -> bool {
+        let nv = self.nv();
+        let ids = ku.map(|k| kv.map(|l| k * nv + l));
+        let mv = self.grid.dims[1];
+        if let Some(cell) = self.dense_cell(ids, ku, kv, &rect) {
+            let target = Target {
+                data: &mut self.grid.data,
+                normals: self.grid.normals.as_deref_mut(),
+                width: mv,
+                row0: rect[0].start,
+                col0: rect[1].start,
+            };
+            dense::pass::<{ 2 * DENSE }, { 2 * DENSE }, false>(
+                &cell.cu,
+                &cell.cv,
+                &cell.net,
+                target,
+                &mut self.degenerate,
+            );
+            return true;
+        }
+        let stride = self.partials.len();
+        for i in rect[0].clone() {
+            self.grid.data[(i * mv + rect[1].start) * stride..(i * mv + rect[1].end) * stride]
+                .fill(DVec3::ZERO);
+        }
+        for idx in ids.into_iter().flatten() {
+            match &self.patches[idx] {
+                PatchLevel::Spline(p) => {
+                    let mut out = Out {
+                        data: &mut self.grid.data,
+                        origin: (0, 0),
+                        width: mv,
+                        stride,
+                    };
+                    let kl = [idx / nv, idx % nv];
+                    add_share(
+                        p,
+                        &self.axes,
+                        kl,
+                        &p.points,
+                        &rect,
+                        &self.partials,
+                        &self.terms,
+                        &mut out,
+                    );
+                }
+                PatchLevel::Erbs(_) => self.blend_patch(idx, &rect),
+            }
+        }
+        false
+    }
+
+    /// The cell's patches side by side, when all four are dense, on a `Shading` level, and the
+    /// two patches of each row (column) share their u (v) basis — the cell is then a tensor
+    /// product.
+    fn dense_cell(
+        &self,
+        ids: [[usize; 2]; 2],
+        ku: [usize; 2],
+        kv: [usize; 2],
+        rect: &[Range<usize>; 2],
+    ) -> Option<DenseCell> {
+        if !self.shading {
+            return None;
+        }
+        let p = ids.map(|row| {
+            row.map(|idx| match &self.patches[idx] {
+                PatchLevel::Spline(p) => p.dense.as_ref().map(|d| (p, d)),
+                PatchLevel::Erbs(_) => None,
+            })
+        });
+        let p = p.map(|row| row.map(|x| x.ok_or(())));
+        let [[Ok(p00), Ok(p01)], [Ok(p10), Ok(p11)]] = p else {
+            return None;
+        };
+        let same =
+            |a: &SplinePatch, b: &SplinePatch, dir: usize| a.tables[dir].same_basis(&b.tables[dir]);
+        if !(same(p00.0, p01.0, 0)
+            && same(p10.0, p11.0, 0)
+            && same(p00.0, p10.0, 1)
+            && same(p01.0, p11.0, 1))
+        {
+            return None;
+        }
+        let [p00, p01, p10, p11] = [p00.1, p01.1, p10.1, p11.1];
+        let side = |dir: usize, locals: [usize; 2], halves: [&[DenseRow<DENSE>]; 2]| {
+            let r = &rect[dir];
+            let first = locals.map(|k| self.axes[dir].local_index(k, r.start));
+            r.clone()
+                .map(|i| {
+                    let t = i - r.start;
+                    std::array::from_fn(|o| {
+                        std::array::from_fn(|c| {
+                            halves[c / DENSE][first[c / DENSE] + t][o][c % DENSE]
+                        })
+                    })
+                })
+                .collect::<Vec<DenseRow<{ 2 * DENSE }>>>()
+        };
+        let cu = side(0, ku, [&p00.rows[0], &p10.rows[0]]);
+        let cv = side(1, kv, [&p00.rows[1], &p01.rows[1]]);
+        let nets = [[&p00.net, &p01.net], [&p10.net, &p11.net]];
+        let net = std::array::from_fn(|a| {
+            std::array::from_fn(|b| nets[a / DENSE][b / DENSE][a % DENSE][b % DENSE])
+        });
+        Some(DenseCell { cu, cv, net })
+    }
+
+    /// Blends ERBS patch idx's own samples in whole over the level samples in `rect`.
+    fn blend_patch(&mut self, idx: usize, rect: &[Range<usize>; 2]) {
+        let PatchLevel::Erbs(child) = &mut self.patches[idx] else {
+            return;
+        };
+        let values = std::mem::take(&mut child.grid.data);
+        let all = child.all();
+        let record = std::mem::replace(&mut self.record, false);
+        self.blend(idx, &values, all, Some(rect));
+        self.record = record;
+        if let PatchLevel::Erbs(child) = &mut self.patches[idx] {
+            child.grid.data = values;
+        }
+    }
+
+    /// ∂^{ab}P += Σ C(a,a')C(b,b') Wu_k^(a−a') Wv_l^(b−b') Δs^(a'b') for ERBS patch idx's local
+    /// samples `local` (rows × cols; `delta` covers exactly them), restricted to level samples
     /// `only` if given. Returns the change of this level's samples, rectangle by rectangle.
     fn blend(
         &mut self,
         idx: usize,
-        source: &mut Delta,
+        delta: &[DVec3],
         local: [Range<usize>; 2],
         only: Option<&[Range<usize>; 2]>,
     ) -> Vec<Patch> {
@@ -292,27 +382,23 @@ impl SurfaceLevel {
         let width = local[1].len();
         let mv = self.grid.dims[1];
         let mut out = Vec::new();
-        let mut row = Vec::new();
-        let upieces: Vec<Piece> = self.axes[0].pieces(k).to_vec();
-        let vpieces: Vec<Piece> = self.axes[1].pieces(l).to_vec();
-        for pu in &upieces {
+        for pu in self.axes[0].pieces(k) {
             let Some(mut rows) = pu.level_range(&local[0]) else {
                 continue;
             };
             if let Some(o) = only {
-                rows = rows.start.max(o[0].start)..rows.end.min(o[0].end);
+                rows = clip(&rows, &o[0]);
             }
-            for pv in &vpieces {
+            for pv in self.axes[1].pieces(l) {
                 let Some(mut cols) = pv.level_range(&local[1]) else {
                     continue;
                 };
                 if let Some(o) = only {
-                    cols = cols.start.max(o[1].start)..cols.end.min(o[1].end);
+                    cols = clip(&cols, &o[1]);
                 }
                 if rows.is_empty() || cols.is_empty() {
                     continue;
                 }
-                let rows = rows.clone();
                 let n = if self.record {
                     rows.len() * cols.len() * stride
                 } else {
@@ -324,15 +410,8 @@ impl SurfaceLevel {
                 for i in rows.clone() {
                     let wu = self.axes[0].weights(i, k);
                     let li = i - pu.samples.start + pu.offset - local[0].start;
-                    let span =
-                        (li * width + lj0) * stride..(li * width + lj0 + cols.len()) * stride;
-                    let d = match source {
-                        Delta::Values(delta) => &delta[span],
-                        Delta::Transform(samples, a) => {
-                            transform_samples(&mut samples[span], a, stride, &mut row);
-                            &row
-                        }
-                    };
+                    let d = &delta
+                        [(li * width + lj0) * stride..(li * width + lj0 + cols.len()) * stride];
                     let o = &mut self.grid.data[(i * mv + cols.start) * stride..]
                         [..cols.len() * stride];
                     if self.shading {
@@ -356,27 +435,35 @@ impl SurfaceLevel {
                         }
                     }
                 }
-                out.push(Patch { rows, cols, values });
+                out.push(Patch {
+                    rows: rows.clone(),
+                    cols,
+                    values,
+                    normals: false,
+                });
             }
         }
         out
     }
 
+    /// Maps every patch and every sample by A (nested levels only: they keep no normals).
     fn transform_all(&mut self, a: &DMat4, delta: &mut Vec<DVec3>) {
         let stride = self.partials.len();
         for p in &mut self.patches {
-            p.transform(a, stride, delta);
+            p.transform(a, delta);
         }
         transform_samples(&mut self.grid.data, a, stride, delta);
     }
 
     /// Applies `op` to the patch at `path` and returns this level's change.
     pub fn apply(&mut self, path: &[[usize; 2]], op: &PatchOp) -> Vec<Patch> {
-        let stride = self.partials.len();
         let Some((&[k, l], rest)) = path.split_first() else {
             return Vec::new();
         };
         let idx = k * self.nv() + l;
+        if idx >= self.patches.len() {
+            return Vec::new();
+        }
         if !rest.is_empty() {
             let PatchLevel::Erbs(child) = &mut self.patches[idx] else {
                 return Vec::new();
@@ -384,86 +471,207 @@ impl SurfaceLevel {
             let changes = child.apply(rest, op);
             return changes
                 .into_iter()
-                .flat_map(|c| {
-                    self.blend(idx, &mut Delta::Values(&c.values), [c.rows, c.cols], None)
-                })
+                .flat_map(|c| self.blend(idx, &c.values, [c.rows, c.cols], None))
                 .collect();
         }
-        let dims = self.local_dims(idx);
-        let all = [0..dims[0], 0..dims[1]];
-        match *op {
-            PatchOp::Transform(a) => {
-                if let PatchLevel::Spline { samples, .. } = &mut self.patches[idx] {
-                    // A row at a time, straight into the blend: the patch's change never
-                    // goes through memory as a whole.
-                    let mut samples = std::mem::take(samples);
-                    let changes =
-                        self.blend(idx, &mut Delta::Transform(&mut samples, a), all, None);
-                    *self.patches[idx].samples_mut() = samples;
-                    return changes;
-                }
+        match (op, &mut self.patches[idx]) {
+            (PatchOp::Transform(a, _), PatchLevel::Erbs(child)) => {
                 let mut delta = std::mem::take(&mut self.scratch);
-                self.patches[idx].transform(a, stride, &mut delta);
-                let changes = self.blend(idx, &mut Delta::Values(&delta), all, None);
+                child.transform_all(a, &mut delta);
+                let all = child.all();
+                let changes = self.blend(idx, &delta, all, None);
                 self.scratch = delta;
                 changes
             }
-            PatchOp::MovePoint([qa, qb], d) => {
-                let PatchLevel::Spline {
-                    tables, samples, ..
-                } = &mut self.patches[idx]
-                else {
-                    return Vec::new();
+            (PatchOp::Transform(_, new) | PatchOp::Update(new), _) => self.update(idx, new),
+        }
+    }
+
+    /// Patch idx became `new`: a net delta through its tables when only its points moved,
+    /// otherwise pre-evaluated again and its support sampled again.
+    fn update(&mut self, idx: usize, new: &LocalPatch) -> Vec<Patch> {
+        if let (PatchLevel::Spline(p), LocalPatch::Spline { surface, .. }) =
+            (&mut self.patches[idx], new)
+            && p.holds(surface)
+        {
+            let delta: Vec<DVec3> = surface
+                .points()
+                .iter()
+                .zip(&p.points)
+                .map(|(n, o)| *n - *o)
+                .collect();
+            p.set_points(surface.points());
+            return self.add_net(idx, &delta);
+        }
+        let nv = self.nv();
+        self.patches[idx] =
+            PatchLevel::new(new, &self.axes, [idx / nv, idx % nv], &self.grid.partials);
+        self.refill_support(idx)
+    }
+
+    /// Adds polynomial patch idx's share for a net change `delta` (the points that did not
+    /// move bound the samples touched).
+    fn add_net(&mut self, idx: usize, delta: &[DVec3]) -> Vec<Patch> {
+        let nv = self.nv();
+        let kl = [idx / nv, idx % nv];
+        let Self {
+            axes,
+            partials,
+            terms,
+            patches,
+            grid,
+            record,
+            degenerate,
+            ..
+        } = self;
+        let PatchLevel::Spline(p) = &patches[idx] else {
+            return Vec::new();
+        };
+        let [nun, nvn] = p.count;
+        let moved: Vec<(usize, usize)> = (0..nun * nvn)
+            .filter(|&q| delta[q] != DVec3::ZERO)
+            .map(|q| (q / nvn, q % nvn))
+            .collect();
+        let (Some(a0), Some(a1)) = (
+            moved.iter().map(|m| m.0).min(),
+            moved.iter().map(|m| m.0).max(),
+        ) else {
+            return Vec::new();
+        };
+        let b0 = moved.iter().map(|m| m.1).min().unwrap_or(0);
+        let b1 = moved.iter().map(|m| m.1).max().unwrap_or(0);
+        let local = p.touched(a0..a1 + 1, b0..b1 + 1);
+        let stride = partials.len();
+        let mv = grid.dims[1];
+        let mut out = Vec::new();
+        for pu in axes[0].pieces(kl[0]) {
+            let Some(rows) = pu.level_range(&local[0]) else {
+                continue;
+            };
+            for pv in axes[1].pieces(kl[1]) {
+                let Some(cols) = pv.level_range(&local[1]) else {
+                    continue;
                 };
-                let (rows, cols) = (tables[0].range(qa), tables[1].range(qb));
-                let width = dims[1];
-                let mut delta = Vec::with_capacity(rows.len() * cols.len() * stride);
-                for li in rows.clone() {
-                    for lj in cols.clone() {
-                        let base = (li * width + lj) * stride;
-                        for (slot, &(a, b)) in self.partials.iter().enumerate() {
-                            let c = coefficient(&tables[0], li, a, qa)
-                                * coefficient(&tables[1], lj, b, qb);
-                            samples[base + slot] += d * c;
-                            delta.push(d * c);
+                let rect = [rows.clone(), cols.clone()];
+                let n = rows.len() * cols.len() * stride;
+                let mut values = if *record {
+                    vec![DVec3::ZERO; n]
+                } else {
+                    Vec::new()
+                };
+                let mut normals = false;
+                match &p.dense {
+                    Some(d) => {
+                        let lr = rows.start - pu.samples.start + pu.offset;
+                        let lc = cols.start - pv.samples.start + pv.offset;
+                        let cu = &d.rows[0][lr..lr + rows.len()];
+                        let cv = &d.rows[1][lc..lc + cols.len()];
+                        let net = super::erbs_patch::padded(delta, p.count);
+                        if *record {
+                            let target = Target {
+                                data: &mut values,
+                                normals: None,
+                                width: cols.len(),
+                                row0: 0,
+                                col0: 0,
+                            };
+                            dense::pass::<DENSE, DENSE, false>(cu, cv, &net, target, degenerate);
+                        } else {
+                            normals = grid.normals.is_some();
+                            let target = Target {
+                                data: &mut grid.data,
+                                normals: grid.normals.as_deref_mut(),
+                                width: mv,
+                                row0: rows.start,
+                                col0: cols.start,
+                            };
+                            dense::pass::<DENSE, DENSE, true>(cu, cv, &net, target, degenerate);
                         }
                     }
+                    None => {
+                        let mut o = if *record {
+                            Out {
+                                data: &mut values,
+                                origin: (rows.start, cols.start),
+                                width: cols.len(),
+                                stride,
+                            }
+                        } else {
+                            Out {
+                                data: &mut grid.data,
+                                origin: (0, 0),
+                                width: mv,
+                                stride,
+                            }
+                        };
+                        add_share(p, axes, kl, delta, &rect, partials, terms, &mut o);
+                    }
                 }
-                self.blend(idx, &mut Delta::Values(&delta), [rows, cols], None)
-            }
-            PatchOp::Replace(patch) => {
-                let nv = self.nv();
-                let params = [
-                    self.axes[0].local_params(idx / nv),
-                    self.axes[1].local_params(idx % nv),
-                ];
-                let fresh = PatchLevel::new(patch, params, &self.grid.partials);
-                let delta: Vec<DVec3> = fresh
-                    .samples()
-                    .iter()
-                    .zip(self.patches[idx].samples())
-                    .map(|(a, b)| *a - *b)
-                    .collect();
-                self.patches[idx] = fresh;
-                self.blend(idx, &mut Delta::Values(&delta), all, None)
+                if *record {
+                    add_rect(&mut grid.data, mv, stride, &rect, &values);
+                }
+                out.push(Patch {
+                    rows: rows.clone(),
+                    cols,
+                    values,
+                    normals,
+                });
             }
         }
+        out
+    }
+
+    /// Samples patch idx's support again; a recording level returns the change.
+    fn refill_support(&mut self, idx: usize) -> Vec<Patch> {
+        let nv = self.nv();
+        let (k, l) = (idx / nv, idx % nv);
+        let stride = self.partials.len();
+        let mv = self.grid.dims[1];
+        let rects: Vec<[Range<usize>; 2]> = self.axes[0]
+            .pieces(k)
+            .iter()
+            .flat_map(|pu| {
+                self.axes[1]
+                    .pieces(l)
+                    .iter()
+                    .map(|pv| [pu.samples.clone(), pv.samples.clone()])
+            })
+            .collect();
+        let mut out = Vec::new();
+        for rect in rects {
+            if rect[0].is_empty() || rect[1].is_empty() {
+                continue;
+            }
+            let old = self
+                .record
+                .then(|| copy_rect(&self.grid.data, mv, stride, &rect));
+            let mut patch = self.fill(&rect);
+            if let Some(mut old) = old {
+                let new = copy_rect(&self.grid.data, mv, stride, &rect);
+                for (o, n) in old.iter_mut().zip(new) {
+                    *o = n - *o;
+                }
+                patch.values = old;
+            }
+            out.push(patch);
+        }
+        out
     }
 
     /// After [`ErbsSurface::insert_knot`] in direction `dir` inside interval i: the restricted
     /// patches and the new row or column are pre-evaluated, the others keep theirs, and the
-    /// samples of the refined strip are blended again. Returns the strip.
+    /// samples of the refined strip are sampled again. Returns the strip.
     pub fn refine(
         &mut self,
         old: &ErbsSurface,
         refined: &ErbsSurface,
         dir: usize,
         i: usize,
-    ) -> [Range<usize>; 2] {
-        let stride = self.partials.len();
+    ) -> Patch {
         let strip = self.axes[dir].touched_by_refinement(&old.knots()[dir], i, old.bfunction());
         let (right, _) = old.knots()[dir].right(i);
         self.axes[dir] = self.axes[dir].refined(&refined.knots()[dir], refined.bfunction(), i);
+        self.knots = refined.knots().clone();
         let new_right = if right == 0 { 0 } else { right + 1 };
         let rebuilt = [i, i + 1, new_right];
         let [nu, nv] = refined.count();
@@ -487,7 +695,8 @@ impl SurfaceLevel {
                     Some(p) => p,
                     None => PatchLevel::new(
                         refined.local_patch(k, l),
-                        [self.axes[0].local_params(k), self.axes[1].local_params(l)],
+                        &self.axes,
+                        [k, l],
                         &self.grid.partials,
                     ),
                 });
@@ -500,14 +709,65 @@ impl SurfaceLevel {
         } else {
             [0..mu, strip.clone()]
         };
-        for i in region[0].clone() {
-            self.grid.data[(i * mv + region[1].start) * stride..(i * mv + region[1].end) * stride]
-                .fill(DVec3::ZERO);
+        self.fill(&region)
+    }
+
+    /// Takes the model's points again at every depth and samples everything again; `None` when
+    /// the structure (knots, patch kinds and bases) is not the tabulated one.
+    pub fn refresh(&mut self, surface: &ErbsSurface) -> Option<Patch> {
+        if !self.refresh_nets(surface) {
+            return None;
         }
-        for idx in 0..self.patches.len() {
-            self.blend_patch(idx, Some(&region));
+        let all = self.all();
+        Some(self.fill(&all))
+    }
+
+    fn refresh_nets(&mut self, surface: &ErbsSurface) -> bool {
+        if self.knots != *surface.knots() || self.patches.len() != surface.local_patches().len() {
+            return false;
         }
-        region
+        let nv = self.nv();
+        for (idx, new) in surface.local_patches().iter().enumerate() {
+            let kept = match (&mut self.patches[idx], new) {
+                (PatchLevel::Spline(p), LocalPatch::Spline { surface, .. }) if p.holds(surface) => {
+                    p.set_points(surface.points());
+                    true
+                }
+                (PatchLevel::Erbs(child), LocalPatch::Erbs(e)) => child.refresh(e).is_some(),
+                _ => false,
+            };
+            if !kept {
+                self.patches[idx] =
+                    PatchLevel::new(new, &self.axes, [idx / nv, idx % nv], &self.grid.partials);
+            }
+        }
+        true
+    }
+}
+
+fn copy_rect(data: &[DVec3], mv: usize, stride: usize, rect: &[Range<usize>; 2]) -> Vec<DVec3> {
+    let mut v = Vec::with_capacity(rect[0].len() * rect[1].len() * stride);
+    for i in rect[0].clone() {
+        v.extend_from_slice(
+            &data[(i * mv + rect[1].start) * stride..(i * mv + rect[1].end) * stride],
+        );
+    }
+    v
+}
+
+fn add_rect(
+    data: &mut [DVec3],
+    mv: usize,
+    stride: usize,
+    rect: &[Range<usize>; 2],
+    values: &[DVec3],
+) {
+    let w = rect[1].len() * stride;
+    for (i, v) in rect[0].clone().zip(values.chunks_exact(w)) {
+        let o = &mut data[(i * mv + rect[1].start) * stride..][..w];
+        for (o, v) in o.iter_mut().zip(v) {
+            *o += *v;
+        }
     }
 }
 
@@ -537,16 +797,6 @@ fn blend_shading_row(
     }
 }
 
-/// M[li][order][q] of a table, 0 when q is not active there or the order is above the degree.
-#[inline]
-fn coefficient(t: &HermiteTable, j: usize, order: usize, q: usize) -> f64 {
-    let first = t.first(j);
-    if q < first || q > first + t.degree() {
-        return 0.0;
-    }
-    t.row(j, order).map_or(0.0, |r| r[q - first])
-}
-
 /// A top-level ERBS surface: the level at uniform parameters over its domain (with unit normals
 /// when rendering).
 #[derive(Debug, Clone)]
@@ -557,25 +807,47 @@ pub struct ErbsSurfaceSampler {
 
 impl ErbsSurfaceSampler {
     pub fn new(model: ErbsSurfaceModel, set: PartialSet, normals: bool) -> Self {
-        let level = Self::level(&model, set, normals);
+        let level = Self::tabulated(&model, set, normals);
         let mut s = Self { model, level };
-        let [mu, mv] = s.level.grid.dims;
-        s.update_normals(0..mu, 0..mv);
+        s.sample_all();
         s
     }
 
-    fn level(model: &ErbsSurfaceModel, set: PartialSet, normals: bool) -> SurfaceLevel {
+    fn tabulated(model: &ErbsSurfaceModel, set: PartialSet, normals: bool) -> SurfaceLevel {
         let [(u0, u1), (v0, v1)] = model.surface().domain();
         let [mu, mv] = model.samples();
         let params = [uniform_params(u0, u1, mu), uniform_params(v0, v1, mv)];
-        SurfaceLevel::new(model.surface(), params, set, normals, false)
+        SurfaceLevel::tabulated(model.surface(), params, set, normals, false)
     }
 
+    fn sample_all(&mut self) -> DirtyRegion {
+        let all = self.level.all();
+        let patch = self.level.fill(&all);
+        self.finish(&[patch])
+    }
+
+    /// Normals where no kernel wrote them, the model fallback where they degenerated, and the
+    /// region changed.
     fn finish(&mut self, changes: &[Patch]) -> DirtyRegion {
         let mut region = DirtyRegion::NOTHING;
         for c in changes {
-            self.update_normals(c.rows.clone(), c.cols.clone());
+            if !c.normals {
+                self.update_normals(c.rows.clone(), c.cols.clone());
+            }
             region = region.union(DirtyRegion::surface(c.rows.clone(), c.cols.clone()));
+        }
+        let degenerate = std::mem::take(&mut self.level.degenerate);
+        if !degenerate.is_empty() {
+            let params = [
+                self.level.axes[0].params.as_slice(),
+                self.level.axes[1].params.as_slice(),
+            ];
+            super::normals::resolve_degenerate(
+                &mut self.level.grid,
+                &degenerate,
+                params,
+                self.model.surface(),
+            );
         }
         region
     }
@@ -594,18 +866,16 @@ impl ErbsSurfaceSampler {
         );
     }
 
-    fn point(&self, path: &[[usize; 2]], [a, b]: [usize; 2]) -> DVec3 {
-        match self.model.surface().local_at(path) {
-            Some(LocalPatch::Spline { surface, .. }) => surface.point(a, b),
-            _ => DVec3::ZERO,
-        }
-    }
-
-    fn replace(&mut self, path: &[[usize; 2]]) -> Vec<Patch> {
-        match self.model.surface().local_at(path) {
-            Some(p) => self.level.apply(path, &PatchOp::Replace(p)),
-            None => Vec::new(),
-        }
+    /// The local at `path` changed in the model (by A if given): the level follows.
+    fn follow(&mut self, path: &[[usize; 2]], transform: Option<&DMat4>) -> Vec<Patch> {
+        let Some(local) = self.model.surface().local_at(path) else {
+            return Vec::new();
+        };
+        let op = match transform {
+            Some(a) => PatchOp::Transform(a, local),
+            None => PatchOp::Update(local),
+        };
+        self.level.apply(path, &op)
     }
 }
 
@@ -627,24 +897,12 @@ impl Sampler for ErbsSurfaceSampler {
     fn apply(&mut self, edit: &ErbsSurfaceEdit) -> DirtyRegion {
         let changes = match edit {
             ErbsEdit::Local(e) => {
-                let path = e.local();
-                match e {
-                    LocalEdit::Transform { matrix, .. } => {
-                        edit.apply(&mut self.model);
-                        self.level.apply(path.steps(), &PatchOp::Transform(matrix))
-                    }
-                    LocalEdit::MovePoint { point, .. } => {
-                        let before = self.point(path.steps(), *point);
-                        edit.apply(&mut self.model);
-                        let d = self.point(path.steps(), *point) - before;
-                        self.level
-                            .apply(path.steps(), &PatchOp::MovePoint(*point, d))
-                    }
-                    LocalEdit::SetPoints { .. } => {
-                        edit.apply(&mut self.model);
-                        self.replace(path.steps())
-                    }
-                }
+                edit.apply(&mut self.model);
+                let transform = match e {
+                    LocalEdit::Transform { matrix, .. } => Some(matrix),
+                    _ => None,
+                };
+                self.follow(e.local().steps(), transform)
             }
             ErbsEdit::InsertKnot {
                 local: None,
@@ -657,12 +915,7 @@ impl Sampler for ErbsSurfaceSampler {
                 if self.model.surface() == &old {
                     return DirtyRegion::NOTHING;
                 }
-                let [rows, cols] = self.level.refine(&old, self.model.surface(), *dir, i);
-                vec![Patch {
-                    rows,
-                    cols,
-                    values: Vec::new(),
-                }]
+                vec![self.level.refine(&old, self.model.surface(), *dir, i)]
             }
             ErbsEdit::InsertKnot {
                 local: Some(path), ..
@@ -670,7 +923,7 @@ impl Sampler for ErbsSurfaceSampler {
             | ErbsEdit::ToErbs { local: path, .. }
             | ErbsEdit::SetLocal { local: path, .. } => {
                 edit.apply(&mut self.model);
-                self.replace(path.steps())
+                self.follow(path.steps(), None)
             }
             ErbsEdit::Restore(_) => {
                 edit.apply(&mut self.model);
@@ -680,17 +933,31 @@ impl Sampler for ErbsSurfaceSampler {
         self.finish(&changes)
     }
 
-    /// ERBS updates are local anyway: drift control re-samples everything.
-    fn rebuild(&mut self, _region: DirtyRegion) -> DirtyRegion {
-        self.full()
+    /// The region again from the nets (which are the model's); a level with ERBS patches
+    /// samples everything again, since their own samples drift too.
+    fn rebuild(&mut self, region: DirtyRegion) -> DirtyRegion {
+        if region.is_empty() {
+            return DirtyRegion::NOTHING;
+        }
+        if !self.level.is_flat() {
+            return self.full();
+        }
+        let patch = self.level.fill(&[region.rows, region.cols]);
+        self.finish(&[patch])
     }
 
+    /// Everything again from the model, reusing the tables when its structure is the
+    /// tabulated one.
     fn full(&mut self) -> DirtyRegion {
-        let normals = self.level.grid.normals.is_some();
-        self.level = Self::level(&self.model, self.level.grid.partials.clone(), normals);
-        let [mu, mv] = self.level.grid.dims;
-        self.update_normals(0..mu, 0..mv);
-        DirtyRegion::surface(0..mu, 0..mv)
+        match self.level.refresh(self.model.surface()) {
+            Some(patch) => self.finish(&[patch]),
+            None => {
+                let normals = self.level.grid.normals.is_some();
+                let set = self.level.grid.partials.clone();
+                self.level = Self::tabulated(&self.model, set, normals);
+                self.sample_all()
+            }
+        }
     }
 }
 

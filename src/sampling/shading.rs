@@ -25,13 +25,13 @@ pub(crate) const LANES: usize = 4;
 
 /// Q0 = M_u[0]·C and Q1 = M_u[1]·C at one control column for L sample rows: x, y, z of Q0, then
 /// of Q1, each with one lane per row.
-type QCol<const L: usize> = [Lanes<L>; 6];
+pub(crate) type QCol<const L: usize> = [Lanes<L>; 6];
 
 /// One value for each of L sample rows. Aligned so that SSE2 arithmetic may take its operands
 /// straight from memory (legacy SSE memory operands must be 16-byte aligned).
 #[derive(Debug, Clone, Copy)]
 #[repr(C, align(16))]
-struct Lanes<const L: usize>([f64; L]);
+pub(crate) struct Lanes<const L: usize>(pub [f64; L]);
 
 impl<const L: usize> std::ops::Index<usize> for Lanes<L> {
     type Output = f64;
@@ -295,7 +295,7 @@ impl<const WU: usize, const WV: usize> Kernel<'_, WU, WV> {
 
 /// S, Su, Sv (x, y, z each) of one sample column for L rows.
 #[inline(always)]
-fn partials<const W: usize, const L: usize>(
+pub(crate) fn partials<const W: usize, const L: usize>(
     win: &[QCol<L>; W],
     cv: &[[Lanes<L>; W]; 2],
 ) -> [Lanes<L>; 9] {
@@ -317,7 +317,7 @@ fn partials<const W: usize, const L: usize>(
 
 /// Normals from Su, Sv in `stage[0..6]` into `stage[6..9]`, and 1 in `stage[9]` where regular.
 #[inline(always)]
-fn normals_staged<const L: usize>(stage: &mut [Lanes<L>; 10]) {
+pub(crate) fn normals_staged<const L: usize>(stage: &mut [Lanes<L>; 10]) {
     let (n, ok) = unit_normals(
         [stage[0].0, stage[1].0, stage[2].0],
         [stage[3].0, stage[4].0, stage[5].0],
@@ -346,11 +346,11 @@ pub(crate) fn unit_normals<const L: usize>(
         let ok = (scale[l] > 0.0) & (len2[l] > 1e-20 * scale[l] * scale[l]) & len2[l].is_finite();
         if ok { 1.0 } else { 0.0 }
     });
-    let len = lanes(&|l| len2[l].sqrt());
+    let inv = lanes(&|l| 1.0 / len2[l].sqrt());
     let n = [
-        lanes(&|l| cx[l] / len[l]),
-        lanes(&|l| cy[l] / len[l]),
-        lanes(&|l| cz[l] / len[l]),
+        lanes(&|l| cx[l] * inv[l]),
+        lanes(&|l| cy[l] * inv[l]),
+        lanes(&|l| cz[l] * inv[l]),
     ];
     (n, ok)
 }

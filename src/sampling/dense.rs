@@ -1,0 +1,293 @@
+//! The ERBS surface kernel: S, Su, Sv and unit normals of a rectangle of samples from a *dense*
+//! basis, one whose every function is active at every sample of the rectangle. That is a Bézier
+//! local patch blended with its ERBS weight (width d+1 padded to 4), and also the 2×2 local
+//! patches active over one knot cell side by side (width 8 each way): over a cell the ERBS
+//! surface is a tensor product on an 8 × 8 net, so a sample costs one pass instead of four.
+//!
+//! The lane layout is `shading`'s: L sample rows share each column's v-coefficients, held
+//! lane-minor so that the autovectoriser emits SIMD across the rows.
+
+use super::shading::{LANES, Lanes, QCol, partials, unit_normals};
+use glam::DVec3;
+
+/// Rows 0 and 1 of a dense basis of width W at one sample: the W functions' values and first
+/// derivatives.
+pub(crate) type DenseRow<const W: usize> = [[f64; W]; 2];
+
+/// Where a pass writes: `rows` consecutive grid rows from `row0`, columns from `col0`, of a
+/// row-major grid of S, Su, Sv per sample with `width` samples per row, and the unit normals
+/// when `normals` is given.
+pub(crate) struct Target<'a> {
+    pub data: &'a mut [DVec3],
+    pub normals: Option<&'a mut [DVec3]>,
+    pub width: usize,
+    pub row0: usize,
+    pub col0: usize,
+}
+
+/// S, Su, Sv of Σ_a Σ_b U_a(u_i) V_b(v_j) P_ab for `cu.len()` rows × `cv.len()` columns, stored
+/// into `out` or, if ADD, added to what is there; unit normals of the result when `out` keeps
+/// normals. Samples whose Su × Sv degenerates are appended to `degenerate` (grid indices) with
+/// an unspecified normal, for the caller's model fallback.
+pub(crate) fn pass<const WU: usize, const WV: usize, const ADD: bool>(
+    cu: &[DenseRow<WU>],
+    cv: &[DenseRow<WV>],
+    net: &[[DVec3; WV]; WU],
+    out: Target<'_>,
+    degenerate: &mut Vec<(usize, usize)>,
+) {
+    let (nr, nc) = (cu.len(), cv.len());
+    if nr == 0 || nc == 0 {
+        return;
+    }
+    let pass = Pass {
+        net,
+        origin: (out.row0, out.col0),
+    };
+    pass.run::<ADD>(cu, cv, out, degenerate);
+}
+
+struct Pass<'a, const WU: usize, const WV: usize> {
+    net: &'a [[DVec3; WV]; WU],
+    origin: (usize, usize),
+}
+
+impl<const WU: usize, const WV: usize> Pass<'_, WU, WV> {
+    /// The row pass over `cu.len()` rows × `cv.len()` columns into `out`.
+    fn run<const ADD: bool>(
+        &self,
+        cu: &[DenseRow<WU>],
+        cv: &[DenseRow<WV>],
+        out: Target<'_>,
+        degenerate: &mut Vec<(usize, usize)>,
+    ) {
+        let nr = cu.len();
+        let nc = cv.len();
+        let w = out.width;
+        let (r0, c0) = (out.row0, out.col0);
+        let mut data = out.data[r0 * w * 3..(r0 + nr) * w * 3]
+            .chunks_exact_mut(w * 3)
+            .map(|r| &mut r[c0 * 3..(c0 + nc) * 3]);
+        let split = nr / LANES * LANES;
+        match out.normals {
+            Some(normals) => {
+                let mut normals = normals[r0 * w..(r0 + nr) * w]
+                    .chunks_exact_mut(w)
+                    .map(|r| &mut r[c0..c0 + nc]);
+                let (n4, n1) = (&mut normals, degenerate);
+                self.rows::<LANES, ADD, true>(0, &cu[..split], cv, &mut data, n4, n1);
+                self.rows::<1, ADD, true>(split, &cu[split..], cv, &mut data, n4, n1);
+            }
+            None => {
+                let none = &mut std::iter::empty();
+                self.rows::<LANES, ADD, false>(0, &cu[..split], cv, &mut data, none, degenerate);
+                self.rows::<1, ADD, false>(split, &cu[split..], cv, &mut data, none, degenerate);
+            }
+        }
+    }
+
+    /// Rows `cu` (a multiple of L of them, the first being rectangle row `first`) in groups of
+    /// L; `data` and `normals` yield the rows' grid segments in the same order.
+    fn rows<'g, const L: usize, const ADD: bool, const N: bool>(
+        &self,
+        first: usize,
+        cu: &[DenseRow<WU>],
+        cv: &[DenseRow<WV>],
+        data: &mut impl Iterator<Item = &'g mut [DVec3]>,
+        normals: &mut impl Iterator<Item = &'g mut [DVec3]>,
+        degenerate: &mut Vec<(usize, usize)>,
+    ) {
+        if cu.is_empty() {
+            return;
+        }
+        // The v-coefficients repeated across the lanes once per rectangle, so the hot loop
+        // loads them as whole vectors.
+        let coeffs: Vec<[[Lanes<L>; WV]; 2]> = cv
+            .iter()
+            .map(|c| c.map(|row| row.map(|x| Lanes([x; L]))))
+            .collect();
+        // Su, Sv of every column of the group, in lane layout: the normals run over them in a
+        // loop of their own, short enough for the out-of-order core to overlap the square
+        // roots and divisions of many columns (inside the column loop their latency stalls
+        // it: measured, a third of an edit's time).
+        let mut staged: Vec<[Lanes<L>; 6]> =
+            vec![[Lanes([0.0; L]); 6]; if N { cv.len() } else { 0 }];
+        let (r0, c0) = self.origin;
+        for (g, rows) in cu.chunks_exact(L).enumerate() {
+            let q = self.fill_q::<L>(rows);
+            let d: [&mut [[DVec3; 3]]; L] = std::array::from_fn(|_| {
+                data.next()
+                    .expect("one grid row per sample row")
+                    .as_chunks_mut::<3>()
+                    .0
+            });
+            for (jj, cv) in coeffs.iter().enumerate() {
+                let mut s = partials::<WV, L>(&q, cv);
+                if ADD {
+                    for l in 0..L {
+                        let o = &d[l][jj];
+                        for c in 0..3 {
+                            s[c][l] += o[0][c];
+                            s[3 + c][l] += o[1][c];
+                            s[6 + c][l] += o[2][c];
+                        }
+                    }
+                }
+                for l in 0..L {
+                    d[l][jj] = [
+                        DVec3::new(s[0][l], s[1][l], s[2][l]),
+                        DVec3::new(s[3][l], s[4][l], s[5][l]),
+                        DVec3::new(s[6][l], s[7][l], s[8][l]),
+                    ];
+                }
+                if N {
+                    staged[jj].copy_from_slice(&s[3..]);
+                }
+            }
+            if !N {
+                continue;
+            }
+            let n: [&mut [DVec3]; L] =
+                std::array::from_fn(|_| normals.next().expect("one normal row per sample row"));
+            let i = r0 + first + g * L;
+            // Normals into lane layout first, then out to the rows: stored straight from the
+            // lanes, LLVM pairs x and y of one lane and leaves the square roots scalar.
+            for st in staged.iter_mut() {
+                let (nn, ok) =
+                    unit_normals::<L>([st[0].0, st[1].0, st[2].0], [st[3].0, st[4].0, st[5].0]);
+                st[..3].copy_from_slice(&nn.map(Lanes));
+                st[3] = Lanes(ok);
+            }
+            for (jj, st) in staged.iter().enumerate() {
+                for l in 0..L {
+                    n[l][jj] = DVec3::new(st[0][l], st[1][l], st[2][l]);
+                }
+                if st[3].0.contains(&0.0) {
+                    let lanes = (0..L).filter(|&l| st[3][l] == 0.0);
+                    degenerate.extend(lanes.map(|l| (i + l, c0 + jj)));
+                }
+            }
+        }
+    }
+
+    /// Q0 = Σ_a U_a P_ab and Q1 = Σ_a U'_a P_ab at every net column b, for L sample rows.
+    #[inline(always)]
+    fn fill_q<const L: usize>(&self, rows: &[DenseRow<WU>]) -> [QCol<L>; WV] {
+        let mut q = [[Lanes([0.0; L]); 6]; WV];
+        for (b, qb) in q.iter_mut().enumerate() {
+            for a in 0..WU {
+                let p = self.net[a][b];
+                for l in 0..L {
+                    let (c0, c1) = (rows[l][0][a], rows[l][1][a]);
+                    qb[0][l] += p.x * c0;
+                    qb[1][l] += p.y * c0;
+                    qb[2][l] += p.z * c0;
+                    qb[3][l] += p.x * c1;
+                    qb[4][l] += p.y * c1;
+                    qb[5][l] += p.z * c1;
+                }
+            }
+        }
+        q
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The kernel against the definition, sample by sample, for a random dense basis and net,
+    /// storing and adding, with and without normals; and a perturbed net must be told apart.
+    #[test]
+    fn dense_pass_is_the_tensor_product() {
+        let mut state = 7u64;
+        let mut rnd = move || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1);
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        const WU: usize = 4;
+        const WV: usize = 3;
+        let (nr, nc, width) = (7, 5, 9);
+        let cu: Vec<DenseRow<WU>> = (0..nr)
+            .map(|_| std::array::from_fn(|_| std::array::from_fn(|_| rnd())))
+            .collect();
+        let cv: Vec<DenseRow<WV>> = (0..nc)
+            .map(|_| std::array::from_fn(|_| std::array::from_fn(|_| rnd())))
+            .collect();
+        let net: [[DVec3; WV]; WU] =
+            std::array::from_fn(|_| std::array::from_fn(|_| DVec3::new(rnd(), rnd(), rnd())));
+        let expect = |i: usize, j: usize, ru: usize, rv: usize| {
+            let mut s = DVec3::ZERO;
+            for (a, row) in net.iter().enumerate() {
+                for (b, p) in row.iter().enumerate() {
+                    s += *p * (cu[i][ru][a] * cv[j][rv][b]);
+                }
+            }
+            s
+        };
+        let (row0, col0) = (2, 3);
+        let base = DVec3::new(1.0, -2.0, 0.5);
+        let check = |data: &[DVec3], add: bool, net_ok: bool| -> f64 {
+            let mut worst = 0.0f64;
+            for i in 0..nr {
+                for j in 0..nc {
+                    let k = ((row0 + i) * width + col0 + j) * 3;
+                    for (p, (ru, rv)) in [(0, 0), (1, 0), (0, 1)].into_iter().enumerate() {
+                        let want = expect(i, j, ru, rv) + if add { base } else { DVec3::ZERO };
+                        let e = (data[k + p] - want).abs().max_element();
+                        worst = if e.is_nan() {
+                            f64::INFINITY
+                        } else {
+                            worst.max(e)
+                        };
+                    }
+                }
+            }
+            assert!(net_ok || worst > 1e-3, "a perturbed net must fail");
+            worst
+        };
+        for add in [false, true] {
+            let mut data = vec![base; 12 * width * 3];
+            let mut normals = vec![DVec3::ZERO; 12 * width];
+            let mut degenerate = Vec::new();
+            let target = Target {
+                data: &mut data,
+                normals: Some(&mut normals),
+                width,
+                row0,
+                col0,
+            };
+            if add {
+                pass::<WU, WV, true>(&cu, &cv, &net, target, &mut degenerate);
+            } else {
+                pass::<WU, WV, false>(&cu, &cv, &net, target, &mut degenerate);
+            }
+            assert!(check(&data, add, true) < 1e-15);
+            for i in 0..nr {
+                for j in 0..nc {
+                    let g = (row0 + i) * width + col0 + j;
+                    let n = crate::geom::surface::regular_normal(data[g * 3 + 1], data[g * 3 + 2]);
+                    match n {
+                        Some(n) => assert_eq!(normals[g], n),
+                        None => assert!(degenerate.contains(&(row0 + i, col0 + j))),
+                    }
+                }
+            }
+            // Outside the rectangle nothing moved.
+            assert_eq!(data[0], base);
+            assert_eq!(normals[0], DVec3::ZERO);
+            let mut bad = net;
+            bad[1][2].y += 0.5;
+            let mut other = vec![base; 12 * width * 3];
+            let t = Target {
+                data: &mut other,
+                normals: None,
+                width,
+                row0,
+                col0,
+            };
+            pass::<WU, WV, false>(&cu, &cv, &bad, t, &mut Vec::new());
+            check(&other, false, false);
+        }
+    }
+}
