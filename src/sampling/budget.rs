@@ -264,15 +264,32 @@ pub fn estimate(extent: &Extent, mode: SampleMode, uses: Uses) -> Estimate {
             blend,
             format!("{samples_text} × 2 × {} orders × 8 B", g + 1),
         );
-        let copies: u128 = if surface { 4 } else { 2 };
-        e.add(
-            "ERBS local samples",
-            copies * vectors * VEC3,
-            format!(
-                "{copies} × {samples_text} × {orders} × 24 B over {} locals",
-                locals.iter().map(|&l| l as u128).product::<u128>()
-            ),
-        );
+        if surface {
+            // Polynomial local patches keep no samples, only their blended bases: per
+            // direction each support row once per patch in the other direction, rows 0 and 1
+            // padded to 4 functions (ERBS locals of locals are levels of their own, sized as
+            // deep as the scene makes them, and not counted here).
+            let dense: u128 = extent
+                .samples
+                .iter()
+                .enumerate()
+                .map(|(dir, &m)| 2 * locals[1 - dir] as u128 * m as u128 * 2 * 4 * F64)
+                .sum();
+            e.add(
+                "ERBS blended bases",
+                dense,
+                "per direction: 2 × samples × patches across × 2 orders × 4 functions × 8 B".into(),
+            );
+        } else {
+            e.add(
+                "ERBS local samples",
+                2 * vectors * VEC3,
+                format!(
+                    "2 × {samples_text} × {orders} × 24 B over {} locals",
+                    locals.iter().map(|&l| l as u128).product::<u128>()
+                ),
+            );
+        }
     }
     if uses.gpu {
         // Per frame in flight a mirror of f32 vertices (surfaces: position + normal), plus the
