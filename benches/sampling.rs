@@ -384,8 +384,49 @@ fn analysis_summary() {
         mean_ns("analysis", MAP_MODES[0].0),
         mean_ns("analysis", MAP_MODES[1].0),
     ) {
-        println!("\nmap on / map off: {:.2}×", on / off);
+        println!("\nmap on / map off: {:.2}× (criterion means)", on / off);
     }
+    paired_map_ratio();
+}
+
+/// The map's cost ratio measured in pairs: the two criterion groups run seconds apart, and on
+/// a shared host their ratio moves with whatever else runs. Here each round times a block of
+/// edits with the map off and then on, so both see the same load, and the median of the
+/// per-round ratios is reported with its spread.
+fn paired_map_ratio() {
+    const ROUNDS: usize = 41;
+    const EDITS: usize = 400;
+    let (_, _, batch) = &scenarios()[0];
+    let mut objs = MAP_MODES.map(|(_, mode)| SampledObject::new(&surface(), mode));
+    let mut block = |obj: &mut SampledObject| {
+        let start = Instant::now();
+        for _ in 0..EDITS {
+            for e in batch {
+                black_box(obj.apply(e).expect("the bench's edits fit their objects"));
+            }
+        }
+        start.elapsed().as_secs_f64()
+    };
+    for obj in &mut objs {
+        block(obj);
+    }
+    let mut ratios: Vec<f64> = (0..ROUNDS)
+        .map(|_| {
+            let [off, on] = &mut objs;
+            let off = block(off);
+            block(on) / off
+        })
+        .collect();
+    ratios.sort_by(f64::total_cmp);
+    println!(
+        "map on / map off, paired: median {:.2}× over {ROUNDS} rounds of {EDITS} edits \
+         (quartiles {:.2}–{:.2}×, range {:.2}–{:.2}×)",
+        ratios[ROUNDS / 2],
+        ratios[ROUNDS / 4],
+        ratios[3 * ROUNDS / 4],
+        ratios[0],
+        ratios[ROUNDS - 1]
+    );
 }
 
 fn structural_summary() {

@@ -9,7 +9,7 @@
 use super::axis::HermiteTable;
 use super::grid::SampleGrid;
 use super::normals::NormalSource;
-use super::shading::{LANES, unit_normals};
+use super::shading::{LANES, unit_normals_inv};
 use crate::geom::surface::regular_normal;
 use glam::DVec3;
 use std::ops::Range;
@@ -20,8 +20,11 @@ pub fn fundamental_forms(p: &[DVec3; 5], n: DVec3) -> [f64; 2] {
     let [su, sv, suu, suv, svv] = *p;
     let (e, f, g) = (su.dot(su), su.dot(sv), sv.dot(sv));
     let (l, m, nn) = (suu.dot(n), suv.dot(n), svv.dot(n));
-    // One division for both (the lane kernel in `shape_of` computes exactly this).
-    let r = 1.0 / (e * g - f * f);
+    // EG − F² is |Su × Sv|², whose reciprocal square root the normal already takes; the
+    // cross product also loses less to cancellation than EG − F² where Su and Sv are near
+    // parallel. The lane kernel in `shape_of` computes exactly this.
+    let inv = 1.0 / su.cross(sv).length_squared().sqrt();
+    let r = inv * inv;
     [
         (l * nn - m * m) * r,
         (e * nn - 2.0 * f * m + g * l) * (0.5 * r),
@@ -163,57 +166,74 @@ pub(crate) fn shape_of(
     mut degenerate: impl FnMut(usize),
 ) {
     const L: usize = LANES;
-    let (data4, rest) = data.as_chunks::<L>();
-    let (normals4, normals_rest) = normals.as_chunks_mut::<L>();
-    let (curv4, curv_rest) = curv.as_chunks_mut::<L>();
-    for (g, ((d, n), c)) in data4.iter().zip(normals4).zip(curv4).enumerate() {
-        // Plain loops, not `array::map`: the map was left as an out-of-line call per partial.
-        let part = |p: usize| {
-            let mut out = [[0.0; L]; 3];
-            for (x, o) in out.iter_mut().enumerate() {
-                for (l, o) in o.iter_mut().enumerate() {
-                    *o = d[l][p][x];
+    let n = data.len();
+    if n < L {
+        for (jj, s) in data.iter().enumerate() {
+            match regular_normal(s[1], s[2]) {
+                Some(v) => {
+                    normals[jj] = v;
+                    curv[jj] = fundamental_forms(&[s[1], s[2], s[3], s[4], s[5]], v);
                 }
+                None => degenerate(jj),
             }
-            out
-        };
-        let (u, v) = (part(1), part(2));
-        let (nn, ok) = unit_normals::<L>(u, v);
-        let dot = |a: &[[f64; L]; 3], b: &[[f64; L]; 3]| -> [f64; L] {
-            std::array::from_fn(|l| a[0][l] * b[0][l] + a[1][l] * b[1][l] + a[2][l] * b[2][l])
-        };
-        let (e, f, gg) = (dot(&u, &u), dot(&u, &v), dot(&v, &v));
-        let (ll, m, n2) = (dot(&part(3), &nn), dot(&part(4), &nn), dot(&part(5), &nn));
-        let r: [f64; L] = std::array::from_fn(|l| 1.0 / (e[l] * gg[l] - f[l] * f[l]));
-        // Through memory, so that the stores below do not pull the lanes apart (see
-        // shading::normals_of).
-        let stage: [[f64; L]; 6] = std::hint::black_box([
-            nn[0],
-            nn[1],
-            nn[2],
-            std::array::from_fn(|l| (ll[l] * n2[l] - m[l] * m[l]) * r[l]),
-            std::array::from_fn(|l| {
-                (e[l] * n2[l] - 2.0 * f[l] * m[l] + gg[l] * ll[l]) * (0.5 * r[l])
-            }),
-            ok,
-        ]);
+        }
+        return;
+    }
+    // A ragged end is one more group over the last L samples instead of a scalar tail: a
+    // sample computed twice gets the same bits, and only the new ones are reported.
+    let starts = (0..n / L)
+        .map(|g| g * L)
+        .chain((n % L != 0).then_some(n - L));
+    let mut done = 0;
+    for start in starts {
+        let d: &[[DVec3; 6]; L] = data[start..start + L].try_into().expect("L samples");
+        let stage = shape_lanes(d);
         for l in 0..L {
+            let j = start + l;
             if stage[5][l] == 0.0 {
-                degenerate(g * L + l);
+                if j >= done {
+                    degenerate(j);
+                }
                 continue;
             }
-            n[l] = DVec3::new(stage[0][l], stage[1][l], stage[2][l]);
-            c[l] = [stage[3][l], stage[4][l]];
+            normals[j] = DVec3::new(stage[0][l], stage[1][l], stage[2][l]);
+            curv[j] = [stage[3][l], stage[4][l]];
         }
+        done = start + L;
     }
-    let base = data4.len() * L;
-    for (jj, ((s, n), c)) in rest.iter().zip(normals_rest).zip(curv_rest).enumerate() {
-        match regular_normal(s[1], s[2]) {
-            Some(v) => {
-                *n = v;
-                *c = fundamental_forms(&[s[1], s[2], s[3], s[4], s[5]], v);
+}
+
+/// Normal (3 rows), K, H and the regular flag of L samples, lane by lane.
+#[inline(always)]
+fn shape_lanes(d: &[[DVec3; 6]; LANES]) -> [[f64; LANES]; 6] {
+    const L: usize = LANES;
+    // Plain loops, not `array::map`: the map was left as an out-of-line call per partial.
+    let part = |p: usize| {
+        let mut out = [[0.0; L]; 3];
+        for (x, o) in out.iter_mut().enumerate() {
+            for (l, o) in o.iter_mut().enumerate() {
+                *o = d[l][p][x];
             }
-            None => degenerate(base + jj),
         }
-    }
+        out
+    };
+    let (u, v) = (part(1), part(2));
+    let (nn, ok, inv) = unit_normals_inv::<L>(u, v);
+    let dot = |a: &[[f64; L]; 3], b: &[[f64; L]; 3]| -> [f64; L] {
+        std::array::from_fn(|l| a[0][l] * b[0][l] + a[1][l] * b[1][l] + a[2][l] * b[2][l])
+    };
+    let (e, f, gg) = (dot(&u, &u), dot(&u, &v), dot(&v, &v));
+    let (ll, m, n2) = (dot(&part(3), &nn), dot(&part(4), &nn), dot(&part(5), &nn));
+    // EG − F² = |Su × Sv|², so the normal's reciprocal length squared saves a division.
+    let r: [f64; L] = std::array::from_fn(|l| inv[l] * inv[l]);
+    // Through memory, so that the caller's stores do not pull the lanes apart (see
+    // shading::normals_of).
+    std::hint::black_box([
+        nn[0],
+        nn[1],
+        nn[2],
+        std::array::from_fn(|l| (ll[l] * n2[l] - m[l] * m[l]) * r[l]),
+        std::array::from_fn(|l| (e[l] * n2[l] - 2.0 * f[l] * m[l] + gg[l] * ll[l]) * (0.5 * r[l])),
+        ok,
+    ])
 }

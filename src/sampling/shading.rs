@@ -334,6 +334,16 @@ pub(crate) fn unit_normals<const L: usize>(
     u: [[f64; L]; 3],
     v: [[f64; L]; 3],
 ) -> ([[f64; L]; 3], [f64; L]) {
+    let (n, ok, _) = unit_normals_inv(u, v);
+    (n, ok)
+}
+
+/// [`unit_normals`] with 1/|Su × Sv| per lane, for kernels that need the area element too.
+#[inline(always)]
+pub(crate) fn unit_normals_inv<const L: usize>(
+    u: [[f64; L]; 3],
+    v: [[f64; L]; 3],
+) -> ([[f64; L]; 3], [f64; L], [f64; L]) {
     let lanes = |f: &dyn Fn(usize) -> f64| -> [f64; L] { std::array::from_fn(f) };
     let cx = lanes(&|l| u[1][l] * v[2][l] - v[1][l] * u[2][l]);
     let cy = lanes(&|l| u[2][l] * v[0][l] - v[2][l] * u[0][l]);
@@ -352,7 +362,7 @@ pub(crate) fn unit_normals<const L: usize>(
         lanes(&|l| cy[l] * inv[l]),
         lanes(&|l| cz[l] * inv[l]),
     ];
-    (n, ok)
+    (n, ok, inv)
 }
 
 /// Moves control point (k, l) of a polynomial surface on a `Shading` grid by `delta`: S, Su, Sv
