@@ -757,6 +757,199 @@ fn nested_surfaces_match_the_oracle_before_and_after_refinement() {
     }
 }
 
+// --- refining nested locals, to_erbs, closed nested locals -----------------------------------
+
+/// The midpoint of the last knot interval of `dir` whose midpoint lies strictly inside its
+/// window: a refinement parameter that is no knot and inserts the new local after the others.
+fn last_mid_interval(dir: &oracle::erbs_tree::Dir) -> f64 {
+    let centres: Vec<f64> = if dir.closed {
+        dir.knots.clone()
+    } else {
+        dir.knots[1..dir.knots.len() - 1].to_vec()
+    };
+    centres
+        .windows(2)
+        .map(|w| 0.5 * (w[0] + w[1]))
+        .rfind(|&m| m > dir.window.0 && m < dir.window.1)
+        .expect("an interval inside the window")
+}
+
+/// The scene entry of the local at `path` (`key` steps `[l]` for curves, `[k][l]` for surfaces).
+fn entry_at<'a>(obj: &'a mut Value, steps: &[Vec<usize>]) -> &'a mut Value {
+    steps.iter().fold(obj, |v, step| {
+        step.iter().fold(&mut v["local"], |v, &i| &mut v[i])
+    })
+}
+
+/// What `to_erbs` must build, written as the scene format's `from` (its default type filled
+/// in): the oracle constructs it on its own.
+fn as_constructed(entry: &mut Value, kind: &str, counts: (&str, Value), degrees: (&str, Value)) {
+    let mut src = entry.clone();
+    if src.get("type").is_none() {
+        src["type"] = json!(kind);
+    }
+    let erbs = kind.replace("bezier", "erbs").replace("bspline", "erbs");
+    *entry = json!({"type": erbs, "from": src, counts.0: counts.1, degrees.0: degrees.1});
+}
+
+/// `nested_curve` with closed ERBS locals below the top: the ERBS local [1, 1] and the
+/// constructed local 3.
+fn nested_curve_closed_locals(closed: bool) -> Value {
+    let mut obj = nested_curve(closed);
+    let inner = &mut obj["local"][1]["local"][1];
+    inner["knots"] = json!([0, 0.4, 0.7, 1]);
+    inner["closed"] = json!(true);
+    obj["local"][3]["closed"] = json!(true);
+    obj
+}
+
+/// `to_erbs` on a top-level and on a level-2 Bézier local, then refinement of ERBS locals at
+/// every depth (the new ones, a closed level-3 local, a closed constructed local, a narrowed
+/// one), on open and closed top levels: the product (delta and `--full`) against the oracle's
+/// own construction of the same locals and its own refinement one level down per step. A
+/// Bézier local turned into an ERBS of at least its degree is reproduced (Taylor polynomials of
+/// a polynomial), so that step must not move a sample.
+#[test]
+fn nested_refinement_to_erbs_and_closed_locals_match_the_oracle() {
+    for closed in [false, true] {
+        let obj = nested_curve_closed_locals(closed);
+        let scene = scene_of(&obj);
+        let before = sample_cli(&scene, None, 4, false);
+        let (params, product) = curve_output(&before, 0);
+        let label = format!("closed={closed}");
+        assert_agrees(
+            &format!("{label}: closed nested locals"),
+            &product,
+            &oracle_curve_samples(&Curve::from_json(&obj), &params, 4),
+            TOL,
+        );
+
+        let mut rewritten = obj.clone();
+        as_constructed(
+            entry_at(&mut rewritten, &[vec![0]]),
+            "bezier_curve",
+            ("local_curves", json!(3)),
+            ("local_degree", json!(2)),
+        );
+        as_constructed(
+            entry_at(&mut rewritten, &[vec![1], vec![0]]),
+            "bezier_curve",
+            ("local_curves", json!(4)),
+            ("local_degree", json!(1)),
+        );
+        let mut oracle = Curve::from_json(&rewritten);
+        let mut edits = vec![
+            json!({"object": "e", "local": 0, "to_erbs": {"local_curves": 3, "local_degree": 2}}),
+            json!({"object": "e", "local": [1, 0], "to_erbs": {"local_curves": 4, "local_degree": 1}}),
+        ];
+        let out = sample_cli(&scene, Some(&json!(edits[..1])), 4, false);
+        assert_agrees(
+            &format!("{label}: to_erbs of degree ≥ the Bézier's reproduces it"),
+            &curve_output(&out, 0).1,
+            &product,
+            TOL,
+        );
+        // Deepest first, each in its last interval, so that no path shifts under a later step.
+        for path in [vec![1, 1], vec![1, 0], vec![3], vec![0], vec![1]] {
+            let s = last_mid_interval(&oracle.nested(&path).dir);
+            let t = oracle.outer_parameter(&path, s);
+            oracle = oracle
+                .insert_knot_at(&path, t, None)
+                .unwrap_or_else(|e| panic!("{label}: oracle refinement of {path:?}: {e}"));
+            edits.push(json!({"object": "e", "local": path, "insert_knot": t}));
+        }
+        let edits = Value::Array(edits);
+        for full in [false, true] {
+            let out = sample_cli(&scene, Some(&edits), 4, full);
+            let (params, product) = curve_output(&out, 0);
+            assert_agrees(
+                &format!("{label}: to_erbs and nested refinement, full={full}"),
+                &product,
+                &oracle_curve_samples(&oracle, &params, 4),
+                TOL,
+            );
+        }
+    }
+}
+
+/// The same for surfaces: a closed (in u) level-3 patch, `to_erbs` at levels 1 and 2, and
+/// refinement of ERBS patches at every depth in both directions.
+#[test]
+fn nested_patch_refinement_to_erbs_and_closed_locals_match_the_oracle() {
+    for closed in [[false, false], [true, false]] {
+        let mut obj = nested_surface(closed);
+        let inner = entry_at(&mut obj, &[vec![1, 0], vec![0, 1]]);
+        inner["knots"] = json!([[0, 0.5, 1], [0, 0, 1, 1]]);
+        inner["closed"] = json!([true, false]);
+        let scene = scene_of(&obj);
+        let before = sample_cli(&scene, None, 2, false);
+        let (params, product) = surface_output(&before, 0);
+        let label = format!("closed={closed:?}");
+        assert_agrees(
+            &format!("{label}: closed nested patch"),
+            &product,
+            &oracle_surface_samples(&Surface::from_json(&obj), &params, 2),
+            TOL,
+        );
+
+        let mut rewritten = obj.clone();
+        as_constructed(
+            entry_at(&mut rewritten, &[vec![0, 0]]),
+            "bezier_surface",
+            ("local_patches", json!([3, 3])),
+            ("local_degree", json!([1, 2])),
+        );
+        as_constructed(
+            entry_at(&mut rewritten, &[vec![1, 0], vec![2, 1]]),
+            "bezier_surface",
+            ("local_patches", json!([2, 3])),
+            ("local_degree", json!([1, 1])),
+        );
+        let mut oracle = Surface::from_json(&rewritten);
+        let mut edits = vec![
+            json!({"object": "s", "local": [0, 0],
+                   "to_erbs": {"local_patches": [3, 3], "local_degree": [1, 2]}}),
+            json!({"object": "s", "local": [[1, 0], [2, 1]],
+                   "to_erbs": {"local_patches": [2, 3], "local_degree": [1, 1]}}),
+        ];
+        let out = sample_cli(&scene, Some(&json!(edits[..1])), 2, false);
+        assert_agrees(
+            &format!("{label}: to_erbs of degree ≥ the Bézier's reproduces it"),
+            &surface_output(&out, 0).1,
+            &product,
+            TOL,
+        );
+        let steps: [(Vec<[usize; 2]>, usize); 6] = [
+            (vec![[1, 0], [0, 1]], 0),
+            (vec![[1, 0], [0, 1]], 1),
+            (vec![[1, 0], [2, 1]], 0),
+            (vec![[0, 0]], 1),
+            (vec![[1, 0]], 1),
+            (vec![[1, 0]], 0),
+        ];
+        for (path, dir) in steps {
+            let s = last_mid_interval(&oracle.nested(&path).dirs[dir]);
+            let t = oracle.outer_parameter(&path, dir, s);
+            oracle = oracle
+                .insert_knot_at(&path, dir, t, None)
+                .unwrap_or_else(|e| panic!("{label}: oracle refinement of {path:?}: {e}"));
+            let key = ["u", "v"][dir];
+            edits.push(json!({"object": "s", "local": path, "insert_knot": {key: t}}));
+        }
+        let edits = Value::Array(edits);
+        for full in [false, true] {
+            let out = sample_cli(&scene, Some(&edits), 2, full);
+            let (params, product) = surface_output(&out, 0);
+            assert_agrees(
+                &format!("{label}: to_erbs and nested refinement, full={full}"),
+                &product,
+                &oracle_surface_samples(&oracle, &params, 2),
+                TOL,
+            );
+        }
+    }
+}
+
 // --- negative controls -------------------------------------------------------------------------
 
 /// The comparison helper fails on a perturbed oracle (a local control point moved by 1e-9 of

@@ -155,6 +155,9 @@ impl Place {
     fn map(&self, t: f64) -> f64 {
         self.to.0 + (t - self.from.0) * self.slope()
     }
+    fn unmap(&self, s: f64) -> f64 {
+        self.from.0 + (s - self.to.0) / self.slope()
+    }
 }
 
 /// A local curve's own geometry.
@@ -263,6 +266,51 @@ impl Curve {
             },
             i + 1,
         ))
+    }
+
+    /// The ERBS local at `path` (empty: this curve).
+    pub fn nested(&self, path: &[usize]) -> &Curve {
+        match path.split_first() {
+            None => self,
+            Some((&l, rest)) => match &self.locals[l].kind {
+                CurveKind::Erbs(e) => e.nested(rest),
+                k => panic!("step {l} is a polynomial local: {k:?}"),
+            },
+        }
+    }
+
+    /// This curve's parameter of the parameter `s` of the ERBS local at `path`.
+    pub fn outer_parameter(&self, path: &[usize], s: f64) -> f64 {
+        match path.split_first() {
+            None => s,
+            Some((&l, rest)) => {
+                let CurveKind::Erbs(e) = &self.locals[l].kind else {
+                    panic!("step {l} is a polynomial local")
+                };
+                self.locals[l].place.unmap(e.outer_parameter(rest, s))
+            }
+        }
+    }
+
+    /// Refinement of the ERBS local at `path` at `t` in this curve's parameter: the local's
+    /// own refinement at its own parameter, its placement unchanged.
+    pub fn insert_knot_at(
+        &self,
+        path: &[usize],
+        t: f64,
+        degree: Option<usize>,
+    ) -> Result<Curve, String> {
+        let Some((&l, rest)) = path.split_first() else {
+            return Ok(self.insert_knot(t, degree)?.0);
+        };
+        let mut out = self.clone();
+        let local = &mut out.locals[l];
+        let CurveKind::Erbs(e) = &local.kind else {
+            return Err(format!("step {l} is a polynomial local"));
+        };
+        let inner = e.insert_knot_at(rest, local.place.map(t), degree)?;
+        local.kind = CurveKind::Erbs(Box::new(inner));
+        Ok(out)
     }
 }
 
@@ -471,6 +519,59 @@ impl Surface {
             },
             i + 1,
         ))
+    }
+
+    fn local_index(&self, [k, l]: [usize; 2]) -> usize {
+        k * self.count()[1] + l
+    }
+
+    /// The ERBS local at `path` (empty: this surface).
+    pub fn nested(&self, path: &[[usize; 2]]) -> &Surface {
+        match path.split_first() {
+            None => self,
+            Some((&kl, rest)) => match &self.locals[self.local_index(kl)].kind {
+                PatchKind::Erbs(e) => e.nested(rest),
+                _ => panic!("step {kl:?} is a polynomial local"),
+            },
+        }
+    }
+
+    /// This surface's parameter in direction `dir` of the parameter `s` of the ERBS local at
+    /// `path`.
+    pub fn outer_parameter(&self, path: &[[usize; 2]], dir: usize, s: f64) -> f64 {
+        match path.split_first() {
+            None => s,
+            Some((&kl, rest)) => {
+                let local = &self.locals[self.local_index(kl)];
+                let PatchKind::Erbs(e) = &local.kind else {
+                    panic!("step {kl:?} is a polynomial local")
+                };
+                local.place[dir].unmap(e.outer_parameter(rest, dir, s))
+            }
+        }
+    }
+
+    /// Refinement in direction `dir` of the ERBS local at `path`, `t` in this surface's
+    /// parameter.
+    pub fn insert_knot_at(
+        &self,
+        path: &[[usize; 2]],
+        dir: usize,
+        t: f64,
+        degree: Option<[usize; 2]>,
+    ) -> Result<Surface, String> {
+        let Some((&kl, rest)) = path.split_first() else {
+            return Ok(self.insert_knot(dir, t, degree)?.0);
+        };
+        let mut out = self.clone();
+        let at = out.local_index(kl);
+        let local = &mut out.locals[at];
+        let PatchKind::Erbs(e) = &local.kind else {
+            return Err(format!("step {kl:?} is a polynomial local"));
+        };
+        let inner = e.insert_knot_at(rest, dir, local.place[dir].map(t), degree)?;
+        local.kind = PatchKind::Erbs(Box::new(inner));
+        Ok(out)
     }
 }
 
