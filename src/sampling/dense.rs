@@ -124,13 +124,14 @@ impl<const WU: usize, const WV: usize> Pass<'_, WU, WV> {
             for (jj, cv) in coeffs.iter().enumerate() {
                 let mut s = partials::<WV, L>(&q, cv);
                 if ADD {
-                    for l in 0..L {
-                        let o = &d[l][jj];
-                        for c in 0..3 {
-                            s[c][l] += o[0][c];
-                            s[3 + c][l] += o[1][c];
-                            s[6 + c][l] += o[2][c];
-                        }
+                    // The old values gathered into lanes first, then one vector sum per
+                    // component: added lane by lane in place, LLVM extracted every lane,
+                    // added it scalar and spilled it (two stores per value).
+                    let old: [Lanes<L>; 9] = std::array::from_fn(|k| {
+                        Lanes(std::array::from_fn(|l| d[l][jj][k / 3][k % 3]))
+                    });
+                    for (s, o) in s.iter_mut().zip(old) {
+                        *s = *s + o;
                     }
                 }
                 for l in 0..L {
@@ -162,7 +163,8 @@ impl<const WU: usize, const WV: usize> Pass<'_, WU, WV> {
                 for l in 0..L {
                     n[l][jj] = DVec3::new(st[0][l], st[1][l], st[2][l]);
                 }
-                if st[3].0.contains(&0.0) {
+                // The flags are 1 or 0: one product tells whether any lane is degenerate.
+                if st[3].0.iter().product::<f64>() == 0.0 {
                     let lanes = (0..L).filter(|&l| st[3][l] == 0.0);
                     degenerate.extend(lanes.map(|l| (i + l, c0 + jj)));
                 }

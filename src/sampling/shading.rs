@@ -350,7 +350,10 @@ pub(crate) fn unit_normals_inv<const L: usize>(
     let cz = lanes(&|l| u[0][l] * v[1][l] - v[0][l] * u[1][l]);
     let lu = lanes(&|l| u[0][l] * u[0][l] + u[1][l] * u[1][l] + u[2][l] * u[2][l]);
     let lv = lanes(&|l| v[0][l] * v[0][l] + v[1][l] * v[1][l] + v[2][l] * v[2][l]);
-    let scale = lanes(&|l| lu[l].max(lv[l]));
+    // A plain select, not `f64::max` (whose NaN rule costs two more instructions): they differ
+    // only when Su or Sv has a NaN, and then |Su × Sv|² is NaN and the lane is not regular
+    // either way, so the flags and normals stay exactly `regular_normal`'s.
+    let scale = lanes(&|l| if lu[l] > lv[l] { lu[l] } else { lv[l] });
     let len2 = lanes(&|l| cx[l] * cx[l] + cy[l] * cy[l] + cz[l] * cz[l]);
     let ok = lanes(&|l| {
         let ok = (scale[l] > 0.0) & (len2[l] > 1e-20 * scale[l] * scale[l]) & len2[l].is_finite();
