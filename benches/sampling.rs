@@ -398,7 +398,7 @@ fn paired_map_ratio() {
     const EDITS: usize = 400;
     let (_, _, batch) = &scenarios()[0];
     let mut objs = MAP_MODES.map(|(_, mode)| SampledObject::new(&surface(), mode));
-    let mut block = |obj: &mut SampledObject| {
+    let block = |obj: &mut SampledObject| {
         let start = Instant::now();
         for _ in 0..EDITS {
             for e in batch {
