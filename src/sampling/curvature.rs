@@ -183,7 +183,7 @@ pub(crate) fn shape_of(
     // sample computed twice gets the same bits, and only the new ones are reported.
     let starts = (0..n / L)
         .map(|g| g * L)
-        .chain((n % L != 0).then_some(n - L));
+        .chain((!n.is_multiple_of(L)).then_some(n - L));
     let mut done = 0;
     for start in starts {
         let d: &[[DVec3; 6]; L] = data[start..start + L].try_into().expect("L samples");
