@@ -379,6 +379,18 @@ pub(super) fn weight_grid(
             ),
         ));
     }
+    // Checked here rather than left to the geometry's flat check, so that the message names
+    // the weight the way the file writes it: [row][column].
+    if let Some(k) = w.iter().position(|x| !(x.is_finite() && *x > 0.0)) {
+        let (i, j) = (k / count[1], k % count[1]);
+        return Err(at.err(
+            "weights",
+            format!(
+                "weight [{i}][{j}] is {}; weights must be positive and finite",
+                w[k]
+            ),
+        ));
+    }
     Ok(Some(w))
 }
 

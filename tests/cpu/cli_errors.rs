@@ -232,6 +232,27 @@ fn weights() {
         None,
         &["object 's'", "field 'weights'", "1 × 2 weights for 2 × 2"],
     );
+    // A surface weight is named as the file writes it, [row][column], not by a flat index.
+    expect_error(
+        &scene(&[&SURF.replace("\"samples\"", "\"weights\": [[1, 1], [1, -2]], \"samples\"")]),
+        None,
+        &[
+            "object 's'",
+            "field 'weights'",
+            "weight [1][1] is -2",
+            "positive",
+        ],
+    );
+    expect_error(
+        &scene(&[&SURF.replace("\"samples\"", "\"weights\": [[1, 0], [1, 1]], \"samples\"")]),
+        None,
+        &[
+            "object 's'",
+            "field 'weights'",
+            "weight [0][1] is 0",
+            "positive",
+        ],
+    );
 }
 
 #[test]
