@@ -432,3 +432,52 @@ fn scene_writes_are_fsynced_before_the_rename() {
         "the directory is not fsynced after the rename:\n{log}"
     );
 }
+
+/// Structural edits (degree elevation here; knot insertion, ERBS refinement, X and B take the
+/// same check) grow nets and Hermite tables: one that would take the scene over the memory
+/// budget is refused on the status line and changes nothing (no undo step); the same key under
+/// a budget that has room applies it.
+#[test]
+fn structural_edits_over_the_memory_budget_are_refused() {
+    use prespline::cli::render::DRAW_USES;
+    use prespline::sampling::SampleMode;
+    use prespline::sampling::budget::{MemoryBudget, check_scene};
+
+    let scratch = common::Scratch::new("view-session");
+    let mut v = Viewer::new(scratch.join("saved.json"));
+    let before = v.scene();
+    let now = check_scene(
+        &before,
+        SampleMode::Render,
+        DRAW_USES,
+        &MemoryBudget::from_flag(Some(u64::MAX)),
+    )
+    .expect("an unlimited budget");
+    // Exactly what the scene takes now: any growth is over it.
+    v.session.memory = MemoryBudget::from_flag(Some(now));
+    v.select(Handle::Point {
+        object: 1,
+        point: Index2::One(2),
+    });
+    v.key('e', false, false);
+    let status = v.session.status().to_string();
+    assert!(
+        status.starts_with("no elevate degree: ") && status.contains("over the memory budget"),
+        "status: {status}"
+    );
+    assert_eq!(v.scene(), before, "a refused elevation changes nothing");
+    assert_eq!(v.session.undo_depth(), (0, 0), "and leaves no undo step");
+
+    v.session.memory = MemoryBudget::from_flag(Some(2 * now));
+    v.select(Handle::Point {
+        object: 1,
+        point: Index2::One(2),
+    });
+    v.key('e', false, false);
+    match &v.scene().objects[1].model {
+        Model::Curve(c) => assert_eq!(c.curve().degree(), 4, "{}", v.session.status()),
+        other => panic!("not a B-spline curve: {other:?}"),
+    }
+    assert_eq!(v.session.undo_depth(), (1, 0));
+    v.finish();
+}

@@ -230,6 +230,7 @@ fn run_window(
         msaa: args.msaa,
         lod: args.lod,
         analysis: args.analysis,
+        memory: args.memory,
     })
     .map_err(CliError)?;
     Ok((run.frames, run.device))

@@ -108,6 +108,7 @@ pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
         msaa: 0,
         lod: true,
         analysis: opts.analysis,
+        memory: opts.memory,
     };
     let title = args.title.clone();
     let run = app::run(args).map_err(CliError)?;

@@ -57,6 +57,9 @@ pub struct ViewArgs {
     pub lod: bool,
     /// A surface analysis map shown from the start.
     pub analysis: Option<crate::render::maps::SurfaceMap>,
+    /// What pre-evaluation may take; structural edits and curvature maps that would need
+    /// more are refused on the status line.
+    pub memory: crate::sampling::budget::MemoryBudget,
 }
 
 /// What a viewer run measured.
@@ -229,6 +232,7 @@ impl App {
         session.set_autosave(self.args.autosave.clone());
         session.naive = self.args.naive;
         session.options.lod = self.args.lod;
+        session.memory = self.args.memory;
         if self.args.analysis.is_some() {
             session.set_map(self.args.analysis);
         }

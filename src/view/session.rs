@@ -123,6 +123,8 @@ pub struct Session {
     map_range: f64,
     /// A scripted action that could not run (see [`Session::take_script_error`]).
     script_error: Option<String>,
+    /// What pre-evaluation may take (`--memory-limit`, else half of physical memory).
+    pub memory: MemoryBudget,
 }
 
 impl Session {
@@ -173,6 +175,7 @@ impl Session {
             autosave: None,
             transform_origin: None,
             osculating: false,
+            memory: MemoryBudget::machine_default(),
             map_range: 1.0,
             script_error: None,
         })
@@ -911,7 +914,9 @@ impl Session {
         match r.edit(&self.doc) {
             Ok(edit) => {
                 let what = r.describe(&self.doc);
-                self.structural("insert knot", edit);
+                if !self.structural("insert knot", edit) {
+                    return;
+                }
                 let at = what
                     .split(" (")
                     .next()
@@ -932,7 +937,9 @@ impl Session {
                 let name = self.doc.objects[r.object].name.clone();
                 let at = r.at.unwrap_or_default();
                 let axis = r.axis_name(&self.doc);
-                self.structural("refine", edit);
+                if !self.structural("refine", edit) {
+                    return;
+                }
                 self.set_status(format!(
                     "refined {name} at {axis} = {at:.4}: new {added} (Ctrl+Z undoes)"
                 ));
@@ -958,13 +965,15 @@ impl Session {
             return self.set_status(format!("cannot make an ERBS local: {e}"));
         }
         let name = self.doc.objects[object].name.clone();
-        self.structural(
+        if !self.structural(
             "make ERBS local",
             Edit {
                 object,
                 edit: edit.clone(),
             },
-        );
+        ) {
+            return;
+        }
         self.selected_local = Some((object, local));
         let what = if self.doc.objects[object].sampled.model().is_surface() {
             format!("{DETAIL_LOCALS} x {DETAIL_LOCALS} patches")
@@ -1003,7 +1012,9 @@ impl Session {
             return self.set_status(format!("cannot elevate the degree: {e}"));
         }
         let name = self.doc.objects[object].name.clone();
-        self.structural("elevate degree", Edit { object, edit });
+        if !self.structural("elevate degree", Edit { object, edit }) {
+            return;
+        }
         let degree = match self.doc.objects[object].sampled.model() {
             ModelRef::Curve(m) => m.curve().degree().to_string(),
             ModelRef::Surface(m) => format!("{:?}", m.surface().degree()),
@@ -1014,7 +1025,14 @@ impl Session {
 
     /// Applies a structural edit as one undo step. Control point indices of that object change,
     /// so its selection and the projected handles are dropped.
-    fn structural(&mut self, label: &str, edit: Edit) {
+    /// Refused (false, the reason on the status line) where the result would not fit the memory
+    /// budget.
+    #[must_use]
+    fn structural(&mut self, label: &str, edit: Edit) -> bool {
+        if let Err(e) = self.fits_budget(&edit) {
+            self.set_status(format!("no {label}: {e}"));
+            return false;
+        }
         let object = edit.object;
         self.undo.begin(label);
         self.queue(edit);
@@ -1025,6 +1043,27 @@ impl Session {
         self.hovered = None;
         self.projected = None;
         self.refresh_bounds();
+        true
+    }
+
+    /// Whether the scene still fits the memory budget with `edit` applied: refinement and
+    /// degree elevation grow nets and Hermite tables, and a key held down must not take the
+    /// machine's memory (the scene loaded under the same check).
+    fn fits_budget(&self, edit: &Edit) -> Result<(), String> {
+        let mut scene = self.doc.to_scene();
+        let Some(o) = scene.objects.get_mut(edit.object) else {
+            return Ok(());
+        };
+        // An edit that does not apply is reported where it is applied, as before.
+        if o.model.apply(&edit.edit).is_err() {
+            return Ok(());
+        }
+        let mode = if self.options.analysis.is_some_and(|m| m.needs_curvature()) {
+            SampleMode::Analysis
+        } else {
+            SampleMode::Render
+        };
+        check_scene(&scene, mode, DRAW_USES, &self.memory).map(|_| ())
     }
 
     fn transform_key(&mut self, key: Key) {
@@ -1213,7 +1252,7 @@ impl Session {
                 &self.doc.to_scene(),
                 SampleMode::Analysis,
                 DRAW_USES,
-                &MemoryBudget::machine_default(),
+                &self.memory,
             )
         {
             return self.set_status(format!("no curvature map: {e}"));
@@ -1253,7 +1292,9 @@ impl Session {
         match self.doc.to_bspline(object) {
             Ok(edit) => {
                 let name = self.doc.objects[object].name.clone();
-                self.structural("convert to B-spline", edit);
+                if !self.structural("convert to B-spline", edit) {
+                    return;
+                }
                 self.set_status(format!("{name} is now a bspline_curve (Ctrl+Z undoes)"));
             }
             Err(e) => self.set_status(e),
