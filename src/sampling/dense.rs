@@ -5,9 +5,10 @@
 //! surface is a tensor product on an 8 × 8 net, so a sample costs one pass instead of four.
 //!
 //! The lane layout is `shading`'s: L sample rows share each column's v-coefficients, held
-//! lane-minor so that the autovectoriser emits SIMD across the rows.
+//! lane-minor so that the autovectoriser emits SIMD across the rows. The normals of a row group
+//! are solved after its columns, through a [`NormalStage`].
 
-use super::shading::{LANES, Lanes, QCol, partials, unit_normals};
+use super::shading::{LANES, Lanes, NormalStage, QCol, partials};
 use glam::DVec3;
 
 /// Rows 0 and 1 of a dense basis of width W at one sample: the W functions' values and first
@@ -107,22 +108,17 @@ impl<const WU: usize, const WV: usize> Pass<'_, WU, WV> {
             .map(|c| c.map(|row| row.map(|x| Lanes([x; L]))))
             .collect();
         let (r0, c0) = self.origin;
+        let nc = coeffs.len();
+        let mut stage = NormalStage::new(if N { nc * L } else { 0 });
         for (g, rows) in cu.chunks_exact(L).enumerate() {
             let q = self.fill_q::<L>(rows);
+            // The rows and stage columns resliced to exactly `nc`, so that indexing them by
+            // the column needs no bounds check (13 of the loop's 220 instructions).
             let d: [&mut [[DVec3; 3]]; L] = std::array::from_fn(|_| {
-                data.next()
-                    .expect("one grid row per sample row")
-                    .as_chunks_mut::<3>()
-                    .0
+                let row = data.next().expect("one grid row per sample row");
+                &mut row.as_chunks_mut::<3>().0[..nc]
             });
-            let n: [&mut [DVec3]; L] = std::array::from_fn(|_| {
-                if N {
-                    normals.next().expect("one normal row per sample row")
-                } else {
-                    &mut []
-                }
-            });
-            let i = r0 + first + g * L;
+            let mut st = stage.inputs::<L>(if N { nc } else { 0 });
             for (jj, cv) in coeffs.iter().enumerate() {
                 let mut s = partials::<WV, L>(&q, cv);
                 if ADD {
@@ -143,21 +139,32 @@ impl<const WU: usize, const WV: usize> Pass<'_, WU, WV> {
                         DVec3::new(s[6][l], s[7][l], s[8][l]),
                     ];
                 }
-                // The normals straight from the lanes: with the sums kept in registers, the
-                // square roots overlap the next column's products as well as a separate
-                // pass over staged Su, Sv did (measured: no slower, the full pass a few
-                // percent faster), without the staging's stores and loads.
                 if N {
-                    let (nn, ok) =
-                        unit_normals::<L>([s[3].0, s[4].0, s[5].0], [s[6].0, s[7].0, s[8].0]);
-                    for l in 0..L {
-                        n[l][jj] = DVec3::new(nn[0][l], nn[1][l], nn[2][l]);
+                    for (col, lanes) in st.iter_mut().zip(&s[3..]) {
+                        col[jj] = lanes.0;
                     }
-                    // The flags are 1 or 0: one product tells whether any lane is degenerate.
-                    if ok.iter().product::<f64>() == 0.0 {
-                        let lanes = (0..L).filter(|&l| ok[l] == 0.0);
-                        degenerate.extend(lanes.map(|l| (i + l, c0 + jj)));
-                    }
+                }
+            }
+            if !N {
+                continue;
+            }
+            // The group's normals in one vectorised loop, then out to the grid rows.
+            let bad = stage.solve();
+            let i = r0 + first + g * L;
+            let n: [&mut [DVec3]; L] = std::array::from_fn(|_| {
+                let row = normals.next().expect("one normal row per sample row");
+                &mut row[..nc]
+            });
+            let [nx, ny, nz] = stage.normals::<L>(nc);
+            for (jj, ((x, y), z)) in nx.iter().zip(ny).zip(nz).enumerate() {
+                for l in 0..L {
+                    n[l][jj] = DVec3::new(x[l], y[l], z[l]);
+                }
+            }
+            if bad > 0 {
+                for jj in 0..nc {
+                    let lanes = (0..L).filter(|&l| !stage.regular(jj * L + l));
+                    degenerate.extend(lanes.map(|l| (i + l, c0 + jj)));
                 }
             }
         }
