@@ -859,7 +859,7 @@ mod tests {
         let cases = normal_cases();
         let groups = cases.len() / LANES;
         let mut stage = NormalStage::new(groups * LANES);
-        let mut inputs = stage.inputs::<LANES>(groups);
+        let inputs = stage.inputs::<LANES>(groups);
         for (k, chunk) in cases.chunks_exact(LANES).enumerate() {
             for (l, (u, v)) in chunk.iter().enumerate() {
                 for c in 0..3 {
