@@ -223,15 +223,19 @@ mod tests {
 
     /// The kernel against the definition, sample by sample, for a random dense basis and net,
     /// storing and adding, with and without normals; and a perturbed net must be told apart.
+    /// A 3-wide net takes the staged normals, an 8-wide one the normals in the column loop.
     #[test]
     fn dense_pass_is_the_tensor_product() {
+        tensor_product::<4, 3>();
+        tensor_product::<4, 8>();
+    }
+
+    fn tensor_product<const WU: usize, const WV: usize>() {
         let mut state = 7u64;
         let mut rnd = move || {
             state = state.wrapping_mul(6364136223846793005).wrapping_add(1);
             (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
         };
-        const WU: usize = 4;
-        const WV: usize = 3;
         let (nr, nc, width) = (7, 5, 9);
         let cu: Vec<DenseRow<WU>> = (0..nr)
             .map(|_| std::array::from_fn(|_| std::array::from_fn(|_| rnd())))
