@@ -275,7 +275,9 @@ mod tests {
             assert!(net_ok || worst > 1e-3, "a perturbed net must fail");
             worst
         };
-        for add in [false, true] {
+        // A 12-row grid filled with `base`, the pass run on it with normals: (S, Su, Sv per
+        // sample, normals, degenerate indices).
+        let run = |net: &[[DVec3; WV]; WU], base: DVec3, add: bool| {
             let mut data = vec![base; 12 * width * 3];
             let mut normals = vec![DVec3::ZERO; 12 * width];
             let mut degenerate = Vec::new();
@@ -287,10 +289,14 @@ mod tests {
                 col0,
             };
             if add {
-                pass::<WU, WV, true>(&cu, &cv, &net, target, &mut degenerate);
+                pass::<WU, WV, true>(&cu, &cv, net, target, &mut degenerate);
             } else {
-                pass::<WU, WV, false>(&cu, &cv, &net, target, &mut degenerate);
+                pass::<WU, WV, false>(&cu, &cv, net, target, &mut degenerate);
             }
+            (data, normals, degenerate)
+        };
+        for add in [false, true] {
+            let (data, normals, degenerate) = run(&net, base, add);
             assert!(check(&data, add, true) < 1e-15);
             for i in 0..nr {
                 for j in 0..nc {
@@ -320,18 +326,7 @@ mod tests {
         }
         // A zero net: Su = Sv = 0 at every sample, so each must be reported degenerate, once,
         // at its grid index (the lane groups and the ragged last row alike).
-        let mut data = vec![DVec3::ZERO; 12 * width * 3];
-        let mut normals = vec![DVec3::ZERO; 12 * width];
-        let mut degenerate = Vec::new();
-        let target = Target {
-            data: &mut data,
-            normals: Some(&mut normals),
-            width,
-            row0,
-            col0,
-        };
-        let zero = [[DVec3::ZERO; WV]; WU];
-        pass::<WU, WV, true>(&cu, &cv, &zero, target, &mut degenerate);
+        let (_, _, mut degenerate) = run(&[[DVec3::ZERO; WV]; WU], DVec3::ZERO, true);
         degenerate.sort_unstable();
         let all: Vec<_> = (row0..row0 + nr)
             .flat_map(|i| (col0..col0 + nc).map(move |j| (i, j)))
