@@ -6,7 +6,11 @@
 //!
 //! The lane layout is `shading`'s: L sample rows share each column's v-coefficients, held
 //! lane-minor so that the autovectoriser emits SIMD across the rows. The normals of a row group
-//! are solved after its columns, through a [`NormalStage`].
+//! are solved after its columns, through a [`NormalStage`]. Where the build has AVX, groups of
+//! four rows take the same steps in explicit AVX instead ([`avx`]).
+
+#[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+mod avx;
 
 use super::shading::{LANES, Lanes, NormalStage, QCol, partials, unit_normals};
 use glam::DVec3;
@@ -37,6 +41,29 @@ pub(crate) fn pass<const WU: usize, const WV: usize, const ADD: bool>(
     out: Target<'_>,
     degenerate: &mut Vec<(usize, usize)>,
 ) {
+    run::<WU, WV, ADD>(cu, cv, net, out, degenerate, false);
+}
+
+/// [`pass`] on the portable path alone, for comparing the two.
+#[cfg(test)]
+fn pass_portable<const WU: usize, const WV: usize, const ADD: bool>(
+    cu: &[DenseRow<WU>],
+    cv: &[DenseRow<WV>],
+    net: &[[DVec3; WV]; WU],
+    out: Target<'_>,
+    degenerate: &mut Vec<(usize, usize)>,
+) {
+    run::<WU, WV, ADD>(cu, cv, net, out, degenerate, true);
+}
+
+fn run<const WU: usize, const WV: usize, const ADD: bool>(
+    cu: &[DenseRow<WU>],
+    cv: &[DenseRow<WV>],
+    net: &[[DVec3; WV]; WU],
+    out: Target<'_>,
+    degenerate: &mut Vec<(usize, usize)>,
+    portable: bool,
+) {
     let (nr, nc) = (cu.len(), cv.len());
     if nr == 0 || nc == 0 {
         return;
@@ -44,6 +71,7 @@ pub(crate) fn pass<const WU: usize, const WV: usize, const ADD: bool>(
     let pass = Pass {
         net,
         origin: (out.row0, out.col0),
+        portable,
     };
     pass.run::<ADD>(cu, cv, out, degenerate);
 }
@@ -51,6 +79,12 @@ pub(crate) fn pass<const WU: usize, const WV: usize, const ADD: bool>(
 struct Pass<'a, const WU: usize, const WV: usize> {
     net: &'a [[DVec3; WV]; WU],
     origin: (usize, usize),
+    /// Whether groups of rows keep to the portable kernel where the build has AVX.
+    #[cfg_attr(
+        not(all(target_arch = "x86_64", target_feature = "avx")),
+        allow(dead_code)
+    )]
+    portable: bool,
 }
 
 impl<const WU: usize, const WV: usize> Pass<'_, WU, WV> {
@@ -69,22 +103,39 @@ impl<const WU: usize, const WV: usize> Pass<'_, WU, WV> {
         let mut data = out.data[r0 * w * 3..(r0 + nr) * w * 3]
             .chunks_exact_mut(w * 3)
             .map(|r| &mut r[c0 * 3..(c0 + nc) * 3]);
-        let split = nr / LANES * LANES;
         match out.normals {
             Some(normals) => {
                 let mut normals = normals[r0 * w..(r0 + nr) * w]
                     .chunks_exact_mut(w)
                     .map(|r| &mut r[c0..c0 + nc]);
-                let (n4, n1) = (&mut normals, degenerate);
-                self.rows::<LANES, ADD, true>(0, &cu[..split], cv, &mut data, n4, n1);
-                self.rows::<1, ADD, true>(split, &cu[split..], cv, &mut data, n4, n1);
+                self.groups::<ADD, true>(cu, cv, &mut data, &mut normals, degenerate);
             }
             None => {
                 let none = &mut std::iter::empty();
-                self.rows::<LANES, ADD, false>(0, &cu[..split], cv, &mut data, none, degenerate);
-                self.rows::<1, ADD, false>(split, &cu[split..], cv, &mut data, none, degenerate);
+                self.groups::<ADD, false>(cu, cv, &mut data, none, degenerate);
             }
         }
+    }
+
+    /// The rows in groups of `LANES`: in explicit AVX where the build has it (the last group
+    /// padded), else through the portable kernel (the rows past the last whole group one by
+    /// one).
+    fn groups<'g, const ADD: bool, const N: bool>(
+        &self,
+        cu: &[DenseRow<WU>],
+        cv: &[DenseRow<WV>],
+        data: &mut impl Iterator<Item = &'g mut [DVec3]>,
+        normals: &mut impl Iterator<Item = &'g mut [DVec3]>,
+        degenerate: &mut Vec<(usize, usize)>,
+    ) {
+        #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+        if !self.portable {
+            avx::groups::<WU, WV, ADD, N>(self, cu, cv, data, normals, degenerate);
+            return;
+        }
+        let split = cu.len() / LANES * LANES;
+        self.rows::<LANES, ADD, N>(0, &cu[..split], cv, data, normals, degenerate);
+        self.rows::<1, ADD, N>(split, &cu[split..], cv, data, normals, degenerate);
     }
 
     /// Rows `cu` (a multiple of L of them, the first being rectangle row `first`) in groups of
@@ -223,20 +274,30 @@ mod tests {
 
     /// The kernel against the definition, sample by sample, for a random dense basis and net,
     /// storing and adding, with and without normals; and a perturbed net must be told apart.
-    /// A 3-wide net takes the staged normals, an 8-wide one the normals in the column loop.
+    /// On the portable path a 3-wide net takes the staged normals, an 8-wide one the normals in
+    /// the column loop; the AVX path, where the build has it, must give the same bits.
     #[test]
     fn dense_pass_is_the_tensor_product() {
-        tensor_product::<4, 3>();
-        tensor_product::<4, 8>();
+        // Row counts with no, one and three rows past the last whole group of four, and one
+        // with no whole group at all.
+        for nr in [8, 7, 9, 3] {
+            tensor_product::<4, 3>(nr);
+            tensor_product::<4, 8>(nr);
+        }
     }
 
-    fn tensor_product<const WU: usize, const WV: usize>() {
+    /// Exact comparison (NaN-aware: equal bits).
+    fn bits(v: &[DVec3]) -> Vec<[u64; 3]> {
+        v.iter().map(|p| p.to_array().map(f64::to_bits)).collect()
+    }
+
+    fn tensor_product<const WU: usize, const WV: usize>(nr: usize) {
         let mut state = 7u64;
         let mut rnd = move || {
             state = state.wrapping_mul(6364136223846793005).wrapping_add(1);
             (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
         };
-        let (nr, nc, width) = (7, 5, 9);
+        let (nc, width) = (5, 9);
         let cu: Vec<DenseRow<WU>> = (0..nr)
             .map(|_| std::array::from_fn(|_| std::array::from_fn(|_| rnd())))
             .collect();
@@ -276,24 +337,40 @@ mod tests {
             worst
         };
         // A 12-row grid filled with `base`, the pass run on it with normals: (S, Su, Sv per
-        // sample, normals, degenerate indices).
+        // sample, normals, degenerate indices). The portable path must give the same bits.
         let run = |net: &[[DVec3; WV]; WU], base: DVec3, add: bool| {
-            let mut data = vec![base; 12 * width * 3];
-            let mut normals = vec![DVec3::ZERO; 12 * width];
-            let mut degenerate = Vec::new();
-            let target = Target {
-                data: &mut data,
-                normals: Some(&mut normals),
-                width,
-                row0,
-                col0,
-            };
-            if add {
-                pass::<WU, WV, true>(&cu, &cv, net, target, &mut degenerate);
-            } else {
-                pass::<WU, WV, false>(&cu, &cv, net, target, &mut degenerate);
-            }
-            (data, normals, degenerate)
+            let runs: [_; 2] = std::array::from_fn(|portable| {
+                let mut data = vec![base; 12 * width * 3];
+                let mut normals = vec![DVec3::ZERO; 12 * width];
+                let mut degenerate = Vec::new();
+                let target = Target {
+                    data: &mut data,
+                    normals: Some(&mut normals),
+                    width,
+                    row0,
+                    col0,
+                };
+                let dg = &mut degenerate;
+                match (add, portable == 1) {
+                    (true, false) => pass::<WU, WV, true>(&cu, &cv, net, target, dg),
+                    (false, false) => pass::<WU, WV, false>(&cu, &cv, net, target, dg),
+                    (true, true) => pass_portable::<WU, WV, true>(&cu, &cv, net, target, dg),
+                    (false, true) => pass_portable::<WU, WV, false>(&cu, &cv, net, target, dg),
+                }
+                (data, normals, degenerate)
+            });
+            let [mut fast, mut portable] = runs;
+            assert_eq!(
+                bits(&fast.0),
+                bits(&portable.0),
+                "S, Su, Sv of the two paths"
+            );
+            assert_eq!(bits(&fast.1), bits(&portable.1), "normals of the two paths");
+            // The order of the degenerate samples is unspecified.
+            fast.2.sort_unstable();
+            portable.2.sort_unstable();
+            assert_eq!(fast.2, portable.2, "degenerate samples of the two paths");
+            fast
         };
         for add in [false, true] {
             let (data, normals, degenerate) = run(&net, base, add);

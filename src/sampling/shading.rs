@@ -584,7 +584,7 @@ pub(crate) fn translate_curve(t: &HermiteTable, k: usize, delta: DVec3, data: &m
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     //! The fast paths against the generic code: `Square(1)` grids (which hold S, Su, Sv among
     //! other partials) and curve orders above 1 never take them.
     use super::*;
@@ -805,7 +805,7 @@ mod tests {
 
     /// (Su, Sv) pairs: zero, tiny, huge, NaN and infinite partials, then random ones over 20
     /// decades, every third pair nearly parallel (near the regularity threshold).
-    fn normal_cases() -> Vec<(DVec3, DVec3)> {
+    pub(crate) fn normal_cases() -> Vec<(DVec3, DVec3)> {
         let mut rng = Rng(99);
         let special = [
             DVec3::ZERO,
@@ -833,7 +833,7 @@ mod tests {
     }
 
     /// Bit for bit `regular_normal`'s normal, or flagged degenerate exactly where it says so.
-    fn assert_is_regular_normal(u: DVec3, v: DVec3, n: [f64; 3], ok: bool) {
+    pub(crate) fn assert_is_regular_normal(u: DVec3, v: DVec3, n: [f64; 3], ok: bool) {
         match regular_normal(u, v) {
             Some(r) => {
                 assert!(ok, "{u} × {v} is regular");
