@@ -15,8 +15,8 @@
 //!
 //! Every value is the portable kernel's product and sum, in its order, so the two paths agree
 //! bit for bit (`dense`'s tests compare them). On the reference machine (Zen 3) an ERBS
-//! local-patch rotation (113 × 113 samples) took 97–119 µs against the portable kernel's
-//! 147–182 µs, in alternating criterion runs (README "Performance"). Measured and dropped: the
+//! local-patch rotation (113 × 113 samples) took 92–119 µs against the portable kernel's
+//! 119–182 µs, in alternating criterion runs (README "Performance"). Measured and dropped: the
 //! normals in the column loop (7 % slower), in three loops (10 % slower), or staged in the
 //! grid's order (5 % slower); fused multiply-adds (5 % faster, but no longer the portable
 //! path's bits).
