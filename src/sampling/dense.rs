@@ -44,18 +44,7 @@ pub(crate) fn pass<const WU: usize, const WV: usize, const ADD: bool>(
     run::<WU, WV, ADD>(cu, cv, net, out, degenerate, false);
 }
 
-/// [`pass`] on the portable path alone, for comparing the two.
-#[cfg(test)]
-fn pass_portable<const WU: usize, const WV: usize, const ADD: bool>(
-    cu: &[DenseRow<WU>],
-    cv: &[DenseRow<WV>],
-    net: &[[DVec3; WV]; WU],
-    out: Target<'_>,
-    degenerate: &mut Vec<(usize, usize)>,
-) {
-    run::<WU, WV, ADD>(cu, cv, net, out, degenerate, true);
-}
-
+/// [`pass`], on the portable kernel alone if `portable` (the tests compare the two paths).
 fn run<const WU: usize, const WV: usize, const ADD: bool>(
     cu: &[DenseRow<WU>],
     cv: &[DenseRow<WV>],
@@ -350,12 +339,10 @@ mod tests {
                     row0,
                     col0,
                 };
-                let dg = &mut degenerate;
-                match (add, portable == 1) {
-                    (true, false) => pass::<WU, WV, true>(&cu, &cv, net, target, dg),
-                    (false, false) => pass::<WU, WV, false>(&cu, &cv, net, target, dg),
-                    (true, true) => pass_portable::<WU, WV, true>(&cu, &cv, net, target, dg),
-                    (false, true) => pass_portable::<WU, WV, false>(&cu, &cv, net, target, dg),
+                let (dg, portable) = (&mut degenerate, portable == 1);
+                match add {
+                    true => run::<WU, WV, true>(&cu, &cv, net, target, dg, portable),
+                    false => run::<WU, WV, false>(&cu, &cv, net, target, dg, portable),
                 }
                 (data, normals, degenerate)
             });
