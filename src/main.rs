@@ -7,6 +7,7 @@ use prespline::cli::{self, CliError};
 use prespline::render::maps::SurfaceMap;
 use prespline::render::{NetMode, OrbitCamera, ViewOptions, Wire};
 use prespline::sampling::budget::{self, MemoryBudget};
+use prespline::scene::escape_controls;
 use prespline::view::scenario::Scenario;
 use std::io::Write;
 use std::path::PathBuf;
@@ -315,7 +316,7 @@ fn main() -> ExitCode {
                 lod: !no_lod,
                 analysis,
             };
-            cli::bench::run(&args).map(|line| eprintln!("{line}"))
+            cli::bench::run(&args).map(|line| eprintln!("{}", escape_controls(&line)))
         }
         Command::Render {
             scene,
@@ -342,19 +343,18 @@ fn main() -> ExitCode {
             }
             cli::render::run(&doc, &out, size.0, size.1, camera, options, msaa)
         })
-        .map(|line| eprintln!("{line}")),
+        .map(|line| eprintln!("{}", escape_controls(&line))),
         Command::Convert {
             input,
             output,
             samples,
-        } => {
-            cli::files::convert(&input, &output, &samples.counts()).map(|line| eprintln!("{line}"))
-        }
+        } => cli::files::convert(&input, &output, &samples.counts())
+            .map(|line| eprintln!("{}", escape_controls(&line))),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error: {}", escape_controls(&e.to_string()));
             ExitCode::FAILURE
         }
     }

@@ -521,3 +521,29 @@ fn knot_insertion_drag_and_two_undos_restore_the_scene_exactly() {
     );
     assert_eq!(undone, original, "two undos restore the scene bit for bit");
 }
+
+/// Script times and frames past what a replay can reach are refused up front in one line
+/// (they used to panic converting to a `Duration`, or draw until killed).
+#[test]
+fn script_times_out_of_reach_are_one_line_errors() {
+    if !common::display() {
+        return;
+    }
+    let dir = Scratch::new("view-xvfb");
+    for script in [
+        r#"[{"t": 1e300, "key": "a"}]"#,
+        r#"[{"t": 1e19, "key": "a"}]"#,
+        r#"[{"frame": 18446744073709551615, "key": "a"}]"#,
+    ] {
+        let out = run(prespline(&dir)
+            .args(["view", "--size", "320x240", "--script"])
+            .arg(dir.file("times.json", script)));
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{script}: {err}");
+        assert_eq!(err.lines().count(), 1, "{script}: one line, got {err}");
+        assert!(
+            err.starts_with("error: ") && err.contains("event 0"),
+            "{err}"
+        );
+    }
+}

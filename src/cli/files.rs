@@ -104,7 +104,7 @@ pub fn load_scene(path: &Path, samples: &SampleOverride) -> Result<Scene, CliErr
         Some(Format::Obj) => {
             let import = load_obj(path).map_err(|e| CliError(e.0))?;
             for w in &import.warnings {
-                eprintln!("{}", w.in_file(path));
+                eprintln!("{}", crate::scene::escape_controls(&w.in_file(path)));
             }
             import.scene
         }

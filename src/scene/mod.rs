@@ -14,7 +14,28 @@ pub use edit::parse_edits;
 pub use parse::parse_scene;
 pub use write::scene_to_json;
 
+use std::borrow::Cow;
 use std::path::Path;
+
+/// User text (object and field names, file contents) as a one-line message may echo it: control
+/// characters escaped as Rust writes them (`\n`, `\u{1b}`), so a name can neither split the line
+/// nor reach the terminal as an escape sequence. Every line the program prints about user input
+/// passes through here.
+#[must_use]
+pub fn escape_controls(s: &str) -> Cow<'_, str> {
+    if !s.chars().any(char::is_control) {
+        return Cow::Borrowed(s);
+    }
+    let mut out = String::with_capacity(s.len() + 8);
+    for c in s.chars() {
+        if c.is_control() {
+            out.extend(c.escape_debug());
+        } else {
+            out.push(c);
+        }
+    }
+    Cow::Owned(out)
+}
 
 /// Anything wrong with a scene or edit file, as one line naming the object, field and index.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -95,4 +116,21 @@ pub fn write_durably(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
         return Err(e);
     }
     std::fs::File::open(dir).and_then(|d| d.sync_all())
+}
+
+#[cfg(test)]
+mod escape_tests {
+    use super::*;
+
+    #[test]
+    fn control_characters_are_escaped_and_nothing_else() {
+        assert!(matches!(escape_controls("teapot_03 ü ∂"), Cow::Borrowed(_)));
+        assert_eq!(
+            escape_controls("a\nb\u{1b}[31m\t\u{7f}c"),
+            r"a\nb\u{1b}[31m\t\u{7f}c"
+        );
+        // Negative control: a line that still holds a control character fails the check.
+        assert!(escape_controls("x\ry").chars().all(|c| !c.is_control()));
+        assert!("x\ry".chars().any(char::is_control));
+    }
 }

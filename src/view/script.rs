@@ -27,6 +27,15 @@ use crate::render::{Document, Handle};
 use serde_json::Value;
 use std::path::PathBuf;
 
+/// The latest time a script may name: a day. Later times are typos or fuzz, and a time past
+/// what `Duration` and `Instant` hold would end the replay in a panic.
+pub const MAX_SCRIPT_SECONDS: f64 = 86_400.0;
+/// The last frame a script may name (about two days at 60 frames a second): frame-numbered
+/// events keep frames coming until they run, so a larger number would draw until killed.
+pub const MAX_SCRIPT_FRAME: u64 = 10_000_000;
+/// Wheel steps per event at most: 0.85^1000 already zooms past any scene.
+pub const MAX_WHEEL_STEPS: f64 = 1000.0;
+
 /// When an action happens.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum When {
@@ -70,12 +79,27 @@ pub fn parse_script(text: &str, doc: &Document) -> Result<Vec<ScriptEvent>, Stri
 fn parse_event(v: &Value, doc: &Document) -> Result<ScriptEvent, String> {
     let obj = v.as_object().ok_or("expected an object")?;
     let when = match (obj.get("frame"), obj.get("t")) {
-        (Some(f), None) => When::Frame(f.as_u64().ok_or("'frame' must be a non-negative integer")?),
-        (None, Some(t)) => When::Seconds(
-            t.as_f64()
+        (Some(f), None) => {
+            let f = f.as_u64().ok_or("'frame' must be a non-negative integer")?;
+            if f > MAX_SCRIPT_FRAME {
+                return Err(format!(
+                    "'frame' {f} is beyond the last frame a script may name ({MAX_SCRIPT_FRAME}, about two days at 60 frames a second)"
+                ));
+            }
+            When::Frame(f)
+        }
+        (None, Some(t)) => {
+            let t = t
+                .as_f64()
                 .filter(|t| *t >= 0.0)
-                .ok_or("'t' must be a non-negative number")?,
-        ),
+                .ok_or("'t' must be a non-negative number")?;
+            if t > MAX_SCRIPT_SECONDS {
+                return Err(format!(
+                    "'t' {t} s is beyond the longest a script may run ({MAX_SCRIPT_SECONDS} s, one day)"
+                ));
+            }
+            When::Seconds(t)
+        }
         _ => return Err("give exactly one of 'frame' and 't'".into()),
     };
     let flag = |k: &str| obj.get(k).and_then(Value::as_bool).unwrap_or(false);
@@ -127,7 +151,12 @@ fn parse_event(v: &Value, doc: &Document) -> Result<ScriptEvent, String> {
             pressed: false,
         }),
         "wheel" => Action::Input(InputEvent::Wheel {
-            delta: arg.as_f64().ok_or("'wheel' expects a number")?,
+            delta: arg
+                .as_f64()
+                .filter(|d| d.abs() <= MAX_WHEEL_STEPS)
+                .ok_or(format!(
+                    "'wheel' expects a number of steps between -{MAX_WHEEL_STEPS} and {MAX_WHEEL_STEPS}"
+                ))?,
         }),
         "key" => {
             let k = arg.as_str().and_then(Key::parse).ok_or(
@@ -137,7 +166,11 @@ fn parse_event(v: &Value, doc: &Document) -> Result<ScriptEvent, String> {
         }
         "type" => Action::Type(arg.as_str().ok_or("'type' expects a string")?.to_string()),
         "screenshot" => Action::Screenshot(
-            PathBuf::from(arg.as_str().ok_or("'screenshot' expects a file name")?),
+            PathBuf::from(
+                arg.as_str()
+                    .filter(|p| !p.trim().is_empty())
+                    .ok_or("'screenshot' expects a file name (a non-empty string)")?,
+            ),
             flag("hud"),
         ),
         "hold" => {
@@ -274,4 +307,46 @@ fn local_path(v: &Value, surface: bool) -> Option<LocalPath<Index2>> {
         (_, false) => vec![Index2::One(one(v)?)],
     };
     LocalPath::new(&steps)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::demo::demo_scene;
+
+    fn parse(text: &str) -> Result<Vec<ScriptEvent>, String> {
+        parse_script(text, &Document::new(&demo_scene()))
+    }
+
+    #[test]
+    fn times_past_what_a_replay_can_reach_are_refused_in_one_line() {
+        for (text, needle) in [
+            (r#"[{"t": 1e300, "key": "a"}]"#, "'t'"),
+            (r#"[{"t": 1e19, "key": "a"}]"#, "'t'"),
+            (
+                r#"[{"frame": 18446744073709551615, "key": "a"}]"#,
+                "'frame'",
+            ),
+            (r#"[{"frame": 10000001, "quit": true}]"#, "'frame'"),
+            (r#"[{"frame": 1, "wheel": 1e300}]"#, "'wheel'"),
+            (r#"[{"frame": 1, "screenshot": ""}]"#, "'screenshot'"),
+        ] {
+            let e = parse(text).expect_err(text);
+            assert!(
+                e.starts_with("event 0: ") && e.contains(needle),
+                "{text}: {e}"
+            );
+            assert!(!e.contains('\n'), "{text}: one line, got {e:?}");
+        }
+    }
+
+    #[test]
+    fn the_limits_themselves_are_accepted() {
+        let text = format!(
+            r#"[{{"t": {MAX_SCRIPT_SECONDS}, "key": "a"}}, {{"frame": {MAX_SCRIPT_FRAME}, "wheel": {MAX_WHEEL_STEPS}}}]"#
+        );
+        let events = parse(&text).unwrap();
+        assert_eq!(events[0].when, When::Seconds(MAX_SCRIPT_SECONDS));
+        assert_eq!(events[1].when, When::Frame(MAX_SCRIPT_FRAME));
+    }
 }

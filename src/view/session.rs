@@ -273,7 +273,8 @@ impl Session {
     }
 
     pub fn set_status(&mut self, s: impl Into<String>) {
-        self.status = s.into();
+        let s: String = s.into();
+        self.status = crate::scene::escape_controls(&s).into_owned();
         self.status_since = Some(Instant::now());
     }
 

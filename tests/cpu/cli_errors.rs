@@ -650,3 +650,23 @@ fn memory_limit_applies_to_every_command() {
     assert!(!bad.status.success());
     assert!(String::from_utf8_lossy(&bad.stderr).contains("--memory-limit"));
 }
+
+/// User text is echoed escaped: a name with a newline cannot split the error line, an ESC
+/// sequence in a name or an unknown field never reaches the terminal.
+#[test]
+fn control_characters_in_user_text_are_escaped() {
+    let bad_name = CURVE.replace(r#""name": "c""#, r#""name": "c\nd\u001b[31m", "oops": 1"#);
+    expect_error(&scene(&[&bad_name]), None, &[r"c\nd\u{1b}[31m", "'oops'"]);
+    let bad_field = CURVE.replace(
+        r#""name": "c","#,
+        r#""name": "c", "x\u001b]0;pwned\u0007": 1,"#,
+    );
+    expect_error(&scene(&[&bad_field]), None, &[r"x\u{1b}]0;pwned\u{7}"]);
+    for text in [&bad_name, &bad_field] {
+        let (_, _, stderr) = sample(&scene(&[text]), None);
+        assert!(
+            !stderr.trim_end_matches('\n').chars().any(char::is_control),
+            "a control character reached stderr: {stderr:?}"
+        );
+    }
+}

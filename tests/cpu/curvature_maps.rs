@@ -226,3 +226,71 @@ fn analysis_delta_path_equals_full_evaluation_after_random_edits() {
         }
     }
 }
+
+/// The saddle z = (x + 1)(y + 1) over [0, 1]², tilted and moved by a rigid motion, as a bicubic
+/// Bézier patch (a bilinear function's control points are its values at the Greville points
+/// i/3, j/3). F = Su·Sv and M = Suv·n are nonzero everywhere, so every term of K and H counts.
+fn tilted_saddle(samples: [usize; 2]) -> (Model, glam::DMat3) {
+    let rot = glam::DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.7);
+    let shift = DVec3::new(0.3, -1.2, 2.5);
+    let pts = (0..16)
+        .map(|k| {
+            let (x, y) = ((k / 4) as f64 / 3.0, (k % 4) as f64 / 3.0);
+            rot * DVec3::new(x, y, (x + 1.0) * (y + 1.0)) + shift
+        })
+        .collect();
+    let s = TensorSurface::bezier([4, 4], pts, None).unwrap();
+    let m = Model::Surface(SurfaceModel::new(SplineForm::Bezier, s, samples).unwrap());
+    (m, rot)
+}
+
+/// K and H of the graph z = f(x, y), f = (x + 1)(y + 1), with the upward normal Su × Sv (a
+/// rigid motion changes neither): with W² = 1 + f_x² + f_y², K = −f_xy² / W⁴ and
+/// H = −f_x f_y f_xy / W³.
+fn saddle_curvatures(u: f64, v: f64, h_factor: f64) -> [f64; 2] {
+    let (fx, fy) = (v + 1.0, u + 1.0);
+    let w2 = 1.0 + fx * fx + fy * fy;
+    [-1.0 / (w2 * w2), -h_factor * fx * fy / (w2 * w2.sqrt())]
+}
+
+/// Largest relative error of every sample's [K, H] against the saddle's (NaN: infinite).
+fn saddle_error(obj: &SampledObject, h_factor: f64) -> f64 {
+    let params = obj.params();
+    let mv = params[1].len();
+    curvatures(obj)
+        .iter()
+        .enumerate()
+        .map(|(s, kh)| {
+            let want = saddle_curvatures(params[0][s / mv], params[1][s % mv], h_factor);
+            (0..2)
+                .map(|c| (kh[c] - want[c]).abs() / want[c].abs())
+                .map(|e| if e.is_nan() { f64::INFINITY } else { e })
+                .fold(0.0, f64::max)
+        })
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn a_tilted_saddle_has_its_analytic_curvatures_in_the_full_and_the_delta_path() {
+    let (model, rot) = tilted_saddle([37, 23]);
+    let mut obj = SampledObject::new(&model, SampleMode::Analysis);
+    let full = saddle_error(&obj, 1.0);
+    assert!(full < 1e-13, "full pass: {full:e}");
+    // Negative control: the check sees a mean curvature missing its 2·F·M term's half.
+    assert!(saddle_error(&obj, 0.5) > 0.4);
+    // The delta path's kernel recomputes K and H of every touched sample: move an interior
+    // point out of the plane and back (the samples return to within rounding).
+    obj.set_rebuild_interval(None);
+    for (point, sign) in [([1, 2], 1.0), ([1, 2], -1.0), ([2, 1], 1.0), ([2, 1], -1.0)] {
+        let delta = rot * DVec3::new(0.0, 0.0, 0.25 * sign);
+        let e = SurfaceEdit::Point(PointEdit::Move { point, delta }).into_object();
+        let region = obj.apply(&e).unwrap();
+        assert_eq!(
+            region.samples(),
+            37 * 23,
+            "a Bézier point touches every sample"
+        );
+    }
+    let delta = saddle_error(&obj, 1.0);
+    assert!(delta < 1e-12, "delta path: {delta:e}");
+}
