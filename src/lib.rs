@@ -6,6 +6,7 @@
 #![deny(unsafe_code)]
 #![warn(clippy::undocumented_unsafe_blocks)]
 pub mod cli;
+pub mod editor;
 pub mod geom;
 #[allow(unsafe_code)]
 pub mod gpu;

@@ -334,10 +334,10 @@ fn main() -> ExitCode {
             edits.as_deref(),
             &samples.counts(),
             &memory.budget(),
+            display.analysis,
         )
-        .and_then(|mut doc| {
+        .and_then(|doc| {
             let mut options = display.options();
-            cli::render::show_analysis(&mut doc, options.analysis, &memory.budget())?;
             if let Some((name, t)) = &osculating {
                 options.osculating_at = Some(cli::render::osculating_at(&doc, name, *t)?);
             }

@@ -5,9 +5,9 @@
 
 mod common;
 
+use prespline::editor::Handle;
 use prespline::geom::erbs::{ErbsCurve, ErbsSurface, LocalCurve, LocalPatch};
 use prespline::model::{Index2, LocalPath, Model};
-use prespline::render::Handle;
 use prespline::scene::Scene;
 use prespline::view::Session;
 use prespline::view::input::{InputEvent, Key, Modifiers, MouseButton};
@@ -194,11 +194,12 @@ impl Headless {
 
     fn with_scene(scene: &Scene) -> Self {
         let (mut renderer, sink) = common::renderer();
-        let session = Session::new(
+        let session = Session::open(
             &mut renderer,
             scene,
             std::env::temp_dir().join("unused.json"),
             [800, 600],
+            prespline::sampling::budget::MemoryBudget::machine_default(),
         )
         .unwrap();
         Self {
@@ -246,7 +247,7 @@ impl Headless {
 
     fn curve(&mut self) -> ErbsCurve {
         self.session.apply_pending();
-        match self.session.doc.to_scene().objects[0].model.clone() {
+        match self.session.doc().to_scene().objects[0].model.clone() {
             Model::ErbsCurve(m) => m.curve().clone(),
             _ => panic!("an erbs_curve"),
         }
@@ -363,7 +364,7 @@ fn closed_torus_refines_across_its_seam_and_inside_a_detail_there() {
     let mut v = Headless::with_scene(&scene);
     let torus = |v: &mut Headless| {
         v.session.apply_pending();
-        match v.session.doc.to_scene().objects[object].model.clone() {
+        match v.session.doc().to_scene().objects[object].model.clone() {
             Model::ErbsSurface(m) => m.surface().clone(),
             _ => panic!("the torus is an erbs_surface"),
         }

@@ -6,8 +6,9 @@
 mod common;
 
 use glam::{DMat4, DVec3};
+use prespline::editor::Handle;
 use prespline::model::{Index2, LocalPath, Model};
-use prespline::render::Handle;
+use prespline::sampling::budget::MemoryBudget;
 use prespline::scene::{Scene, parse_scene};
 use prespline::view::Session;
 use prespline::view::autosave::{AUTOSAVE_DELAY, Autosave};
@@ -36,7 +37,14 @@ impl Viewer {
     fn new(save_path: PathBuf) -> Self {
         let (mut renderer, sink) = common::renderer();
         let scene = parse_scene(SCENE).unwrap();
-        let session = Session::new(&mut renderer, &scene, save_path, [800, 600]).unwrap();
+        let session = Session::open(
+            &mut renderer,
+            &scene,
+            save_path,
+            [800, 600],
+            MemoryBudget::machine_default(),
+        )
+        .unwrap();
         Viewer {
             session,
             renderer,
@@ -82,7 +90,7 @@ impl Viewer {
 
     fn scene(&mut self) -> Scene {
         self.session.apply_pending();
-        self.session.doc.to_scene()
+        self.session.doc().to_scene()
     }
 
     fn finish(self) {
@@ -441,7 +449,7 @@ fn scene_writes_are_fsynced_before_the_rename() {
 fn structural_edits_over_the_memory_budget_are_refused() {
     use prespline::cli::render::DRAW_USES;
     use prespline::sampling::SampleMode;
-    use prespline::sampling::budget::{MemoryBudget, check_scene};
+    use prespline::sampling::budget::check_scene;
 
     let scratch = common::Scratch::new("view-session");
     let mut v = Viewer::new(scratch.join("saved.json"));
@@ -454,7 +462,8 @@ fn structural_edits_over_the_memory_budget_are_refused() {
     )
     .expect("an unlimited budget");
     // Exactly what the scene takes now: any growth is over it.
-    v.session.memory = MemoryBudget::from_flag(Some(now));
+    v.session
+        .set_memory_budget(MemoryBudget::from_flag(Some(now)));
     v.select(Handle::Point {
         object: 1,
         point: Index2::One(2),
@@ -468,7 +477,8 @@ fn structural_edits_over_the_memory_budget_are_refused() {
     assert_eq!(v.scene(), before, "a refused elevation changes nothing");
     assert_eq!(v.session.undo_depth(), (0, 0), "and leaves no undo step");
 
-    v.session.memory = MemoryBudget::from_flag(Some(2 * now));
+    v.session
+        .set_memory_budget(MemoryBudget::from_flag(Some(2 * now)));
     v.select(Handle::Point {
         object: 1,
         point: Index2::One(2),

@@ -139,9 +139,15 @@ fn run_headless(
             samples: args.msaa,
         })
         .map_err(gpu)?;
-    let mut session =
-        Session::new(&mut renderer, scene, dir.join("scene.json"), [w, h]).map_err(gpu)?;
-    session.naive = naive;
+    let mut session = Session::open(
+        &mut renderer,
+        scene,
+        dir.join("scene.json"),
+        [w, h],
+        args.memory,
+    )
+    .map_err(CliError)?;
+    session.set_naive(naive);
     session.options.lod = args.lod;
     session.set_map(args.analysis);
     let total = args.warmup + args.frames;

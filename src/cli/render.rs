@@ -2,14 +2,14 @@
 
 use super::CliError;
 use super::files::{SampleOverride, load_scene};
-use crate::gpu::{Renderer, RendererDesc, ValidationMode};
+use crate::editor::{Document, Editor, EditorOptions, ListRefused};
+use crate::gpu::{Renderer, RendererDesc};
 use crate::render::maps::SurfaceMap;
 use crate::render::offscreen::{Shot, render_document};
-use crate::render::{Document, OrbitCamera, ViewOptions};
+use crate::render::{OrbitCamera, ViewOptions};
 use crate::sampling::SampleMode;
-use crate::sampling::budget::{MemoryBudget, Uses, check_scene};
-use crate::scene::edit::{apply_all, parse_edits};
-use crate::scene::{Scene, SceneError};
+use crate::sampling::budget::{MemoryBudget, check_scene};
+use crate::scene::{EditList, Scene};
 use std::path::Path;
 use std::time::Instant;
 
@@ -32,25 +32,7 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     Ok((w, h))
 }
 
-/// Validation layer policy for interactive commands: on in debug builds or with
-/// `PRESPLINE_VALIDATION=1`, when the layer is installed; `PRESPLINE_VALIDATION=required`
-/// refuses to run without it (tests must not pass unvalidated); `0` turns it off.
-pub fn validation_mode() -> ValidationMode {
-    let env = std::env::var("PRESPLINE_VALIDATION").ok();
-    match env.as_deref() {
-        Some("required") => ValidationMode::Required,
-        Some("1") => ValidationMode::IfAvailable,
-        Some("0") => ValidationMode::Off,
-        _ if cfg!(debug_assertions) => ValidationMode::IfAvailable,
-        _ => ValidationMode::Off,
-    }
-}
-
-/// What drawing commands (`render`, `view`, `bench`) keep per object.
-pub const DRAW_USES: Uses = Uses {
-    gpu: true,
-    json_text: false,
-};
+pub use crate::render::{DRAW_USES, validation_mode};
 
 /// Refuses a scene whose pre-evaluation and GPU mirrors would not fit `budget` (one line naming
 /// the object and the estimate).
@@ -60,45 +42,38 @@ pub fn check_drawable(scene: &Scene, path: &Path, budget: &MemoryBudget) -> Resu
         .map_err(|e| CliError::in_file(path, e))
 }
 
-/// Loads a scene (JSON or OBJ), checks it against the memory budget and applies an edits file
-/// (through the delta path; edits that refine the model are budgeted too).
+/// Loads a scene (JSON or OBJ) into an editor held to the memory budget and applies an edits
+/// file through it (the delta path; edits that grow an object are budgeted as they come), with
+/// `map` shown on the surfaces (a curvature map is budgeted first).
 pub fn load_document(
     scene_path: &Path,
     edits: Option<&Path>,
     samples: &SampleOverride,
     budget: &MemoryBudget,
+    map: Option<SurfaceMap>,
 ) -> Result<Document, CliError> {
     let scene = load_scene(scene_path, samples)?;
-    check_drawable(&scene, scene_path, budget)?;
-    let Some(path) = edits else {
-        return Ok(Document::new(&scene));
+    let options = EditorOptions {
+        mode: SampleMode::Render,
+        uses: DRAW_USES,
+        budget: *budget,
     };
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| CliError(format!("cannot read {}: {e}", path.display())))?;
-    let edits = parse_edits(&text, &scene).map_err(|e| CliError::in_file(path, e))?;
-    // Knot insertion and degree elevation grow the tables: budget the edited model too.
-    let mut refined = scene.clone();
-    apply_all(&mut refined, &edits).map_err(|e| CliError::in_file(path, e))?;
-    check_drawable(&refined, scene_path, budget)?;
-    let mut doc = Document::new(&scene);
-    for e in edits {
-        doc.apply(&e)
-            .map_err(|err| CliError::in_file(path, SceneError(err.to_string())))?;
+    let mut editor = Editor::new(&scene, options).map_err(|e| CliError::in_file(scene_path, e))?;
+    if let Some(path) = edits {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| CliError(format!("cannot read {}: {e}", path.display())))?;
+        let list = EditList::parse(&text).map_err(|e| CliError::in_file(path, e))?;
+        editor.submit_list(&list).map_err(|r| match r {
+            ListRefused::Edit(e) => CliError::in_file(path, e),
+            ListRefused::OverBudget(e) => CliError::in_file(scene_path, e),
+        })?;
     }
-    Ok(doc)
-}
-
-/// Shows `map` on the document's surfaces (`--analysis`). A curvature map keeps second
-/// partials and K, H per sample: the scene is budgeted for that first (one line naming the
-/// object when it does not fit).
-pub fn show_analysis(
-    doc: &mut Document,
-    map: Option<SurfaceMap>,
-    budget: &MemoryBudget,
-) -> Result<(), CliError> {
-    check_analysis(&doc.to_scene(), map, budget)?;
-    doc.set_analysis(map);
-    Ok(())
+    if let Some(m) = map.filter(|m| m.needs_curvature()) {
+        editor
+            .set_surface_mode(SampleMode::Analysis)
+            .map_err(|e| CliError(format!("--analysis {}: {e}", m.name())))?;
+    }
+    Ok(editor.into_document())
 }
 
 /// Budgets `scene` for `map` (`--analysis`): a curvature map keeps second partials, K and H

@@ -2,9 +2,10 @@
 //! JSON contract of docs/scene-format.md on stdout.
 
 use super::CliError;
-use crate::sampling::budget::{MemoryBudget, Uses, check_scene};
+use crate::editor::{Editor, EditorOptions, ListRefused};
+use crate::sampling::budget::{MemoryBudget, Uses};
 use crate::sampling::{SampleMode, SampledObject};
-use crate::scene::edit::{apply_all, parse_edits};
+use crate::scene::EditList;
 use std::fmt::Write;
 use std::path::Path;
 
@@ -32,49 +33,42 @@ pub fn run(args: &SampleArgs) -> Result<String, CliError> {
             args.derivatives
         )));
     }
-    let mut scene = super::files::load_scene(args.scene, &Default::default())?;
+    let scene = super::files::load_scene(args.scene, &Default::default())?;
     let edits = match args.edits {
         Some(path) => {
             let text = std::fs::read_to_string(path)
                 .map_err(|e| CliError(format!("cannot read {}: {e}", path.display())))?;
-            parse_edits(&text, &scene).map_err(|e| CliError::in_file(path, e))?
+            Some((
+                path,
+                EditList::parse(&text).map_err(|e| CliError::in_file(path, e))?,
+            ))
         }
-        None => Vec::new(),
+        None => None,
     };
-    let mode = SampleMode::Derivatives(args.derivatives);
-    let uses = Uses {
-        gpu: false,
-        json_text: true,
+    let options = EditorOptions {
+        mode: SampleMode::Derivatives(args.derivatives),
+        uses: Uses {
+            gpu: false,
+            json_text: true,
+        },
+        budget: args.memory,
     };
-    check_scene(&scene, mode, uses, &args.memory).map_err(|e| CliError::in_file(args.scene, e))?;
-    if !edits.is_empty() {
-        // Knot insertion and degree elevation grow the tables: budget the edited model too.
-        let mut refined = scene.clone();
-        apply_all(&mut refined, &edits).map_err(|e| CliError(e.to_string()))?;
-        check_scene(&refined, mode, uses, &args.memory)
-            .map_err(|e| CliError::in_file(args.scene, e))?;
-        if args.full {
-            scene = refined;
-        }
+    let mut editor = Editor::new(&scene, options).map_err(|e| CliError::in_file(args.scene, e))?;
+    if let Some((path, list)) = &edits {
+        // Through the delta path; edits that grow an object are budgeted as they come.
+        editor.submit_list(list).map_err(|r| match r {
+            ListRefused::Edit(e) => CliError::in_file(path, e),
+            ListRefused::OverBudget(e) => CliError::in_file(args.scene, e),
+        })?;
     }
-    let mut objects: Vec<SampledObject> = scene
-        .objects
-        .iter()
-        .map(|o| SampledObject::new(&o.model, mode))
-        .collect();
-    if !args.full {
-        for (k, e) in edits.iter().enumerate() {
-            objects[e.object].apply(&e.edit).map_err(|err| {
-                CliError(format!(
-                    "edit {k} (object '{}'): {err}",
-                    scene.objects[e.object].name
-                ))
-            })?;
-        }
+    if args.full {
+        editor.resample_all();
     }
+    let doc = editor.into_document();
+    let objects: Vec<&SampledObject> = doc.objects.iter().map(|o| &o.sampled).collect();
     let mut out = String::with_capacity(1 << 16);
     out.push_str("{\"objects\": [\n");
-    for (i, (meta, obj)) in scene.objects.iter().zip(&objects).enumerate() {
+    for (i, (meta, obj)) in doc.objects.iter().zip(&objects).enumerate() {
         write_object(&mut out, &meta.name, obj)?;
         out.push_str(if i + 1 < objects.len() { ",\n" } else { "\n" });
     }

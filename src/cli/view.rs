@@ -88,7 +88,7 @@ pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
         Some(p) => {
             let text = std::fs::read_to_string(p)
                 .map_err(|e| CliError(format!("cannot read {}: {e}", p.display())))?;
-            let doc = crate::render::Document::new(&scene);
+            let doc = crate::editor::Document::new(&scene);
             Some(parse_script(&text, &doc).map_err(|e| CliError::in_file(p, e))?)
         }
         None => None,

@@ -2,7 +2,8 @@
 //! (continuity badges) and the osculating circle with curvature and torsion at a parameter.
 //! Pure f64 computations from the model; drawing them is the overlays' business.
 
-use super::document::Document;
+pub use super::style::short;
+use crate::editor::Document;
 use crate::geom::continuity::{JoinClass, classify};
 use crate::geom::differential::frenet_frame;
 use crate::geom::{BSplineCurve, ErbsCurve};
@@ -198,19 +199,6 @@ impl Osculating {
             short(self.radius()),
             short(self.torsion)
         )
-    }
-}
-
-/// Four significant digits, plain ASCII (the overlay font).
-pub fn short(x: f64) -> String {
-    if x == 0.0 {
-        // log10(0) is −∞: a planar curve's torsion would overflow the digit count.
-        "0".to_string()
-    } else if (1e-3..1e5).contains(&x.abs()) {
-        let digits = (3 - x.abs().log10().floor() as i32).clamp(0, 6) as usize;
-        format!("{x:.digits$}")
-    } else {
-        format!("{x:.3e}")
     }
 }
 

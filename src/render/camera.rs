@@ -1,5 +1,6 @@
 //! The orbit camera: a target point, a distance and two angles, z up.
 
+pub use crate::geom::Bounds;
 use glam::{DMat4, DVec3, DVec4, Mat4, Vec3};
 
 /// A camera orbiting `target` (z up): `yaw` around z, `pitch` above the xy-plane.
@@ -23,46 +24,6 @@ impl Default for OrbitCamera {
             yaw: -0.6,
             pitch: 0.45,
             fov_y: 40f64.to_radians(),
-        }
-    }
-}
-
-/// Axis-aligned bounds of the scene (for framing and clip planes).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Bounds {
-    pub min: DVec3,
-    pub max: DVec3,
-}
-
-impl Bounds {
-    pub const EMPTY: Bounds = Bounds {
-        min: DVec3::splat(f64::INFINITY),
-        max: DVec3::splat(f64::NEG_INFINITY),
-    };
-
-    pub fn include(&mut self, p: DVec3) {
-        self.min = self.min.min(p);
-        self.max = self.max.max(p);
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.min.x > self.max.x
-    }
-
-    pub fn centre(&self) -> DVec3 {
-        if self.is_empty() {
-            DVec3::ZERO
-        } else {
-            0.5 * (self.min + self.max)
-        }
-    }
-
-    /// Radius of the bounding sphere around the centre (at least a tiny positive value).
-    pub fn radius(&self) -> f64 {
-        if self.is_empty() {
-            1.0
-        } else {
-            (0.5 * (self.max - self.min).length()).max(1e-9)
         }
     }
 }

@@ -2,48 +2,21 @@
 //! structures, with per-frame-slot dirty tracking so each slot receives exactly the rows changed
 //! since it was last written.
 
-use super::document::{
-    Controls, Document, Handle, LOCAL_CURVE_SAMPLES, LOCAL_PATCH_SAMPLES, LocalControls,
-};
 use super::lod::{GridMetrics, Lod};
 use super::map_mirror::{MapScalars, MapView, SurfaceSlot};
 use super::style::{NetMode, Palette, ViewOptions, Wire};
+use crate::editor::{
+    Applied, ControlLayout, ControlsChange, Document, Handle, LOCAL_CURVE_SAMPLES,
+    LOCAL_PATCH_SAMPLES, LocalEntry,
+};
 use crate::gpu::{
     FRAMES_IN_FLIGHT, Frame, GpuResult, GridShape, GridStride, MapStyle, Mirror, PointRun,
     PointStyle, PolylineStyle, Renderer, SurfaceBatch, SurfaceStyle,
 };
-use crate::model::{Edit, Index2, LocalPath, ModelRef, Target};
-use crate::sampling::{DirtyRegion, DirtySet};
+use crate::model::{Index2, LocalPath};
+use crate::sampling::DirtySet;
 use glam::DVec3;
 use std::collections::BTreeMap;
-
-/// Where an object's control structures sit in its control mirror (offsets in floats).
-#[derive(Debug, Clone, PartialEq)]
-enum ControlLayout {
-    Polygon {
-        count: usize,
-    },
-    Net {
-        rows: usize,
-        cols: usize,
-    },
-    /// Per polynomial local curve at any depth: its path, sample offset, control-point
-    /// offset and control-point count.
-    LocalCurves(Vec<LocalEntry>),
-    /// Per polynomial local patch at any depth: its path, grid offset, control-point offset,
-    /// net rows and columns.
-    LocalPatches(Vec<LocalEntry>),
-}
-
-/// Where one local's display floats sit in the control mirror.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct LocalEntry {
-    path: LocalPath<Index2>,
-    samples: usize,
-    points: usize,
-    rows: usize,
-    cols: usize,
-}
 
 /// Where an object's samples sit: an arena mirror and a float offset in it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -58,13 +31,10 @@ struct ObjectGpu {
     /// Sample rows (surfaces) or samples (curves) each slot has not seen yet.
     dirty: [DirtySet; FRAMES_IN_FLIGHT],
     controls: Mirror,
-    /// The control mirror's contents, kept so an edit of one ERBS local recomputes only that
-    /// local's floats and each slot copies only the float ranges it has not seen.
-    controls_cache: Vec<f32>,
+    /// Control display vertices each slot has not seen yet.
     controls_dirty: [DirtySet; FRAMES_IN_FLIGHT],
-    /// The control structures changed size: the next upload replaces the control mirror.
+    /// The control display changed layout: the next upload replaces the control mirror.
     controls_resized: bool,
-    layout: ControlLayout,
     /// Stride chosen for the view in `GpuScene::lod_view`, until the view or the samples change.
     lod: Option<GridStride>,
     /// World-space measures of the samples for choosing strides; `None` until measured after
@@ -189,7 +159,7 @@ impl GpuScene {
             filled?;
         }
         for (i, o) in doc.objects.iter().enumerate() {
-            let (layout, data) = control_floats(&doc.controls(i));
+            let data = vertex_floats(&o.controls.vertices);
             let mut controls =
                 renderer.create_mirror(&format!("{} controls", o.name), data.len().max(3))?;
             let filled = renderer.fill_mirror(&mut controls, 0, &data);
@@ -198,10 +168,8 @@ impl GpuScene {
                 samples: places[i],
                 dirty: Default::default(),
                 controls,
-                controls_cache: data,
                 controls_dirty: Default::default(),
                 controls_resized: false,
-                layout,
                 lod: None,
                 metrics: None,
             });
@@ -210,114 +178,28 @@ impl GpuScene {
         Ok(())
     }
 
-    /// Records what an applied edit changed: the sample rows of `region`, and the control
-    /// structures its target says changed (one point, one ERBS local, or the whole layout).
-    pub fn note(&mut self, doc: &Document, edit: &Edit, region: &DirtyRegion) {
-        self.note_samples(edit.object, region);
-        match edit.edit.target() {
-            Target::Point(point) => self.note_point(doc, edit.object, point),
-            Target::Local(local) => self.note_local(doc, edit.object, local),
-            // A weight moves no control point.
-            Target::Weight(_) => {}
-            Target::Structure => self.note_controls(doc, edit.object),
-        }
-    }
-
-    /// Updates one control point's three floats (a drag must not copy a 10 000-point net).
-    fn note_point(&mut self, doc: &Document, object: usize, point: Index2) {
-        let o = &mut self.objects[object];
-        let (index, p) = match (&o.layout, doc.objects[object].sampled.model()) {
-            (ControlLayout::Polygon { .. }, ModelRef::Curve(c)) => match point {
-                Index2::One(k) => (k, c.curve().points()[k]),
-                Index2::Two(..) => return,
-            },
-            (ControlLayout::Net { cols, .. }, ModelRef::Surface(s)) => match point {
-                Index2::Two(i, j) => (i * cols + j, s.surface().point(i, j)),
-                Index2::One(_) => return,
-            },
-            _ => return self.note_controls(doc, object),
-        };
-        let r = index * 3..index * 3 + 3;
-        o.controls_cache[r.clone()].copy_from_slice(&[p.x as f32, p.y as f32, p.z as f32]);
-        for d in &mut o.controls_dirty {
-            d.insert(r.clone());
-        }
-    }
-
-    /// Marks sample rows dirty for every slot.
-    pub fn note_samples(&mut self, object: usize, region: &DirtyRegion) {
-        for d in &mut self.objects[object].dirty {
-            d.insert(region.rows.clone());
-        }
-    }
-
-    /// Recomputes all control structures of `object` and marks them dirty for every slot; when
-    /// their size changed (a refinement), the next upload replaces that object's control
-    /// mirror, and only that one.
-    pub fn note_controls(&mut self, doc: &Document, object: usize) {
-        let (layout, data) = control_floats(&doc.controls(object));
-        let o = &mut self.objects[object];
-        let resized = data.len().max(3) != o.controls.len();
-        o.layout = layout;
-        o.controls_cache = data;
-        if resized {
-            o.controls_resized = true;
-            o.controls_dirty = Default::default();
-        } else {
-            for d in &mut o.controls_dirty {
-                d.insert(0..o.controls_cache.len());
+    /// Takes in what an apply changed: its sample rows and control vertices become dirty for
+    /// every frame slot; a control display with a new layout replaces its mirror at the next
+    /// upload. The report is all it reads: what the edits were does not matter here.
+    pub fn consume(&mut self, applied: &Applied) {
+        for c in &applied.changes {
+            let o = &mut self.objects[c.object];
+            for region in &c.samples {
+                for d in &mut o.dirty {
+                    d.insert(region.rows.clone());
+                }
             }
-        }
-    }
-
-    /// Recomputes the display floats (samples or grid, control points) of the polynomial locals
-    /// at or below one ERBS local; falls back to all controls if the layout no longer fits.
-    fn note_local(&mut self, doc: &Document, object: usize, local: LocalPath<Index2>) {
-        let o = &mut self.objects[object];
-        let mut updates: Vec<(std::ops::Range<usize>, Vec<f32>)> = Vec::new();
-        let fits = match (&o.layout, doc.local_controls(object, local)) {
-            (ControlLayout::LocalCurves(entries), Some(LocalControls::Curves(curves))) => {
-                curves.iter().all(|c| {
-                    let Some(e) = entries.iter().find(|e| e.path == c.path) else {
-                        return false;
-                    };
-                    let mut s = Vec::new();
-                    c.samples.iter().for_each(|&q| push3(&mut s, q));
-                    let mut p = Vec::new();
-                    c.points.iter().for_each(|&q| push3(&mut p, q));
-                    let ok = p.len() == e.rows * 3;
-                    updates.push((e.samples..e.samples + s.len(), s));
-                    updates.push((e.points..e.points + p.len(), p));
-                    ok
-                })
-            }
-            (ControlLayout::LocalPatches(entries), Some(LocalControls::Patches(patches))) => {
-                patches.iter().all(|p| {
-                    let Some(e) = entries.iter().find(|e| e.path == p.path) else {
-                        return false;
-                    };
-                    let mut g = Vec::new();
-                    for &(pos, n) in &p.grid {
-                        push3(&mut g, pos);
-                        push3(&mut g, n);
+            match &c.controls {
+                ControlsChange::Unchanged => {}
+                ControlsChange::Vertices(set) => {
+                    for d in &mut o.controls_dirty {
+                        set.ranges().iter().for_each(|r| d.insert(r.clone()));
                     }
-                    let mut q = Vec::new();
-                    p.points.iter().for_each(|&x| push3(&mut q, x));
-                    let ok = (p.net_rows, p.net_cols) == (e.rows, e.cols);
-                    updates.push((e.samples..e.samples + g.len(), g));
-                    updates.push((e.points..e.points + q.len(), q));
-                    ok
-                })
-            }
-            _ => false,
-        };
-        if !fits {
-            return self.note_controls(doc, object);
-        }
-        for (r, f) in updates {
-            o.controls_cache[r.clone()].copy_from_slice(&f);
-            for d in &mut o.controls_dirty {
-                d.insert(r.clone());
+                }
+                ControlsChange::Resized => {
+                    o.controls_resized = true;
+                    o.controls_dirty = Default::default();
+                }
             }
         }
     }
@@ -399,17 +281,20 @@ impl GpuScene {
                     }
                 }
             }
+            let vertices = &doc.objects[i].controls.vertices;
             if std::mem::take(&mut o.controls_resized) {
                 let name = format!("{} controls", o.name);
-                frame.replace_mirror(&mut o.controls, &name, &o.controls_cache)?;
-                stats.bytes += o.controls_cache.len() * 4 * FRAMES_IN_FLIGHT;
+                let data = vertex_floats(vertices);
+                frame.replace_mirror(&mut o.controls, &name, &data)?;
+                stats.bytes += data.len() * 4 * FRAMES_IN_FLIGHT;
             }
             let ranges = o.controls_dirty[slot].take();
             if !ranges.is_empty() {
                 let mut w = frame.write_mirror(&mut o.controls);
                 for r in ranges {
-                    w.write(r.start, &o.controls_cache[r.clone()])?;
-                    stats.bytes += r.len() * 4;
+                    let data = vertex_floats(&vertices[r.clone()]);
+                    w.write(r.start * 3, &data)?;
+                    stats.bytes += data.len() * 4;
                 }
             }
         }
@@ -494,7 +379,8 @@ impl GpuScene {
                 };
                 frame.draw_polyline(&self.arenas[o.samples.arena], run, &style)?;
             }
-            self.draw_controls(frame, i, o, opts, hl, &palette)?;
+            let layout = &doc.objects[i].controls.layout;
+            self.draw_controls(frame, i, o, layout, opts, hl, &palette)?;
         }
         Ok(report)
     }
@@ -529,11 +415,13 @@ impl GpuScene {
         }
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn draw_controls(
         &self,
         frame: &mut Frame<'_>,
         i: usize,
         o: &ObjectGpu,
+        layout: &ControlLayout,
         opts: &ViewOptions,
         hl: &Highlight,
         palette: &Palette,
@@ -558,7 +446,7 @@ impl GpuScene {
             selected: sel,
             ..PointStyle::default()
         };
-        match &o.layout {
+        match layout {
             ControlLayout::Polygon { count } if nets => {
                 let run = PointRun::packed(0, *count);
                 polyline(frame, &o.controls, run, &net)?;
@@ -611,7 +499,7 @@ impl GpuScene {
                             frame,
                             &o.controls,
                             PointRun {
-                                offset: e.samples,
+                                offset: e.samples * 3,
                                 stride: 3,
                                 count: LOCAL_CURVE_SAMPLES,
                             },
@@ -620,7 +508,7 @@ impl GpuScene {
                     }
                     if nets || chosen {
                         let run = PointRun {
-                            offset: e.points,
+                            offset: e.points * 3,
                             stride: 3,
                             count: e.rows,
                         };
@@ -661,21 +549,21 @@ impl GpuScene {
                     let offsets: Vec<usize> = entries
                         .iter()
                         .filter(|e| !chosen(e))
-                        .map(|e| e.samples)
+                        .map(|e| e.samples * 3)
                         .collect();
                     wire(frame, &offsets, palette.local)?;
                 }
                 let selected: Vec<usize> = entries
                     .iter()
                     .filter(|e| chosen(e))
-                    .map(|e| e.samples)
+                    .map(|e| e.samples * 3)
                     .collect();
                 if !selected.is_empty() {
                     wire(frame, &selected, palette.selected_local)?;
                 }
                 for e in entries {
                     if nets || chosen(e) {
-                        control_net(frame, &o.controls, e.points, e.rows, e.cols, &net)?;
+                        control_net(frame, &o.controls, e.points * 3, e.rows, e.cols, &net)?;
                         let pick = |h: Handle| match h {
                             Handle::LocalPoint {
                                 local,
@@ -685,7 +573,7 @@ impl GpuScene {
                             _ => None,
                         };
                         let run = PointRun {
-                            offset: e.points,
+                            offset: e.points * 3,
                             stride: 3,
                             count: e.rows * e.cols,
                         };
@@ -849,64 +737,10 @@ fn sample_floats(doc: &Document, i: usize, rows: std::ops::Range<usize>, out: &m
     }
 }
 
-fn push3(out: &mut Vec<f32>, p: DVec3) {
-    out.extend_from_slice(&[p.x as f32, p.y as f32, p.z as f32]);
-}
-
-/// The control mirror's contents and layout.
-fn control_floats(c: &Controls) -> (ControlLayout, Vec<f32>) {
-    let mut out = Vec::new();
-    let layout = match c {
-        Controls::Polygon(p) => {
-            p.iter().for_each(|&q| push3(&mut out, q));
-            ControlLayout::Polygon { count: p.len() }
-        }
-        Controls::Net { rows, cols, points } => {
-            points.iter().for_each(|&q| push3(&mut out, q));
-            ControlLayout::Net {
-                rows: *rows,
-                cols: *cols,
-            }
-        }
-        Controls::LocalCurves(locals) => {
-            let mut entries = Vec::with_capacity(locals.len());
-            for l in locals {
-                entries.push(LocalEntry {
-                    path: l.path,
-                    samples: out.len(),
-                    points: 0,
-                    rows: l.points.len(),
-                    cols: 1,
-                });
-                l.samples.iter().for_each(|&q| push3(&mut out, q));
-            }
-            for (l, e) in locals.iter().zip(entries.iter_mut()) {
-                e.points = out.len();
-                l.points.iter().for_each(|&q| push3(&mut out, q));
-            }
-            ControlLayout::LocalCurves(entries)
-        }
-        Controls::LocalPatches(patches) => {
-            let mut entries = Vec::with_capacity(patches.len());
-            for p in patches {
-                entries.push(LocalEntry {
-                    path: p.path,
-                    samples: out.len(),
-                    points: 0,
-                    rows: p.net_rows,
-                    cols: p.net_cols,
-                });
-                for &(pos, n) in &p.grid {
-                    push3(&mut out, pos);
-                    push3(&mut out, n);
-                }
-            }
-            for (p, e) in patches.iter().zip(entries.iter_mut()) {
-                e.points = out.len();
-                p.points.iter().for_each(|&q| push3(&mut out, q));
-            }
-            ControlLayout::LocalPatches(entries)
-        }
-    };
-    (layout, out)
+/// Display vertices as the f32 triples of a control mirror.
+fn vertex_floats(vertices: &[DVec3]) -> Vec<f32> {
+    vertices
+        .iter()
+        .flat_map(|p| [p.x as f32, p.y as f32, p.z as f32])
+        .collect()
 }

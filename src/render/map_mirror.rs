@@ -6,8 +6,8 @@
 //! The scalars follow the samples: the sample rows an edit dirtied are the scalar rows it
 //! dirtied, so a drag copies only the touched rows of the map, like the vertex mirrors.
 
-use super::document::Document;
 use super::maps::SurfaceMap;
+use crate::editor::Document;
 use crate::gpu::{Frame, GpuResult, Mirror};
 use std::ops::Range;
 

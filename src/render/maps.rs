@@ -6,6 +6,7 @@
 //! extreme samples near a singular point do not wash the map out). The shader applies the
 //! same scale ([`SCALE`] is its table), so the legend shows exactly what the surface does.
 
+use crate::editor::Document;
 use crate::gpu::OverlayVertex;
 use crate::gpu::font::{push_rect, push_text, text_size};
 use crate::sampling::curvature::principal;
@@ -100,6 +101,20 @@ impl SurfaceMap {
     }
 }
 
+/// The half range of `map`'s colour scale over every surface of `doc` (see
+/// [`symmetric_range`]).
+#[must_use]
+pub fn map_range(doc: &Document, map: SurfaceMap) -> f64 {
+    symmetric_range(doc.objects.iter().flat_map(|o| {
+        o.sampled
+            .grid()
+            .curvatures
+            .iter()
+            .flatten()
+            .map(move |&kh| map.value(kh))
+    }))
+}
+
 /// The colour scale's half range R (values map to ±R): the 98th percentile of |value| over
 /// `values` (NaN ignored); 1 when nothing is finite or everything is 0.
 pub fn symmetric_range(values: impl Iterator<Item = f64>) -> f64 {
@@ -191,8 +206,8 @@ pub fn legend(map: SurfaceMap, r: f64, width: f32, height: f32) -> Vec<OverlayVe
         );
     }
     let ly = by + bar_h + 6.0;
-    let lo = format!("-{}", super::analysis::short(r));
-    let hi = super::analysis::short(r);
+    let lo = format!("-{}", super::style::short(r));
+    let hi = super::style::short(r);
     push_text(&mut v, &lo, bx, ly, scale, TEXT);
     let [zw, _] = text_size("0", scale);
     push_text(&mut v, "0", bx + 0.5 * (bar_w - zw), ly, scale, TEXT);

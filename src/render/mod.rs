@@ -1,10 +1,9 @@
-//! Scene → GPU: the document being viewed, the orbit camera, per-object mirrors with per-slot
-//! dirty tracking, display options and overlays. Used by `prespline render` (offscreen) and the
+//! Editor → GPU: the orbit camera, per-object mirrors with per-slot dirty tracking fed by the
+//! editor's [`Applied`](crate::editor::Applied) reports, display options and overlays. Used by `prespline render` (offscreen) and the
 //! viewer (swapchain).
 
 pub mod analysis;
 pub mod camera;
-pub mod document;
 pub mod gpu_scene;
 pub mod lod;
 pub mod map_mirror;
@@ -14,8 +13,32 @@ pub mod overlays;
 pub mod style;
 
 pub use camera::{Bounds, OrbitCamera};
-pub use document::{Controls, DocObject, Document, Handle};
 pub use gpu_scene::{DrawReport, GpuScene, Highlight, UploadStats};
 pub use lod::Lod;
 pub use map_mirror::MapView;
 pub use style::{NetMode, Palette, ViewOptions, Wire};
+
+use crate::gpu::ValidationMode;
+use crate::sampling::budget::Uses;
+
+/// What drawing (`render`, `view`, `bench`) keeps per object besides the samples: GPU mirrors
+/// and index buffers.
+pub const DRAW_USES: Uses = Uses {
+    gpu: true,
+    json_text: false,
+};
+
+/// Validation layer policy for interactive commands: on in debug builds or with
+/// `PRESPLINE_VALIDATION=1`, when the layer is installed; `PRESPLINE_VALIDATION=required`
+/// refuses to run without it (tests must not pass unvalidated); `0` turns it off.
+#[must_use]
+pub fn validation_mode() -> ValidationMode {
+    let env = std::env::var("PRESPLINE_VALIDATION").ok();
+    match env.as_deref() {
+        Some("required") => ValidationMode::Required,
+        Some("1") => ValidationMode::IfAvailable,
+        Some("0") => ValidationMode::Off,
+        _ if cfg!(debug_assertions) => ValidationMode::IfAvailable,
+        _ => ValidationMode::Off,
+    }
+}

@@ -2,13 +2,13 @@
 
 use super::analysis::{CurveEval, Osculating, badge_overlay, osculating_lines, osculating_overlay};
 use super::camera::OrbitCamera;
-use super::document::Document;
 use super::gpu_scene::{GpuScene, Highlight};
 use super::lod::Lod;
 use super::map_mirror::MapView;
 use super::maps::legend;
 use super::overlays::overlay_lines;
 use super::style::{Palette, ViewOptions};
+use crate::editor::Document;
 use crate::gpu::{GpuResult, OffscreenDesc, Pixels, Renderer};
 
 /// One offscreen image.
@@ -67,7 +67,7 @@ fn record(
     let mut frame = renderer.begin_offscreen(target)?;
     let map = shot.options.analysis.map(|map| MapView {
         map,
-        range: doc.map_range(map),
+        range: super::maps::map_range(doc, map),
     });
     scene.set_map(map);
     scene.upload(&mut frame, doc)?;

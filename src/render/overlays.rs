@@ -2,8 +2,8 @@
 //! combs along curves. Computed from the model and the canonical samples each frame they are
 //! shown (a few hundred evaluations).
 
-use super::document::Document;
 use super::style::{NetMode, ViewOptions};
+use crate::editor::Document;
 use crate::geom::Handles;
 use crate::geom::differential::frenet_frame;
 use crate::geom::knots::uniform_params;

@@ -9,7 +9,7 @@
 //! [`MemoryBudget`] (by default half of physical memory; `--memory-limit` overrides).
 
 use super::object::SampleMode;
-use crate::model::Model;
+use crate::model::{Model, ModelRef};
 use crate::scene::Scene;
 use std::fmt::Write;
 
@@ -41,36 +41,42 @@ impl Extent {
     /// The extent of an object's model.
     #[must_use]
     pub fn of(model: &Model) -> Self {
+        Self::of_ref(model.as_ref())
+    }
+
+    /// The extent of a borrowed model.
+    #[must_use]
+    pub fn of_ref(model: ModelRef<'_>) -> Self {
         let samples = match model.sample_dims() {
             [m, 1] if !model.is_surface() => vec![m],
             dims => dims.to_vec(),
         };
         match model {
-            Model::Curve(m) => Extent {
+            ModelRef::Curve(m) => Extent {
                 samples,
                 degree: vec![m.curve().degree()],
                 rational: m.curve().is_rational(),
                 erbs_locals: None,
             },
-            Model::CatmullRom(_) => Extent {
+            ModelRef::CatmullRom(_) => Extent {
                 samples,
                 degree: vec![3],
                 rational: false,
                 erbs_locals: None,
             },
-            Model::BezierSpline(m) => Extent {
+            ModelRef::BezierSpline(m) => Extent {
                 samples,
                 degree: vec![m.spline().degree()],
                 rational: false,
                 erbs_locals: None,
             },
-            Model::Surface(m) => Extent {
+            ModelRef::Surface(m) => Extent {
                 samples,
                 degree: m.surface().degree().to_vec(),
                 rational: m.surface().is_rational(),
                 erbs_locals: None,
             },
-            Model::ErbsCurve(m) => {
+            ModelRef::ErbsCurve(m) => {
                 let c = m.curve();
                 Extent {
                     samples,
@@ -85,7 +91,7 @@ impl Extent {
                     erbs_locals: Some(vec![c.local_curves().len()]),
                 }
             }
-            Model::ErbsSurface(m) => {
+            ModelRef::ErbsSurface(m) => {
                 let s = m.surface();
                 let degree = s.local_patches().iter().fold(vec![0, 0], |d, p| {
                     let [a, b] = p.degree();
@@ -417,15 +423,30 @@ pub fn check_scene(
     uses: Uses,
     budget: &MemoryBudget,
 ) -> Result<u64, String> {
+    let extents: Vec<(&str, Extent)> = scene
+        .objects
+        .iter()
+        .map(|o| (o.name.as_str(), Extent::of(&o.model)))
+        .collect();
+    check_extents(&extents, mode, uses, budget)
+}
+
+/// As [`check_scene`] for objects given by name and extent (a document with one object about
+/// to change, say, without copying any model).
+pub fn check_extents(
+    objects: &[(&str, Extent)],
+    mode: SampleMode,
+    uses: Uses,
+    budget: &MemoryBudget,
+) -> Result<u64, String> {
     let mut total = 0u64;
     let mut largest: Option<(usize, u64)> = None;
-    for (i, o) in scene.objects.iter().enumerate() {
-        let e = estimate(&Extent::of(&o.model), mode, uses);
+    for (i, (name, extent)) in objects.iter().enumerate() {
+        let e = estimate(extent, mode, uses);
         let bytes = e.bytes();
         if bytes > budget.bytes {
             return Err(format!(
-                "object '{}' (objects[{i}]): needs about {} to pre-evaluate ({}), over the memory budget of {}",
-                o.name,
+                "object '{name}' (objects[{i}]): needs about {} to pre-evaluate ({}), over the memory budget of {}",
                 format_bytes(bytes),
                 e.describe(),
                 budget.describe()
@@ -439,9 +460,9 @@ pub fn check_scene(
     match largest {
         Some((i, bytes)) if total > budget.bytes => Err(format!(
             "{} objects need about {} together to pre-evaluate (the largest, object '{}' (objects[{i}]), about {}), over the memory budget of {}",
-            scene.objects.len(),
+            objects.len(),
             format_bytes(total),
-            scene.objects[i].name,
+            objects[i].0,
             format_bytes(bytes),
             budget.describe()
         )),

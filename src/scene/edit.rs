@@ -11,28 +11,75 @@ use crate::model::{
 use glam::DMat4;
 use serde_json::{Map, Value};
 
-/// Parses an edits file against `scene`, validating names, kinds, indices and parameters in
-/// order. Nothing is applied to `scene`.
+/// An edits file: a JSON list whose entries are parsed one at a time, each against its
+/// object's model as the edits before it leave it (a refinement renumbers what follows).
+#[derive(Debug, Clone)]
+pub struct EditList(Vec<Value>);
+
+impl EditList {
+    /// The list, checked to be a JSON list; its entries are read by [`EditList::edit`].
+    pub fn parse(text: &str) -> Result<Self, SceneError> {
+        let v: Value =
+            serde_json::from_str(text).map_err(|e| SceneError(format!("invalid JSON: {e}")))?;
+        match v {
+            Value::Array(list) => Ok(Self(list)),
+            v => Err(SceneError(format!(
+                "the edits file must be a JSON list of edits, found {}",
+                kind(&v)
+            ))),
+        }
+    }
+
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.0.len()
+    }
+
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.0.is_empty()
+    }
+
+    /// Edit `k`: `find` gives the index and current model of the object it names. Returns the
+    /// edit and its message prefix ("edit 3 (object 'c')") for a refusal later on.
+    pub fn edit<'m>(
+        &self,
+        k: usize,
+        find: impl Fn(&str) -> Option<(usize, ModelRef<'m>)>,
+    ) -> Result<(Edit, At), SceneError> {
+        let v = &self.0[k];
+        let at = At(format!("edit {k}"));
+        let obj = v.as_object().ok_or_else(|| {
+            SceneError(format!("edit {k}: expected an object, found {}", kind(v)))
+        })?;
+        let name = as_str(&at, "object", require(&at, obj, "object")?)?;
+        let (object, model) =
+            find(name).ok_or_else(|| at.err("object", format!("unknown object '{name}'")))?;
+        let at = At(format!("edit {k} (object '{name}')"));
+        let edit = parse_edit(&at, obj, model)?;
+        Ok((Edit { object, edit }, at))
+    }
+}
+
+/// Parses an edits file against `scene`, validating each edit against the model the edits
+/// before it leave (models are copied only for objects that are edited).
 pub fn parse_edits(text: &str, scene: &Scene) -> Result<Vec<Edit>, SceneError> {
-    let v: Value =
-        serde_json::from_str(text).map_err(|e| SceneError(format!("invalid JSON: {e}")))?;
-    let list = v.as_array().ok_or_else(|| {
-        SceneError(format!(
-            "the edits file must be a JSON list of edits, found {}",
-            kind(&v)
-        ))
-    })?;
-    // Models as the edits so far leave them; cloned only for objects that are edited.
+    let list = EditList::parse(text)?;
     let mut edited: Vec<Option<Model>> = vec![None; scene.objects.len()];
     let mut out = Vec::with_capacity(list.len());
-    for (k, e) in list.iter().enumerate() {
-        let (object, at, obj) = locate(k, e, scene)?;
-        let model = edited[object].get_or_insert_with(|| scene.objects[object].model.clone());
-        let edit = parse_edit(&at, obj, model.as_ref())?;
-        edit.validate(model.as_ref())
-            .and_then(|()| model.apply(&edit))
+    for k in 0..list.len() {
+        let (edit, at) = list.edit(k, |name| {
+            let i = scene.find(name)?;
+            let m = edited[i].as_ref().unwrap_or(&scene.objects[i].model);
+            Some((i, m.as_ref()))
+        })?;
+        let model =
+            edited[edit.object].get_or_insert_with(|| scene.objects[edit.object].model.clone());
+        edit.edit
+            .validate(model.as_ref())
+            .and_then(|()| model.apply(&edit.edit))
             .map_err(|e| at.err(e.field, e.message))?;
-        out.push(Edit { object, edit });
+        out.push(edit);
     }
     Ok(out)
 }
@@ -46,23 +93,6 @@ pub fn apply_all(scene: &mut Scene, edits: &[Edit]) -> Result<(), SceneError> {
             .map_err(|err| SceneError(format!("edit {k} (object '{}'): {err}", o.name)))?;
     }
     Ok(())
-}
-
-/// The edit's object index, its message prefix and its fields.
-fn locate<'a>(
-    k: usize,
-    v: &'a Value,
-    scene: &Scene,
-) -> Result<(usize, At, &'a Map<String, Value>), SceneError> {
-    let at = At(format!("edit {k}"));
-    let obj = v
-        .as_object()
-        .ok_or_else(|| SceneError(format!("edit {k}: expected an object, found {}", kind(v))))?;
-    let name = as_str(&at, "object", require(&at, obj, "object")?)?;
-    let object = scene
-        .find(name)
-        .ok_or_else(|| at.err("object", format!("unknown object '{name}'")))?;
-    Ok((object, At(format!("edit {k} (object '{name}')")), obj))
 }
 
 fn parse_edit(

@@ -10,7 +10,8 @@ mod parse_erbs;
 mod write;
 
 pub use crate::model::{Index2, MAX_CURVE_SAMPLES, MAX_DEGREE, MAX_SURFACE_SAMPLES, Model};
-pub use edit::parse_edits;
+pub use edit::{EditList, parse_edits};
+pub use json::At;
 pub use parse::parse_scene;
 pub use write::scene_to_json;
 

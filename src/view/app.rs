@@ -13,12 +13,12 @@ use super::input::{InputEvent, Key, Modifiers, MouseButton};
 use super::scenario::{Scenario, ScenarioDriver};
 use super::script::{ScriptPlayer, When};
 use super::session::Session;
-use crate::cli::render::validation_mode;
 use crate::gpu::{
     FRAMES_IN_FLIGHT, Fault, OffscreenDesc, Renderer, RendererDesc, Swapchain, SwapchainDesc,
     ValidationSink, vk,
 };
 use crate::profile::{FrameRecord, Phase, Recorder};
+use crate::render::validation_mode;
 use crate::scene::Scene;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -221,18 +221,16 @@ impl App {
                 },
             )
             .map_err(|e| e.to_string())?;
-        let session = Session::new(
+        let mut session = Session::open(
             &mut renderer,
             &self.args.scene,
             self.args.save_path.clone(),
             [size.width, size.height],
-        )
-        .map_err(|e| e.to_string())?;
-        let mut session = session;
+            self.args.memory,
+        )?;
         session.set_autosave(self.args.autosave.clone());
-        session.naive = self.args.naive;
+        session.set_naive(self.args.naive);
         session.options.lod = self.args.lod;
-        session.memory = self.args.memory;
         if self.args.analysis.is_some() {
             session.set_map(self.args.analysis);
         }

@@ -12,6 +12,5 @@ pub mod scenario;
 pub mod script;
 pub mod session;
 pub mod tools;
-pub mod undo;
 
 pub use session::Session;

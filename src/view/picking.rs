@@ -1,6 +1,7 @@
 //! Screen-space picking of control points.
 
-use crate::render::{Bounds, Handle, OrbitCamera};
+use crate::editor::Handle;
+use crate::render::{Bounds, OrbitCamera};
 use glam::DVec3;
 
 /// Pick radius in pixels.

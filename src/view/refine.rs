@@ -5,13 +5,13 @@
 //! nested inside it, with a new Hermite local centred at the parameter.
 
 use super::tools::View;
+use crate::editor::Document;
 use crate::geom::erbs::{ErbsKnots, LocalCurve, LocalPatch};
 use crate::gpu::LineVertex;
 use crate::model::{
     CurveEdit, Edit, ErbsCurveEdit, ErbsSurfaceEdit, Index2, KindEdit, LocalPath, ModelRef,
     SurfaceEdit,
 };
-use crate::render::Document;
 use crate::sampling::SampleGrid;
 use glam::DVec3;
 

@@ -4,8 +4,8 @@
 use super::input::{InputEvent, Key, MouseButton};
 use super::script::Action;
 use super::session::Session;
+use crate::editor::Handle;
 use crate::model::{Index2, LocalPath, ModelRef};
-use crate::render::Handle;
 use std::f64::consts::TAU;
 
 /// What the scripted user does.
@@ -193,7 +193,7 @@ impl ScenarioDriver {
 
 /// An interior control point of the surface with the most control points (else of any object).
 fn drag_target(session: &Session) -> Option<Handle> {
-    let doc = &session.doc;
+    let doc = session.doc();
     let best = (0..doc.objects.len())
         .filter(|&i| matches!(doc.objects[i].sampled.model(), ModelRef::Surface(_)))
         .max_by_key(|&i| doc.handles(i).len())
@@ -213,7 +213,7 @@ fn drag_target(session: &Session) -> Option<Handle> {
 
 /// The middle control point of the middle local patch (or curve) of the first ERBS object.
 fn erbs_target(session: &Session) -> Option<Handle> {
-    let doc = &session.doc;
+    let doc = session.doc();
     for (object, o) in doc.objects.iter().enumerate() {
         match o.sampled.model() {
             ModelRef::ErbsSurface(s) => {

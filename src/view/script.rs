@@ -22,8 +22,8 @@
 //! with an error.
 
 use super::input::{InputEvent, Key, Modifiers, MouseButton};
+use crate::editor::{Document, Handle};
 use crate::model::{Index2, LocalPath, ModelRef};
-use crate::render::{Document, Handle};
 use serde_json::Value;
 use std::path::PathBuf;
 

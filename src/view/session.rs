@@ -10,26 +10,21 @@ use super::picking::{PICK_RADIUS, Projected, pick, project_all};
 use super::refine::{Refine, index_text, path_text};
 use super::script::Action;
 use super::tools::{Axis, Drag, Transform, TransformKind, View};
-use super::undo::UndoStack;
-use crate::cli::render::DRAW_USES;
+use crate::editor::{Applied, Document, Editor, Handle, Refused};
 use crate::gpu::{Frame, GpuResult, Renderer};
-use crate::model::{
-    CurveEdit, Edit, Index2, KindEdit, LocalPath, Model, ModelRef, SurfaceEdit, merge_edits,
-};
+use crate::model::{CurveEdit, Edit, Index2, KindEdit, LocalPath, Model, ModelRef, SurfaceEdit};
 use crate::render::analysis::{
     CurveEval, Osculating, badge_overlay, osculating_lines, osculating_overlay,
 };
 use crate::render::lod::Lod;
 use crate::render::map_mirror::MapView;
-use crate::render::maps::{SurfaceMap, legend};
+use crate::render::maps::{SurfaceMap, legend, map_range};
 use crate::render::overlays::overlay_lines;
 use crate::render::{
-    Bounds, Document, GpuScene, Handle, Highlight, NetMode, OrbitCamera, Palette, UploadStats,
-    ViewOptions, Wire,
+    Bounds, GpuScene, Highlight, NetMode, OrbitCamera, Palette, UploadStats, ViewOptions, Wire,
 };
-use crate::sampling::budget::{MemoryBudget, check_scene};
-use crate::sampling::{DirtyRegion, SampleMode};
-use crate::scene::Scene;
+use crate::sampling::SampleMode;
+use crate::sampling::budget::MemoryBudget;
 use glam::{DMat4, DVec3};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -83,7 +78,7 @@ pub struct ApplyStats {
 }
 
 pub struct Session {
-    pub doc: Document,
+    editor: Editor,
     gpu: GpuScene,
     pub camera: OrbitCamera,
     home: OrbitCamera,
@@ -97,8 +92,6 @@ pub struct Session {
     selected: Option<Handle>,
     selected_local: Option<(usize, LocalPath<Index2>)>,
     mode: Mode,
-    pending: Vec<Edit>,
-    undo: UndoStack,
     save_path: PathBuf,
     status: String,
     status_since: Option<Instant>,
@@ -107,11 +100,6 @@ pub struct Session {
     pub quit: bool,
     /// Projected handles, recomputed when the camera or the model changes.
     projected: Option<Vec<Projected>>,
-    /// Apply every edit as it comes instead of merging a frame's edits.
-    pub merge: bool,
-    /// What tools without pre-evaluation do on an edit: re-sample every edited object from
-    /// scratch and upload all of it (`prespline bench --naive`).
-    pub naive: bool,
     /// Unsaved edits kept beside the scene file (`None`: not kept, as in benchmarks).
     autosave: Option<Autosave>,
     /// The transformed object's model when the gesture began.
@@ -123,28 +111,44 @@ pub struct Session {
     map_range: f64,
     /// A scripted action that could not run (see [`Session::take_script_error`]).
     script_error: Option<String>,
-    /// What pre-evaluation may take (`--memory-limit`, else half of physical memory).
-    pub memory: MemoryBudget,
 }
 
 impl Session {
-    /// Pre-evaluates `scene`, uploads it, and frames it for a `size` image. Ctrl+S writes to
+    /// Opens `scene` for drawing and editing: an editor held to `budget` (the scene refused
+    /// in one line when it does not fit), uploaded and framed for a `size` image.
+    pub fn open(
+        renderer: &mut Renderer,
+        scene: &crate::scene::Scene,
+        save_path: PathBuf,
+        size: [u32; 2],
+        budget: MemoryBudget,
+    ) -> Result<Self, String> {
+        let options = crate::editor::EditorOptions {
+            mode: SampleMode::Render,
+            uses: crate::render::DRAW_USES,
+            budget,
+        };
+        let editor = Editor::new(scene, options)?;
+        Self::new(renderer, editor, save_path, size).map_err(|e| e.to_string())
+    }
+
+    /// Uploads the editor's document and frames it for a `size` image. Ctrl+S writes to
     /// `save_path`.
     pub fn new(
         renderer: &mut Renderer,
-        scene: &Scene,
+        editor: Editor,
         save_path: PathBuf,
         size: [u32; 2],
     ) -> GpuResult<Self> {
-        let doc = Document::new(scene);
-        let nets = default_nets(&doc);
-        let gpu = GpuScene::new(renderer, &doc)?;
+        let doc = editor.doc();
+        let nets = default_nets(doc);
+        let gpu = GpuScene::new(renderer, doc)?;
         let bounds = doc.bounds();
         let size = [size[0].max(1) as f64, size[1].max(1) as f64];
         let mut camera = OrbitCamera::default_for(&bounds);
         camera.frame(&bounds, size[0] / size[1]);
         Ok(Self {
-            doc,
+            editor,
             gpu,
             camera,
             home: camera,
@@ -161,8 +165,6 @@ impl Session {
             selected: None,
             selected_local: None,
             mode: Mode::Idle,
-            pending: Vec::new(),
-            undo: UndoStack::default(),
             save_path,
             status: "H or F1: keys".into(),
             status_since: Some(Instant::now()),
@@ -170,12 +172,9 @@ impl Session {
             show_help: false,
             quit: false,
             projected: None,
-            merge: true,
-            naive: false,
             autosave: None,
             transform_origin: None,
             osculating: false,
-            memory: MemoryBudget::machine_default(),
             map_range: 1.0,
             script_error: None,
         })
@@ -222,7 +221,7 @@ impl Session {
             return;
         }
         self.apply_pending();
-        let scene = self.doc.to_scene();
+        let scene = self.editor.doc().to_scene();
         if let Some(a) = self.autosave.as_mut()
             && let Err(e) = a.write(&scene)
         {
@@ -264,7 +263,34 @@ impl Session {
     }
 
     pub fn undo_depth(&self) -> (usize, usize) {
-        self.undo.depth()
+        self.editor.undo_depth()
+    }
+
+    /// The document being edited.
+    #[must_use]
+    pub fn doc(&self) -> &Document {
+        self.editor.doc()
+    }
+
+    /// The current scene, every queued edit in (what Ctrl+S writes).
+    pub fn to_scene(&mut self) -> crate::scene::Scene {
+        self.apply_pending();
+        self.editor.doc().to_scene()
+    }
+
+    /// What pre-evaluation may take from now on (`--memory-limit`).
+    pub fn set_memory_budget(&mut self, budget: MemoryBudget) {
+        self.editor.set_budget(budget);
+    }
+
+    /// Re-samples and uploads edited objects in full on every edit (`bench --naive`).
+    pub fn set_naive(&mut self, naive: bool) {
+        self.editor.naive = naive;
+    }
+
+    /// Applies every edit as it comes instead of merging a frame's edits per target.
+    pub fn set_merge(&mut self, merge: bool) {
+        self.editor.merge = merge;
     }
 
     /// The status line's message (what the last action did or why it could not).
@@ -289,86 +315,58 @@ impl Session {
     /// Screen position of a handle (for scripts that aim at a control point).
     pub fn handle_position(&self, handle: Handle) -> Option<(f64, f64)> {
         let (_, world) = self
-            .doc
+            .editor
+            .doc()
             .handles(handle.object())
             .into_iter()
             .find(|(h, _)| *h == handle)?;
         self.view().project(world)
     }
 
-    /// Queues an edit for this frame, recording it for undo. A structural edit is applied at
-    /// once, after what was queued before it: undo must capture the model each edit sees, and
-    /// the edits after a refinement address the refined net.
-    pub fn queue(&mut self, edit: Edit) {
-        let structural = edit.edit.is_structural();
-        if structural {
-            self.apply_pending();
-        }
-        self.undo.record(&self.doc, &edit);
-        self.pending.push(edit);
-        if structural {
-            self.apply_pending();
+    /// Submits an edit for this frame (validated, budgeted, recorded for undo); a refusal goes
+    /// to the status line. Structural edits apply at once (see [`Editor::submit`]).
+    fn queue(&mut self, edit: Edit) -> bool {
+        let object = edit.object;
+        match self.editor.submit(edit) {
+            Ok(()) => true,
+            Err(e) => {
+                let name = &self.editor.doc().objects[object].name;
+                self.set_status(format!("{name}: edit refused: {e}"));
+                false
+            }
         }
     }
 
-    /// Applies this frame's queued edits (merged per control point) through the delta path and
-    /// marks the touched rows dirty for every frame slot's mirrors.
+    /// Applies this frame's queued edits through the delta path and hands the editor's report
+    /// to the GPU scene, which marks what it rewrote dirty for every frame slot's mirrors.
     pub fn apply_pending(&mut self) -> ApplyStats {
-        if self.pending.is_empty() {
-            return ApplyStats::default();
-        }
-        let start = Instant::now();
-        // One edit per frame (a drag) is the common case: nothing to merge.
-        let edits = if self.merge && self.pending.len() > 1 {
-            let merged = merge_edits(&self.pending);
-            self.pending.clear();
-            merged
-        } else {
-            std::mem::take(&mut self.pending)
-        };
-        let mut samples = 0;
-        let mut edited = Vec::new();
-        for e in &edits {
-            let region = match self.doc.apply(e) {
-                Ok(r) => r,
-                Err(err) => {
-                    let name = &self.doc.objects[e.object].name;
-                    self.set_status(format!("{name}: edit refused: {err}"));
-                    continue;
-                }
-            };
-            if self.naive {
-                if !edited.contains(&e.object) {
-                    edited.push(e.object);
-                }
-            } else {
-                samples += region.samples();
-                self.gpu.note(&self.doc, e, &region);
-            }
-        }
-        for &i in &edited {
-            let region = self.doc.objects[i].sampled.rebuild_all();
-            samples += region.samples();
-            self.gpu.note_samples(i, &region);
-            self.gpu.note_controls(&self.doc, i);
-        }
-        if let Some(a) = self.autosave.as_mut() {
-            a.edited(start);
-        }
-        let micros = start.elapsed().as_secs_f64() * 1e6;
-        self.projected = None;
-        self.hud.edit_us = micros;
-        self.hud.samples_touched = samples;
+        let applied = self.editor.apply_pending();
+        self.take_applied(&applied);
         ApplyStats {
-            edits: edits.len(),
-            samples,
-            micros,
+            edits: applied.edits,
+            samples: applied.samples,
+            micros: applied.micros,
         }
+    }
+
+    fn take_applied(&mut self, applied: &Applied) {
+        if applied.is_empty() && applied.edits == 0 {
+            return;
+        }
+        self.gpu.consume(applied);
+        if applied.edits > 0
+            && let Some(a) = self.autosave.as_mut()
+        {
+            a.edited(Instant::now());
+        }
+        self.projected = None;
+        self.hud.edit_us = applied.micros;
+        self.hud.samples_touched = applied.samples;
     }
 
     /// Copies this slot's dirty rows into the mirrors.
     pub fn upload(&mut self, frame: &mut Frame<'_>) -> GpuResult<UploadStats> {
-        let stats = self.gpu.upload(frame, &self.doc)?;
+        let stats = self.gpu.upload(frame, self.editor.doc())?;
         self.hud.bytes = stats.bytes;
         Ok(stats)
     }
@@ -396,7 +394,13 @@ impl Session {
             Action::MoveTo(h) => {
                 if let Some((x, y)) = self.handle_position(h) {
                     self.handle(InputEvent::CursorMoved { x, y });
-                } else if !self.doc.handles(h.object()).iter().any(|(x, _)| *x == h) {
+                } else if !self
+                    .editor
+                    .doc()
+                    .handles(h.object())
+                    .iter()
+                    .any(|(x, _)| *x == h)
+                {
                     self.script_error =
                         Some(format!("move_to: there is no {} now", self.handle_name(h)));
                 }
@@ -435,9 +439,11 @@ impl Session {
         };
         let view_proj = self.camera.view_proj(aspect, &self.bounds);
         let lod = Lod::new(view_proj, self.size, frame.samples());
-        let report = self.gpu.draw(frame, &self.doc, &self.options, &hl, &lod)?;
+        let report = self
+            .gpu
+            .draw(frame, self.editor.doc(), &self.options, &hl, &lod)?;
         self.hud.triangles = (report.triangles, report.full_triangles);
-        let mut lines = overlay_lines(&self.doc, &self.options, self.bounds.radius());
+        let mut lines = overlay_lines(self.editor.doc(), &self.options, self.bounds.radius());
         let mut analysis = Vec::new();
         if self.osculating
             && matches!(
@@ -448,7 +454,7 @@ impl Session {
         {
             lines.extend(osculating_lines(&o));
             if let Some(at) = self.view().project(o.point) {
-                let name = &self.doc.objects[object].name;
+                let name = &self.editor.doc().objects[object].name;
                 let size = [self.size[0] as f32, self.size[1] as f32];
                 analysis.extend(osculating_overlay(name, &o, at, size));
             }
@@ -458,7 +464,7 @@ impl Session {
         }
         if self.options.badges {
             let view = self.view();
-            analysis.extend(badge_overlay(&self.doc, |p| view.project(p)));
+            analysis.extend(badge_overlay(self.editor.doc(), |p| view.project(p)));
         }
         if let Some(map) = self.options.analysis {
             analysis.extend(legend(
@@ -478,11 +484,11 @@ impl Session {
         let status = match &self.mode {
             Mode::Transform { t, .. } => t.describe(),
             Mode::Refine(r) => {
-                let preview = r.preview(&self.doc, self.bounds.radius());
+                let preview = r.preview(self.editor.doc(), self.bounds.radius());
                 if !preview.is_empty() {
                     frame.draw_lines3d(&preview)?;
                 }
-                r.describe(&self.doc)
+                r.describe(self.editor.doc())
             }
             Mode::WeightEntry { handle, text } => format!(
                 "weight of {}: [{text}]  (type a positive number, Enter sets it, Esc cancels)",
@@ -491,7 +497,7 @@ impl Session {
             Mode::Weight { handle, .. } => format!(
                 "weight of {}: {}  (drag up/down, release to keep)",
                 self.handle_name(*handle),
-                self.doc.weight_of(*handle).unwrap_or(1.0)
+                self.editor.doc().weight_of(*handle).unwrap_or(1.0)
             ),
             _ => self.status.clone(),
         };
@@ -526,7 +532,7 @@ impl Session {
 
     fn projected(&mut self) -> &[Projected] {
         if self.projected.is_none() {
-            let handles = self.doc.all_handles();
+            let handles = self.editor.doc().all_handles();
             self.projected = Some(project_all(&handles, &self.camera, &self.bounds, self.size));
         }
         self.projected.as_deref().unwrap_or(&[])
@@ -559,7 +565,7 @@ impl Session {
             }
             Mode::Drag { handle, mut drag } => {
                 if let Some(inc) = drag.update(&self.view(), self.cursor)
-                    && let Some(edit) = self.doc.move_handle(handle, inc)
+                    && let Some(edit) = self.editor.doc().move_handle(handle, inc)
                 {
                     self.queue(edit);
                 }
@@ -577,7 +583,7 @@ impl Session {
             } => {
                 // A factor of 2 per 80 pixels, kept within [1e-4, 1e4].
                 let w = (from * 2f64.powf((start_y - y) / 80.0)).clamp(1e-4, 1e4);
-                if let Ok(edit) = self.doc.set_weight(handle, w) {
+                if let Ok(edit) = self.editor.doc().set_weight(handle, w) {
                     self.queue(edit);
                 }
                 self.mode = Mode::Weight {
@@ -588,7 +594,7 @@ impl Session {
             }
             m @ Mode::WeightEntry { .. } => self.mode = m,
             Mode::Refine(mut r) => {
-                r.aim(&self.doc, &self.view(), self.cursor);
+                r.aim(self.editor.doc(), &self.view(), self.cursor);
                 self.mode = Mode::Refine(r);
             }
         }
@@ -622,9 +628,9 @@ impl Session {
                 match pick(self.projected(), cursor, PICK_RADIUS) {
                     Some(p) if self.mods.alt => {
                         self.select(p.handle);
-                        match self.doc.weight_of(p.handle) {
+                        match self.editor.doc().weight_of(p.handle) {
                             Some(from) => {
-                                self.undo.begin("weight");
+                                self.editor.begin("weight");
                                 Mode::Weight {
                                     handle: p.handle,
                                     start_y: self.cursor.1,
@@ -632,8 +638,12 @@ impl Session {
                                 }
                             }
                             None => {
-                                let why =
-                                    self.doc.set_weight(p.handle, 1.0).err().unwrap_or_default();
+                                let why = self
+                                    .editor
+                                    .doc()
+                                    .set_weight(p.handle, 1.0)
+                                    .err()
+                                    .unwrap_or_default();
                                 self.set_status(why);
                                 Mode::Idle
                             }
@@ -643,7 +653,7 @@ impl Session {
                         self.select(p.handle);
                         let mut drag = Drag::new(p.world);
                         drag.grab(&self.view(), self.cursor);
-                        self.undo.begin("move point");
+                        self.editor.begin("move point");
                         Mode::Drag {
                             handle: p.handle,
                             drag,
@@ -663,15 +673,15 @@ impl Session {
                 }
             }
             (Mode::Drag { .. }, MouseButton::Left, false) => {
-                self.undo.end();
+                self.editor.end();
                 self.refresh_bounds();
                 self.refit_map();
                 Mode::Idle
             }
             (Mode::Weight { handle, .. }, MouseButton::Left, false) => {
-                self.undo.end();
+                self.editor.end();
                 self.refit_map();
-                let w = self.doc.weight_of(handle).unwrap_or(1.0);
+                let w = self.editor.doc().weight_of(handle).unwrap_or(1.0);
                 self.set_status(format!(
                     "weight of {} is {w} (Ctrl+Z undoes)",
                     self.handle_name(handle)
@@ -695,7 +705,7 @@ impl Session {
     fn object_near_cursor(&self) -> Option<usize> {
         let view = self.view();
         let mut best: Option<(f64, usize)> = None;
-        for (i, o) in self.doc.objects.iter().enumerate() {
+        for (i, o) in self.editor.doc().objects.iter().enumerate() {
             let g = o.sampled.grid();
             let [rows, cols] = g.dims;
             for r in (0..rows).step_by(4) {
@@ -724,7 +734,7 @@ impl Session {
             Handle::LocalPoint { object, local, .. } => Some((object, local)),
             Handle::Point { .. } => None,
         };
-        let name = &self.doc.objects[handle.object()].name;
+        let name = &self.editor.doc().objects[handle.object()].name;
         let what = match handle {
             Handle::Point { point, .. } => format!("{name}: point {}", index_text(point)),
             Handle::LocalPoint { local, point, .. } => {
@@ -876,10 +886,10 @@ impl Session {
             return self.set_status("select a curve or surface first (click one of its points)");
         };
         let mut r = match self.selected_local {
-            Some((o, local)) if o == object => Refine::for_local(object, local, &self.doc),
+            Some((o, local)) if o == object => Refine::for_local(object, local, self.editor.doc()),
             _ => Refine::new(object),
         };
-        r.aim(&self.doc, &self.view(), self.cursor);
+        r.aim(self.editor.doc(), &self.view(), self.cursor);
         self.mode = Mode::Refine(r);
     }
 
@@ -890,9 +900,14 @@ impl Session {
         match key {
             Key::Char(c @ ('u' | 'v')) => {
                 r.dir = usize::from(c == 'v')
-                    * usize::from(self.doc.objects[r.object].sampled.model().is_surface());
+                    * usize::from(
+                        self.editor.doc().objects[r.object]
+                            .sampled
+                            .model()
+                            .is_surface(),
+                    );
                 let mut r = r.clone();
-                r.aim(&self.doc, &self.view(), self.cursor);
+                r.aim(self.editor.doc(), &self.view(), self.cursor);
                 self.mode = Mode::Refine(r);
             }
             Key::Enter => {
@@ -909,12 +924,12 @@ impl Session {
     }
 
     fn insert_knot(&mut self, r: &Refine) {
-        if r.is_erbs(&self.doc) {
+        if r.is_erbs(self.editor.doc()) {
             return self.refine_erbs(r);
         }
-        match r.edit(&self.doc) {
+        match r.edit(self.editor.doc()) {
             Ok(edit) => {
-                let what = r.describe(&self.doc);
+                let what = r.describe(self.editor.doc());
                 if !self.structural("insert knot", edit) {
                     return;
                 }
@@ -932,12 +947,14 @@ impl Session {
     /// ERBS refinement at the aimed parameter: a new Hermite local (a row or column of local
     /// patches on surfaces) in the refined level, one undo step.
     fn refine_erbs(&mut self, r: &Refine) {
-        match r.edit(&self.doc) {
+        match r.edit(self.editor.doc()) {
             Ok(edit) => {
-                let added = r.new_local(&self.doc).unwrap_or_else(|| "a local".into());
-                let name = self.doc.objects[r.object].name.clone();
+                let added = r
+                    .new_local(self.editor.doc())
+                    .unwrap_or_else(|| "a local".into());
+                let name = self.editor.doc().objects[r.object].name.clone();
                 let at = r.at.unwrap_or_default();
-                let axis = r.axis_name(&self.doc);
+                let axis = r.axis_name(self.editor.doc());
                 if !self.structural("refine", edit) {
                     return;
                 }
@@ -959,13 +976,17 @@ impl Session {
                 "select a local curve or patch of an ERBS object first (click one of its points), then X",
             );
         };
-        let Some((edit, degree)) = self.doc.local_to_erbs_edit(object, local, DETAIL_LOCALS) else {
+        let Some((edit, degree)) =
+            self.editor
+                .doc()
+                .local_to_erbs_edit(object, local, DETAIL_LOCALS)
+        else {
             return self.set_status("the selected local is not a polynomial local curve or patch");
         };
-        if let Err(e) = edit.validate(self.doc.objects[object].sampled.model()) {
+        if let Err(e) = edit.validate(self.editor.doc().objects[object].sampled.model()) {
             return self.set_status(format!("cannot make an ERBS local: {e}"));
         }
-        let name = self.doc.objects[object].name.clone();
+        let name = self.editor.doc().objects[object].name.clone();
         if !self.structural(
             "make ERBS local",
             Edit {
@@ -976,7 +997,11 @@ impl Session {
             return;
         }
         self.selected_local = Some((object, local));
-        let what = if self.doc.objects[object].sampled.model().is_surface() {
+        let what = if self.editor.doc().objects[object]
+            .sampled
+            .model()
+            .is_surface()
+        {
             format!("{DETAIL_LOCALS} x {DETAIL_LOCALS} patches")
         } else {
             format!("{DETAIL_LOCALS} curves")
@@ -992,7 +1017,7 @@ impl Session {
         let Some(object) = self.focused_object() else {
             return self.set_status("select a curve or surface first (click one of its points)");
         };
-        let model = self.doc.objects[object].sampled.model();
+        let model = self.editor.doc().objects[object].sampled.model();
         let dir = usize::from(self.mods.shift);
         let edit = match model {
             ModelRef::Curve(_) => CurveEdit::ElevateDegree { by: 1 }.into_object(),
@@ -1012,11 +1037,11 @@ impl Session {
         if let Err(e) = edit.validate(model) {
             return self.set_status(format!("cannot elevate the degree: {e}"));
         }
-        let name = self.doc.objects[object].name.clone();
+        let name = self.editor.doc().objects[object].name.clone();
         if !self.structural("elevate degree", Edit { object, edit }) {
             return;
         }
-        let degree = match self.doc.objects[object].sampled.model() {
+        let degree = match self.editor.doc().objects[object].sampled.model() {
             ModelRef::Curve(m) => m.curve().degree().to_string(),
             ModelRef::Surface(m) => format!("{:?}", m.surface().degree()),
             _ => String::new(),
@@ -1026,18 +1051,26 @@ impl Session {
 
     /// Applies a structural edit as one undo step. Control point indices of that object change,
     /// so its selection and the projected handles are dropped.
-    /// Refused (false, the reason on the status line) where the result would not fit the memory
-    /// budget.
+    /// Refused (false, the reason on the status line) where the edit does not fit its object or
+    /// the result would not fit the memory budget.
     #[must_use]
     fn structural(&mut self, label: &str, edit: Edit) -> bool {
-        if let Err(e) = self.fits_budget(&edit) {
-            self.set_status(format!("no {label}: {e}"));
-            return false;
-        }
         let object = edit.object;
-        self.undo.begin(label);
-        self.queue(edit);
-        self.undo.end();
+        self.editor.begin(label);
+        let result = self.editor.submit(edit);
+        self.editor.end();
+        match result {
+            Ok(()) => {}
+            Err(Refused::OverBudget(e)) => {
+                self.set_status(format!("no {label}: {e}"));
+                return false;
+            }
+            Err(Refused::Invalid(e)) => {
+                self.set_status(format!("cannot {label}: {e}"));
+                return false;
+            }
+        }
+        self.apply_pending();
         if self.selected.is_some_and(|h| h.object() == object) {
             self.selected = None;
         }
@@ -1045,26 +1078,6 @@ impl Session {
         self.projected = None;
         self.refresh_bounds();
         true
-    }
-
-    /// Whether the scene still fits the memory budget with `edit` applied: refinement and
-    /// degree elevation grow nets and Hermite tables, and a key held down must not take the
-    /// machine's memory (the scene loaded under the same check).
-    fn fits_budget(&self, edit: &Edit) -> Result<(), String> {
-        let mut scene = self.doc.to_scene();
-        let Some(o) = scene.objects.get_mut(edit.object) else {
-            return Ok(());
-        };
-        // An edit that does not apply is reported where it is applied, as before.
-        if o.model.apply(&edit.edit).is_err() {
-            return Ok(());
-        }
-        let mode = if self.options.analysis.is_some_and(|m| m.needs_curvature()) {
-            SampleMode::Analysis
-        } else {
-            SampleMode::Render
-        };
-        check_scene(&scene, mode, DRAW_USES, &self.memory).map(|_| ())
     }
 
     fn transform_key(&mut self, key: Key) {
@@ -1104,23 +1117,25 @@ impl Session {
         };
         let pivot = match target {
             Target::Point(h) => self
-                .doc
+                .editor
+                .doc()
                 .handles(h.object())
                 .into_iter()
                 .find(|(x, _)| *x == h)
                 .map(|(_, p)| p),
             Target::Local(o, l) => self
-                .doc
+                .editor
+                .doc()
                 .local_points(o, l)
                 .map(|p| p.iter().sum::<DVec3>() / p.len() as f64),
         };
         let Some(pivot) = pivot else { return };
         self.transform_origin = match target {
-            Target::Local(o, _) => Some(self.doc.objects[o].sampled.model().to_model()),
+            Target::Local(o, _) => Some(self.editor.doc().objects[o].sampled.model().to_model()),
             Target::Point(_) => None,
         };
         let t = Box::new(Transform::new(kind, pivot, &self.view(), self.cursor));
-        self.undo.begin(kind.name());
+        self.editor.begin(kind.name());
         self.mode = Mode::Transform { target, t };
     }
 
@@ -1151,9 +1166,9 @@ impl Session {
                 .transform_origin
                 .as_ref()
                 .and_then(|origin| Document::set_local_transformed(object, local, origin, &total)),
-            Target::Local(object, local) => self.doc.transform_local(object, local, inc),
+            Target::Local(object, local) => self.editor.doc().transform_local(object, local, inc),
             // A point only translates: the increment's translation part.
-            Target::Point(h) => self.doc.move_handle(h, inc.w_axis.truncate()),
+            Target::Point(h) => self.editor.doc().move_handle(h, inc.w_axis.truncate()),
         };
         if let Some(edit) = edit {
             self.queue(edit);
@@ -1163,24 +1178,20 @@ impl Session {
     fn confirm_transform(&mut self) {
         self.update_transform();
         self.mode = Mode::Idle;
-        self.undo.end();
+        self.editor.end();
         self.refresh_bounds();
         self.set_status("transform applied (Ctrl+Z undoes)");
     }
 
     fn cancel_transform(&mut self) {
         self.mode = Mode::Idle;
-        if let Some(step) = self.undo.discard() {
-            // Exact prior values: queued after any pending increments of this gesture.
-            self.pending.extend(step.restore.into_iter().rev());
-        }
+        self.editor.cancel_step();
         self.set_status("transform cancelled");
     }
 
     pub fn undo(&mut self) {
-        match self.undo.undo() {
-            Some((label, edits)) => {
-                self.pending.extend(edits);
+        match self.editor.undo() {
+            Some(label) => {
                 self.set_status(format!("undo: {label}"));
                 self.refresh_bounds_later();
             }
@@ -1189,9 +1200,8 @@ impl Session {
     }
 
     pub fn redo(&mut self) {
-        match self.undo.redo() {
-            Some((label, edits)) => {
-                self.pending.extend(edits);
+        match self.editor.redo() {
+            Some(label) => {
                 self.set_status(format!("redo: {label}"));
                 self.refresh_bounds_later();
             }
@@ -1201,8 +1211,7 @@ impl Session {
 
     /// Writes the scene (exact control data) to the save path, as OBJ when it ends in `.obj`.
     pub fn save(&mut self) {
-        self.apply_pending();
-        let scene = self.doc.to_scene();
+        let scene = self.to_scene();
         match crate::scene::obj::save_scene_file(&scene, &self.save_path) {
             Ok(()) => {
                 if let Some(a) = self.autosave.as_mut() {
@@ -1215,17 +1224,17 @@ impl Session {
     }
 
     fn refresh_bounds(&mut self) {
-        self.bounds = self.doc.bounds();
+        self.bounds = self.editor.doc().bounds();
         self.projected = None;
         // An undone or redone refinement changes control point indices.
         let exists =
             |doc: &Document, h: Handle| doc.handles(h.object()).iter().any(|(x, _)| *x == h);
-        if self.selected.is_some_and(|h| !exists(&self.doc, h)) {
+        if self.selected.is_some_and(|h| !exists(self.editor.doc(), h)) {
             self.selected = None;
         }
         if self
             .selected_local
-            .is_some_and(|(o, l)| self.doc.local_points(o, l).is_none())
+            .is_some_and(|(o, l)| self.editor.doc().local_points(o, l).is_none())
         {
             self.selected_local = None;
         }
@@ -1246,24 +1255,15 @@ impl Session {
 
     /// Shows `map` (or none) on every surface.
     pub fn set_map(&mut self, map: Option<SurfaceMap>) {
-        self.apply_pending();
-        if map.is_some_and(|m| m.needs_curvature())
-            && self.options.analysis.is_none_or(|m| !m.needs_curvature())
-            && let Err(e) = check_scene(
-                &self.doc.to_scene(),
-                SampleMode::Analysis,
-                DRAW_USES,
-                &self.memory,
-            )
-        {
+        let mode = match map {
+            Some(m) if m.needs_curvature() => SampleMode::Analysis,
+            _ => SampleMode::Render,
+        };
+        if let Err(e) = self.editor.set_surface_mode(mode) {
             return self.set_status(format!("no curvature map: {e}"));
         }
+        self.apply_pending();
         self.options.analysis = map;
-        for i in self.doc.set_analysis(map) {
-            let [rows, cols] = self.doc.objects[i].sampled.grid().dims;
-            self.gpu
-                .note_samples(i, &DirtyRegion::surface(0..rows, 0..cols));
-        }
         self.refit_map();
         match map {
             Some(m) => self.set_status(format!("analysis: {} (M: next map)", m.title())),
@@ -1274,7 +1274,7 @@ impl Session {
     /// Refits the colour scale to the current surfaces.
     fn refit_map(&mut self) {
         if let Some(map) = self.options.analysis.filter(|m| m.needs_curvature()) {
-            self.map_range = self.doc.map_range(map);
+            self.map_range = map_range(self.editor.doc(), map);
         }
         self.gpu.set_map(self.options.analysis.map(|map| MapView {
             map,
@@ -1290,9 +1290,9 @@ impl Session {
                 "select a Catmull–Rom or Bézier spline first (click one of its points)",
             );
         };
-        match self.doc.to_bspline(object) {
+        match self.editor.doc().to_bspline(object) {
             Ok(edit) => {
-                let name = self.doc.objects[object].name.clone();
+                let name = self.editor.doc().objects[object].name.clone();
                 if !self.structural("convert to B-spline", edit) {
                     return;
                 }
@@ -1307,7 +1307,7 @@ impl Session {
         let Some(handle) = self.selected else {
             return self.set_status("select a control point first, then Shift+W types its weight");
         };
-        if let Err(e) = self.doc.set_weight(handle, 1.0) {
+        if let Err(e) = self.editor.doc().set_weight(handle, 1.0) {
             return self.set_status(e);
         }
         self.mode = Mode::WeightEntry {
@@ -1331,15 +1331,15 @@ impl Session {
                 self.mode = Mode::Idle;
                 let edit = typed
                     .map_err(|_| "not a number".to_string())
-                    .and_then(|w| self.doc.set_weight(handle, w));
+                    .and_then(|w| self.editor.doc().set_weight(handle, w));
                 match edit {
                     Ok(edit) => {
-                        self.undo.begin("weight");
+                        self.editor.begin("weight");
                         self.queue(edit);
-                        self.undo.end();
+                        self.editor.end();
                         self.apply_pending();
                         self.refit_map();
-                        let w = self.doc.weight_of(handle).unwrap_or(1.0);
+                        let w = self.editor.doc().weight_of(handle).unwrap_or(1.0);
                         self.set_status(format!(
                             "weight of {} is {w} (Ctrl+Z undoes)",
                             self.handle_name(handle)
@@ -1358,7 +1358,7 @@ impl Session {
 
     /// "name point 3" for messages.
     fn handle_name(&self, h: Handle) -> String {
-        let name = &self.doc.objects[h.object()].name;
+        let name = &self.editor.doc().objects[h.object()].name;
         match h {
             Handle::Point { point, .. } => format!("{name} point {}", index_text(point)),
             Handle::LocalPoint { local, point, .. } => format!(
@@ -1373,7 +1373,7 @@ impl Session {
     fn osculating_at_cursor(&self) -> Option<(usize, Osculating)> {
         let view = self.view();
         let mut best: Option<(f64, usize, f64)> = None;
-        for (i, o) in self.doc.objects.iter().enumerate() {
+        for (i, o) in self.editor.doc().objects.iter().enumerate() {
             if o.sampled.model().is_surface() {
                 continue;
             }
@@ -1391,7 +1391,7 @@ impl Session {
             }
         }
         let (_, i, t) = best?;
-        let curve = CurveEval::of(self.doc.objects[i].sampled.model())?;
+        let curve = CurveEval::of(self.editor.doc().objects[i].sampled.model())?;
         Osculating::at(&curve, t).map(|o| (i, o))
     }
 
@@ -1403,9 +1403,10 @@ impl Session {
 
     fn frame_selection(&mut self) {
         let points: Vec<DVec3> = match (self.selected_local, self.selected) {
-            (Some((o, l)), _) => self.doc.local_points(o, l).unwrap_or_default(),
+            (Some((o, l)), _) => self.editor.doc().local_points(o, l).unwrap_or_default(),
             (None, Some(h)) => self
-                .doc
+                .editor
+                .doc()
                 .handles(h.object())
                 .into_iter()
                 .map(|(_, p)| p)

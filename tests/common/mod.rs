@@ -418,3 +418,37 @@ impl Rng {
         lo + (hi - lo) * ((self.next_u64() >> 40) as f32 / (1u64 << 24) as f32)
     }
 }
+
+/// An editor over `scene` as the viewer runs one (shading samples, GPU mirrors budgeted),
+/// with `map` shown on its surfaces (curvature maps sample second partials).
+pub fn editor(
+    scene: &prespline::scene::Scene,
+    map: Option<prespline::render::maps::SurfaceMap>,
+) -> prespline::editor::Editor {
+    use prespline::sampling::SampleMode;
+    let options = prespline::editor::EditorOptions {
+        mode: SampleMode::Render,
+        uses: prespline::render::DRAW_USES,
+        budget: prespline::sampling::budget::MemoryBudget::machine_default(),
+    };
+    let mut ed = prespline::editor::Editor::new(scene, options).expect("the scene fits");
+    if map.is_some_and(|m| m.needs_curvature()) {
+        ed.set_surface_mode(SampleMode::Analysis)
+            .expect("the map fits");
+        ed.apply_pending();
+    }
+    ed
+}
+
+/// Submits `e` through the editor and hands what it changed to the GPU scene: the route of
+/// every edit.
+pub fn edit(
+    ed: &mut prespline::editor::Editor,
+    gs: &mut prespline::render::GpuScene,
+    e: prespline::model::Edit,
+) -> prespline::editor::Applied {
+    ed.submit(e).expect("a valid edit");
+    let applied = ed.apply_pending();
+    gs.consume(&applied);
+    applied
+}

@@ -4,9 +4,10 @@
 
 use crate::common;
 
+use prespline::editor::Document;
 use prespline::model::Model;
 use prespline::render::offscreen::{Shot, render_document};
-use prespline::render::{Document, NetMode, ViewOptions};
+use prespline::render::{NetMode, ViewOptions};
 use prespline::scene::Scene;
 use prespline::scene::obj::{load_obj, parse_obj};
 use std::path::{Path, PathBuf};

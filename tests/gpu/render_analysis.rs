@@ -9,11 +9,12 @@
 use crate::common;
 
 use glam::DVec3;
+use prespline::editor::Document;
 use prespline::gpu::{OffscreenDesc, OffscreenTarget, Pixels, Renderer};
 use prespline::model::{Edit, KindEdit, PointEdit, SurfaceEdit};
 use prespline::render::maps::SurfaceMap;
 use prespline::render::offscreen::{Shot, render_document, shot_camera};
-use prespline::render::{Document, GpuScene, Highlight, Lod, MapView, ViewOptions};
+use prespline::render::{GpuScene, Highlight, Lod, MapView, ViewOptions};
 use prespline::scene::Scene;
 use std::path::Path;
 
@@ -25,8 +26,7 @@ fn load(path: &str) -> Scene {
 /// surfaces with second partials first.
 fn render_with(scene: &Scene, options: ViewOptions) -> Pixels {
     let (mut renderer, sink) = common::renderer();
-    let mut doc = Document::new(scene);
-    doc.set_analysis(options.analysis);
+    let doc = common::editor(scene, options.analysis).into_document();
     let shot = Shot {
         width: 640,
         height: 400,
@@ -256,15 +256,17 @@ fn surface_move(point: [usize; 2], delta: DVec3) -> Edit {
 #[test]
 fn dragging_with_a_map_ends_identical_to_a_fresh_upload() {
     let (mut renderer, sink) = common::renderer();
-    let mut doc = Document::new(&load("examples/bspline_surface.json"));
-    doc.set_analysis(Some(SurfaceMap::Gaussian));
-    let [nu, nv] = match doc.objects[0].sampled.model() {
+    let mut ed = common::editor(
+        &load("examples/bspline_surface.json"),
+        Some(SurfaceMap::Gaussian),
+    );
+    let [nu, nv] = match ed.doc().objects[0].sampled.model() {
         prespline::model::ModelRef::Surface(s) => s.surface().count(),
         _ => unreachable!("the example is a surface"),
     };
-    let s = shot(&doc, SurfaceMap::Mean);
+    let s = shot(ed.doc(), SurfaceMap::Mean);
     let mut target = offscreen(&mut renderer, &s);
-    let mut gs = GpuScene::new(&mut renderer, &doc).unwrap();
+    let mut gs = GpuScene::new(&mut renderer, ed.doc()).unwrap();
     gs.set_map(view(SurfaceMap::Gaussian));
     let mut rng = common::Rng::new(11);
     for f in 0..40 {
@@ -276,14 +278,14 @@ fn dragging_with_a_map_ends_identical_to_a_fresh_upload() {
             let p = [rng.range(0, nu), rng.range(0, nv)];
             let d = DVec3::new(0.0, 0.0, 0.6 * f64::from(rng.f32(-1.0, 1.0)));
             let e = surface_move(p, d);
-            let region = doc.apply(&e).unwrap();
-            gs.note(&doc, &e, &region);
+            common::edit(&mut ed, &mut gs, e);
         }
-        frame(&mut renderer, &mut target, &mut gs, &doc, &s);
+        frame(&mut renderer, &mut target, &mut gs, ed.doc(), &s);
     }
     let incremental = renderer.read_pixels(&target).unwrap();
     gs.destroy(&mut renderer);
 
+    let doc = ed.into_document();
     let mut fresh_gs = GpuScene::new(&mut renderer, &doc).unwrap();
     fresh_gs.set_map(view(SurfaceMap::Mean));
     frame(&mut renderer, &mut target, &mut fresh_gs, &doc, &s);
@@ -311,19 +313,19 @@ fn a_drag_copies_only_its_rows_of_the_map() {
     let (mut renderer, sink) = common::renderer();
     let mut bytes = Vec::new();
     for map in [None, Some(SurfaceMap::Gaussian)] {
-        let mut doc = Document::new(&load("examples/bspline_surface.json"));
-        doc.set_analysis(map);
-        let s = shot(&doc, SurfaceMap::Gaussian);
+        let mut ed = common::editor(&load("examples/bspline_surface.json"), map);
+        let s = shot(ed.doc(), SurfaceMap::Gaussian);
         let mut target = offscreen(&mut renderer, &s);
-        let mut gs = GpuScene::new(&mut renderer, &doc).unwrap();
+        let mut gs = GpuScene::new(&mut renderer, ed.doc()).unwrap();
         gs.set_map(map.and_then(view));
         // The first frame builds the scalars; then both slots are up to date.
-        frame(&mut renderer, &mut target, &mut gs, &doc, &s);
-        frame(&mut renderer, &mut target, &mut gs, &doc, &s);
+        frame(&mut renderer, &mut target, &mut gs, ed.doc(), &s);
+        frame(&mut renderer, &mut target, &mut gs, ed.doc(), &s);
         let e = surface_move([1, 1], DVec3::new(0.0, 0.0, 0.4));
-        let region = doc.apply(&e).unwrap();
-        gs.note(&doc, &e, &region);
-        let copied = frame(&mut renderer, &mut target, &mut gs, &doc, &s);
+        let applied = common::edit(&mut ed, &mut gs, e);
+        let region = applied.changes[0].samples[0].clone();
+        let doc = ed.doc();
+        let copied = frame(&mut renderer, &mut target, &mut gs, doc, &s);
         let cols = doc.objects[0].sampled.grid().dims[1];
         let rows = region.rows.len();
         assert!(rows > 0 && rows < doc.objects[0].sampled.grid().dims[0]);

@@ -7,9 +7,10 @@
 
 use crate::common;
 
+use prespline::editor::Document;
 use prespline::gpu::Pixels;
 use prespline::render::offscreen::{Shot, render_document};
-use prespline::render::{Document, NetMode, OrbitCamera, ViewOptions, Wire};
+use prespline::render::{NetMode, OrbitCamera, ViewOptions, Wire};
 use prespline::scene::{Scene, parse_scene};
 use std::path::Path;
 

@@ -7,11 +7,12 @@
 use crate::common;
 
 use glam::DVec3;
+use prespline::editor::Document;
 use prespline::gpu::{OffscreenDesc, Pixels, Renderer};
 use prespline::model::{Edit, KindEdit, PointEdit, SurfaceEdit};
 use prespline::render::lod::{Lod, LodTolerance};
 use prespline::render::offscreen::{Shot, shot_camera};
-use prespline::render::{Document, DrawReport, GpuScene, Highlight, ViewOptions};
+use prespline::render::{DrawReport, GpuScene, Highlight, ViewOptions};
 use prespline::scene::demo::demo_scene;
 
 /// The golden tolerance of the render tests: 2 levels per channel on at most 0.2 % of pixels.
@@ -140,17 +141,17 @@ fn lod_at_the_default_view_stays_within_golden_tolerance_of_the_full_draw() {
 #[test]
 fn changing_the_level_of_detail_uploads_nothing_and_edits_update_full_rows() {
     let (mut r, sink) = common::renderer();
-    let mut doc = Document::new(&demo_scene());
-    let near = shot(&doc);
+    let mut ed = common::editor(&demo_scene(), None);
+    let near = shot(ed.doc());
     let mut far = near.clone();
     if let Some(c) = far.camera.as_mut() {
         c.distance *= 4.0;
     }
-    let mut scene = GpuScene::new(&mut r, &doc).unwrap();
+    let mut scene = GpuScene::new(&mut r, ed.doc()).unwrap();
     let tol = default_tolerance(&r);
-    let (_, a, first) = draw(&mut r, &mut scene, &doc, &near, Some(tol));
-    let (_, b, second) = draw(&mut r, &mut scene, &doc, &far, Some(tol));
-    let (_, c, third) = draw(&mut r, &mut scene, &doc, &near, None);
+    let (_, a, first) = draw(&mut r, &mut scene, ed.doc(), &near, Some(tol));
+    let (_, b, second) = draw(&mut r, &mut scene, ed.doc(), &far, Some(tol));
+    let (_, c, third) = draw(&mut r, &mut scene, ed.doc(), &near, None);
     assert_eq!(
         (first, second, third),
         (0, 0, 0),
@@ -170,18 +171,17 @@ fn changing_the_level_of_detail_uploads_nothing_and_edits_update_full_rows() {
         })
         .into_object(),
     };
-    let region = doc.apply(&edit).unwrap();
-    scene.note(&doc, &edit, &region);
-    let cols = doc.objects[0].sampled.grid().dims[1];
+    let region = common::edit(&mut ed, &mut scene, edit).changes[0].samples[0].clone();
+    let cols = ed.doc().objects[0].sampled.grid().dims[1];
     let rows = region.rows.len();
     let row_bytes = rows * cols * 6 * 4;
-    let (_, _, slot0) = draw(&mut r, &mut scene, &doc, &far, Some(tol));
-    let (_, _, slot1) = draw(&mut r, &mut scene, &doc, &far, Some(tol));
+    let (_, _, slot0) = draw(&mut r, &mut scene, ed.doc(), &far, Some(tol));
+    let (_, _, slot1) = draw(&mut r, &mut scene, ed.doc(), &far, Some(tol));
     assert!(rows > 0);
     // The samples' rows plus the moved control point's three floats.
     assert_eq!(slot0, row_bytes + 12, "first slot");
     assert_eq!(slot1, row_bytes + 12, "second slot");
-    let (_, _, after) = draw(&mut r, &mut scene, &doc, &far, Some(tol));
+    let (_, _, after) = draw(&mut r, &mut scene, ed.doc(), &far, Some(tol));
     assert_eq!(after, 0, "nothing left to copy");
     scene.destroy(&mut r);
     common::teardown(r, sink);

@@ -5,10 +5,11 @@
 use crate::common;
 
 use glam::{DMat4, DVec3};
+use prespline::editor::{Document, Handle};
 use prespline::gpu::{OffscreenDesc, OffscreenTarget, Pixels, Renderer};
 use prespline::model::{CurveEdit, Edit, KindEdit, ModelRef, ObjectEdit, PointEdit, SurfaceEdit};
 use prespline::render::offscreen::{Shot, shot_camera};
-use prespline::render::{Document, GpuScene, Highlight, Lod, NetMode, ViewOptions, Wire};
+use prespline::render::{GpuScene, Highlight, Lod, NetMode, ViewOptions, Wire};
 use prespline::scene::Scene;
 use prespline::scene::demo::demo_scene;
 
@@ -49,9 +50,7 @@ fn random_edit(doc: &Document, rng: &mut Lcg) -> Edit {
     }
     let handles = doc.handles(object);
     let pick = handles.get(rng.below(handles.len())).copied();
-    if let (0, Some((prespline::render::Handle::LocalPoint { local, .. }, pos))) =
-        (rng.below(3), pick)
-    {
+    if let (0, Some((Handle::LocalPoint { local, .. }, pos))) = (rng.below(3), pick) {
         let m = DMat4::from_translation(pos)
             * DMat4::from_rotation_z(0.2 * rng.signed())
             * DMat4::from_scale(DVec3::splat(1.0 + 0.05 * rng.signed()))
@@ -183,20 +182,21 @@ fn fresh_render(
 #[test]
 fn incremental_mirrors_end_identical_to_a_fresh_upload() {
     let (mut renderer, sink) = common::renderer();
-    let mut doc = Document::new(&scene());
-    let shot = fixed_shot(&doc, 480, 320);
+    let mut ed = common::editor(&scene(), None);
+    let shot = fixed_shot(ed.doc(), 480, 320);
     let mut target = offscreen(&mut renderer, &shot);
-    let mut gs = GpuScene::new(&mut renderer, &doc).unwrap();
+    let mut gs = GpuScene::new(&mut renderer, ed.doc()).unwrap();
     let mut rng = Lcg(7);
     let mut uploaded = 0;
     for _ in 0..60 {
         for _ in 0..1 + rng.below(4) {
-            let e = random_edit(&doc, &mut rng);
-            let region = doc.apply(&e).unwrap();
-            gs.note(&doc, &e, &region);
+            let e = random_edit(ed.doc(), &mut rng);
+            ed.submit(e).unwrap();
         }
-        uploaded += draw_frame(&mut renderer, &mut target, &mut gs, &doc, &shot);
+        gs.consume(&ed.apply_pending());
+        uploaded += draw_frame(&mut renderer, &mut target, &mut gs, ed.doc(), &shot);
     }
+    let doc = ed.into_document();
     assert!(uploaded > 0);
     let incremental: Pixels = renderer.read_pixels(&target).unwrap();
     gs.destroy(&mut renderer);
@@ -228,11 +228,11 @@ fn incremental_mirrors_end_identical_to_a_fresh_upload() {
 fn a_missed_update_is_detected() {
     // Negative control: if one slot skipped its dirty rows the comparison must fail.
     let (mut renderer, sink) = common::renderer();
-    let mut doc = Document::new(&scene());
-    let shot = fixed_shot(&doc, 320, 200);
+    let mut ed = common::editor(&scene(), None);
+    let shot = fixed_shot(ed.doc(), 320, 200);
     let mut target = offscreen(&mut renderer, &shot);
-    let mut gs = GpuScene::new(&mut renderer, &doc).unwrap();
-    draw_frame(&mut renderer, &mut target, &mut gs, &doc, &shot);
+    let mut gs = GpuScene::new(&mut renderer, ed.doc()).unwrap();
+    draw_frame(&mut renderer, &mut target, &mut gs, ed.doc(), &shot);
     // Lift the centre of the B-spline surface but do not tell the GPU scene.
     let e = Edit {
         object: 0,
@@ -242,7 +242,9 @@ fn a_missed_update_is_detected() {
         })
         .into_object(),
     };
-    doc.apply(&e).unwrap();
+    ed.submit(e).unwrap();
+    let _ = ed.apply_pending();
+    let doc = ed.into_document();
     draw_frame(&mut renderer, &mut target, &mut gs, &doc, &shot);
     let stale = renderer.read_pixels(&target).unwrap();
     gs.destroy(&mut renderer);

@@ -1,23 +1,18 @@
-//! The scene being viewed and edited: every object pre-evaluated for drawing, plus the control
-//! structures (polygons, nets, ERBS local curves and patches) that are drawn and picked.
+//! The document: every object of the scene with its name, colour, pre-evaluated samples
+//! ([`SampledObject`]) and control display, and what can be read and built from it (handles,
+//! bounds, the edits a gesture stands for).
 
-use super::camera::Bounds;
-use super::maps::{SurfaceMap, symmetric_range};
-use crate::geom::erbs::{ErbsCurve, ErbsSurface};
-use crate::geom::knots::uniform_params;
-use crate::geom::{LocalCurve as GeomLocalCurve, LocalPatch as GeomLocalPatch};
-use crate::model::{
-    BezierSplineEdit, CatmullRomEdit, CurveEdit, Edit, EditError, ErbsCurveEdit, ErbsSurfaceEdit,
-    Index2, KindEdit, LocalEdit, LocalPath, Model, ModelRef, ObjectEdit, PointEdit, SurfaceEdit,
+use super::controls::{
+    ControlDisplay, each_curve_leaf, each_curve_leaf_of, each_patch_leaf, each_patch_leaf_of,
 };
-use crate::sampling::{DirtyRegion, SampleMode, SampledObject};
+use crate::geom::Bounds;
+use crate::model::{
+    BezierSplineEdit, CatmullRomEdit, CurveEdit, Edit, ErbsCurveEdit, ErbsSurfaceEdit, Index2,
+    KindEdit, LocalEdit, LocalPath, Model, ModelRef, ObjectEdit, PointEdit, SurfaceEdit,
+};
+use crate::sampling::{SampleMode, SampledObject};
 use crate::scene::{Scene, SceneObject};
 use glam::DVec3;
-
-/// Samples per ERBS local curve drawn in its own colour.
-pub const LOCAL_CURVE_SAMPLES: usize = 48;
-/// Samples per direction of an ERBS local patch drawn as a wire grid.
-pub const LOCAL_PATCH_SAMPLES: usize = 9;
 
 /// One object of the document.
 #[derive(Debug, Clone)]
@@ -25,6 +20,23 @@ pub struct DocObject {
     pub name: String,
     pub color: Option<[f64; 3]>,
     pub sampled: SampledObject,
+    /// What is drawn and picked besides the samples, kept up to date by every apply.
+    pub controls: ControlDisplay,
+}
+
+impl DocObject {
+    /// Pre-evaluates `model` in `mode`.
+    #[must_use]
+    pub fn new(name: String, color: Option<[f64; 3]>, model: &Model, mode: SampleMode) -> Self {
+        let sampled = SampledObject::new(model, mode);
+        let controls = ControlDisplay::of(sampled.model());
+        Self {
+            name,
+            color,
+            sampled,
+            controls,
+        }
+    }
 }
 
 /// The scene as the viewer holds it.
@@ -56,53 +68,20 @@ impl Handle {
     }
 }
 
-/// Control structures of one object, in f64 world coordinates.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Controls {
-    /// Control polygon of a Bézier/B-spline curve.
-    Polygon(Vec<DVec3>),
-    /// Control net of a tensor surface, row-major.
-    Net {
-        rows: usize,
-        cols: usize,
-        points: Vec<DVec3>,
-    },
-    /// ERBS curve: every polynomial local at any depth (in path order) with its control
-    /// points and samples over its support.
-    LocalCurves(Vec<LocalCurve>),
-    /// ERBS surface: every polynomial local patch at any depth with its control net and a small
-    /// grid of samples.
-    LocalPatches(Vec<LocalPatch>),
-}
-
-#[derive(Debug, Clone, PartialEq)]
-pub struct LocalCurve {
-    pub path: LocalPath<Index2>,
-    pub points: Vec<DVec3>,
-    pub samples: Vec<DVec3>,
-}
-
-#[derive(Debug, Clone, PartialEq)]
-pub struct LocalPatch {
-    pub path: LocalPath<Index2>,
-    pub net_rows: usize,
-    pub net_cols: usize,
-    pub points: Vec<DVec3>,
-    /// LOCAL_PATCH_SAMPLES² (position, normal) pairs, row-major.
-    pub grid: Vec<(DVec3, DVec3)>,
-}
-
 impl Document {
     /// Pre-evaluates every object of `scene` for drawing.
+    #[must_use]
     pub fn new(scene: &Scene) -> Self {
+        Self::with_mode(scene, SampleMode::Render)
+    }
+
+    /// Pre-evaluates every object of `scene` in `mode` (surfaces and curves alike).
+    #[must_use]
+    pub fn with_mode(scene: &Scene, mode: SampleMode) -> Self {
         let objects = scene
             .objects
             .iter()
-            .map(|o| DocObject {
-                name: o.name.clone(),
-                color: o.color,
-                sampled: SampledObject::new(&o.model, SampleMode::Render),
-            })
+            .map(|o| DocObject::new(o.name.clone(), o.color, &o.model, mode))
             .collect();
         Self { objects }
     }
@@ -122,14 +101,10 @@ impl Document {
         }
     }
 
-    /// Samples every surface for `map` (second partials with K and H for the curvature maps,
+    /// Samples every surface in `mode` (second partials with K and H for the curvature maps,
     /// what shading needs otherwise); returns the objects re-sampled, whose every sample
     /// changed (models are kept exactly).
-    pub fn set_analysis(&mut self, map: Option<SurfaceMap>) -> Vec<usize> {
-        let mode = match map {
-            Some(m) if m.needs_curvature() => SampleMode::Analysis,
-            _ => SampleMode::Render,
-        };
+    pub fn set_surface_mode(&mut self, mode: SampleMode) -> Vec<usize> {
         let mut changed = Vec::new();
         for (i, o) in self.objects.iter_mut().enumerate() {
             if o.sampled.model().is_surface() && o.sampled.mode() != mode {
@@ -138,18 +113,6 @@ impl Document {
             }
         }
         changed
-    }
-
-    /// The half range of `map`'s colour scale over every surface (see [`symmetric_range`]).
-    pub fn map_range(&self, map: SurfaceMap) -> f64 {
-        symmetric_range(self.objects.iter().flat_map(|o| {
-            o.sampled
-                .grid()
-                .curvatures
-                .iter()
-                .flatten()
-                .map(move |&kh| map.value(kh))
-        }))
     }
 
     /// The weight of a control point (1 for polynomial objects), or `None` for handles that
@@ -236,11 +199,6 @@ impl Document {
         })
     }
 
-    /// Applies a validated edit through the delta path.
-    pub fn apply(&mut self, edit: &Edit) -> Result<DirtyRegion, EditError> {
-        self.objects[edit.object].sampled.apply(&edit.edit)
-    }
-
     /// Bounds of every sample and control point.
     pub fn bounds(&self) -> Bounds {
         let mut b = Bounds::EMPTY;
@@ -254,29 +212,6 @@ impl Document {
             }
         }
         b
-    }
-
-    /// Control structures of object `i`.
-    pub fn controls(&self, i: usize) -> Controls {
-        match self.objects[i].sampled.model() {
-            ModelRef::Curve(c) => Controls::Polygon(c.curve().points().to_vec()),
-            // The interpolated points.
-            ModelRef::CatmullRom(c) => Controls::Polygon(c.spline().points().to_vec()),
-            // Bézier points, or the de Boor polygon of splines edited through it (their Bézier
-            // points are drawn as an overlay).
-            ModelRef::BezierSpline(c) => Controls::Polygon(c.spline().handles()),
-            ModelRef::Surface(s) => {
-                let s = s.surface();
-                let [rows, cols] = s.count();
-                Controls::Net {
-                    rows,
-                    cols,
-                    points: s.points().to_vec(),
-                }
-            }
-            ModelRef::ErbsCurve(c) => Controls::LocalCurves(curve_leaves(c.curve(), None)),
-            ModelRef::ErbsSurface(s) => Controls::LocalPatches(patch_leaves(s.surface(), None)),
-        }
     }
 
     /// Every pickable control point of object `i` with its position (no sampling: cheap).
@@ -558,164 +493,3 @@ impl Document {
         }
     }
 }
-
-/// Display data of the polynomial locals under one ERBS local.
-#[derive(Debug, Clone, PartialEq)]
-pub enum LocalControls {
-    Curves(Vec<LocalCurve>),
-    Patches(Vec<LocalPatch>),
-}
-
-impl Document {
-    /// Display data of the polynomial locals at or below `local` of object `i` (what an edit of
-    /// that local changes), without recomputing the others.
-    pub fn local_controls(&self, i: usize, local: LocalPath<Index2>) -> Option<LocalControls> {
-        match self.objects[i].sampled.model() {
-            ModelRef::ErbsCurve(c) => {
-                Some(LocalControls::Curves(curve_leaves(c.curve(), Some(local))))
-            }
-            ModelRef::ErbsSurface(s) => Some(LocalControls::Patches(patch_leaves(
-                s.surface(),
-                Some(local),
-            ))),
-            _ => None,
-        }
-    }
-}
-
-/// Every polynomial local of an ERBS curve at any depth with its path, in depth-first path
-/// order; only those at or below `under` if given.
-fn each_curve_leaf(
-    c: &ErbsCurve,
-    under: Option<LocalPath<Index2>>,
-) -> Vec<(LocalPath<Index2>, &GeomLocalCurve)> {
-    let mut out = Vec::new();
-    for (l, local) in c.local_curves().iter().enumerate() {
-        let path = LocalPath::top(Index2::One(l));
-        collect_curve_leaves(local, path, under, &mut out);
-    }
-    out
-}
-
-fn each_curve_leaf_of(
-    root: &GeomLocalCurve,
-    path: LocalPath<Index2>,
-) -> Vec<(LocalPath<Index2>, &GeomLocalCurve)> {
-    let mut out = Vec::new();
-    collect_curve_leaves(root, path, None, &mut out);
-    out
-}
-
-fn collect_curve_leaves<'a>(
-    local: &'a GeomLocalCurve,
-    path: LocalPath<Index2>,
-    under: Option<LocalPath<Index2>>,
-    out: &mut Vec<(LocalPath<Index2>, &'a GeomLocalCurve)>,
-) {
-    match local {
-        GeomLocalCurve::Spline { .. } => {
-            if under.is_none_or(|u| path.starts_with(&u)) {
-                out.push((path, local));
-            }
-        }
-        GeomLocalCurve::Erbs(e) => {
-            for (l, child) in e.local_curves().iter().enumerate() {
-                if let Some(p) = path.child(Index2::One(l)) {
-                    collect_curve_leaves(child, p, under, out);
-                }
-            }
-        }
-    }
-}
-
-fn each_patch_leaf(
-    s: &ErbsSurface,
-    under: Option<LocalPath<Index2>>,
-) -> Vec<(LocalPath<Index2>, &GeomLocalPatch)> {
-    let mut out = Vec::new();
-    let nv = s.count()[1];
-    for (idx, p) in s.local_patches().iter().enumerate() {
-        let path = LocalPath::top(Index2::Two(idx / nv, idx % nv));
-        collect_patch_leaves(p, path, under, &mut out);
-    }
-    out
-}
-
-fn each_patch_leaf_of(
-    root: &GeomLocalPatch,
-    path: LocalPath<Index2>,
-) -> Vec<(LocalPath<Index2>, &GeomLocalPatch)> {
-    let mut out = Vec::new();
-    collect_patch_leaves(root, path, None, &mut out);
-    out
-}
-
-fn collect_patch_leaves<'a>(
-    patch: &'a GeomLocalPatch,
-    path: LocalPath<Index2>,
-    under: Option<LocalPath<Index2>>,
-    out: &mut Vec<(LocalPath<Index2>, &'a GeomLocalPatch)>,
-) {
-    match patch {
-        GeomLocalPatch::Spline { .. } => {
-            if under.is_none_or(|u| path.starts_with(&u)) {
-                out.push((path, patch));
-            }
-        }
-        GeomLocalPatch::Erbs(e) => {
-            let nv = e.count()[1];
-            for (idx, child) in e.local_patches().iter().enumerate() {
-                if let Some(p) = path.child(Index2::Two(idx / nv, idx % nv)) {
-                    collect_patch_leaves(child, p, under, out);
-                }
-            }
-        }
-    }
-}
-
-fn curve_leaves(c: &ErbsCurve, under: Option<LocalPath<Index2>>) -> Vec<LocalCurve> {
-    each_curve_leaf(c, under)
-        .into_iter()
-        .map(|(path, l)| {
-            let (a, b) = l.domain();
-            let samples = uniform_params(a, b, LOCAL_CURVE_SAMPLES)
-                .into_iter()
-                .map(|t| l.eval(t))
-                .collect();
-            LocalCurve {
-                path,
-                points: l.points().unwrap_or(&[]).to_vec(),
-                samples,
-            }
-        })
-        .collect()
-}
-
-fn patch_leaves(s: &ErbsSurface, under: Option<LocalPatchPath>) -> Vec<LocalPatch> {
-    each_patch_leaf(s, under)
-        .into_iter()
-        .filter_map(|(path, p)| {
-            let GeomLocalPatch::Spline { surface, .. } = p else {
-                return None;
-            };
-            let [nr, nc] = surface.count();
-            let [(u0, u1), (v0, v1)] = surface.domain();
-            let us = uniform_params(u0, u1, LOCAL_PATCH_SAMPLES);
-            let vs = uniform_params(v0, v1, LOCAL_PATCH_SAMPLES);
-            let grid = us
-                .iter()
-                .flat_map(|&u| vs.iter().map(move |&v| (u, v)))
-                .map(|(u, v)| (surface.eval(u, v), surface.normal(u, v)))
-                .collect();
-            Some(LocalPatch {
-                path,
-                net_rows: nr,
-                net_cols: nc,
-                points: surface.points().to_vec(),
-                grid,
-            })
-        })
-        .collect()
-}
-
-type LocalPatchPath = LocalPath<Index2>;

@@ -5,8 +5,8 @@
 //! target it touched, the exact value before the step (undo sets them back, so undo is
 //! bit-exact too — inverse matrices would leave rounding behind).
 
+use super::document::Document;
 use crate::model::{Edit, Target};
-use crate::render::Document;
 
 #[derive(Debug, Clone, Default)]
 pub struct UndoStep {
