@@ -224,14 +224,28 @@ impl OrbitCamera {
             .clamp(-1.0, 1.0)
             .asin()
             .clamp(-Self::MAX_PITCH, Self::MAX_PITCH);
-        let yaw = dir.x.atan2(-dir.y);
         Ok(Self {
             target,
             distance,
-            yaw,
+            yaw: Self::yaw_of(dir),
             pitch,
             fov_y: fov.to_radians(),
         })
+    }
+
+    /// The yaw of a view direction (target to eye). A vertical one has none of its own: +Y is
+    /// then up on screen, the limit of tilting the eye towards −Y from above (+X to the right)
+    /// or towards +Y from below, so a view straight down continues the views next to it instead
+    /// of showing the scene turned half a circle.
+    fn yaw_of(dir: DVec3) -> f64 {
+        let horizontal = dir.x.hypot(dir.y);
+        if horizontal > 1e-9 * dir.z.abs() {
+            dir.x.atan2(-dir.y)
+        } else if dir.z >= 0.0 {
+            0.0
+        } else {
+            std::f64::consts::PI
+        }
     }
 }
 

@@ -157,3 +157,77 @@ fn display_flags_draw_what_the_goldens_show() {
             .unwrap_or_else(|e| panic!("{example} {flags:?} against {golden}: {e}"));
     }
 }
+
+/// Centroid (x, y) of the pixels of an image where `channel` clearly dominates.
+fn centroid(path: &Path, channel: usize) -> Option<(f64, f64)> {
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    let (w, bpp) = (info.width as usize, info.color_type.samples());
+    let (mut sx, mut sy, mut n) = (0.0, 0.0, 0.0);
+    for (k, px) in buf[..info.buffer_size()].chunks(bpp).enumerate() {
+        let c = px[channel] as i32;
+        let others = (0..3).filter(|&i| i != channel).map(|i| px[i] as i32);
+        if c > 120 && others.clone().all(|o| o * 2 < c) {
+            sx += (k % w) as f64;
+            sy += (k / w) as f64;
+            n += 1.0;
+        }
+    }
+    (n > 0.0).then(|| (sx / n, sy / n))
+}
+
+/// A camera straight above, straight below or at an angle keeps the screen the right way
+/// round: red marker on +X, green on −X, blue on +Y; +Y is up on screen for the vertical views
+/// (+X to the right from above, to the left from below, as a mirror shows it).
+#[test]
+fn vertical_cameras_keep_plus_y_up() {
+    let scratch = common::Scratch::new("cli-render");
+    let dir = scratch.path();
+    let marker = |name: &str, x: f64, y: f64, color: &str| {
+        format!(
+            r#"{{"name": "{name}a", "type": "bezier_curve", "points": [[{}, {y}, 0], [{}, {y}, 0]], "samples": 8, "color": {color}}},
+               {{"name": "{name}b", "type": "bezier_curve", "points": [[{x}, {}, 0], [{x}, {}, 0]], "samples": 8, "color": {color}}}"#,
+            x - 0.4,
+            x + 0.4,
+            y - 0.4,
+            y + 0.4
+        )
+    };
+    let scene = dir.join("markers.json");
+    std::fs::write(
+        &scene,
+        format!(
+            r#"{{"objects": [{}, {}, {}]}}"#,
+            marker("px", 2.0, 0.0, "[1, 0, 0]"),
+            marker("mx", -2.0, 0.0, "[0, 1, 0]"),
+            marker("py", 0.0, 2.0, "[0, 0, 1]"),
+        ),
+    )
+    .unwrap();
+    // (camera, red right of green, blue above the centre)
+    for (camera, red_right, name) in [
+        ("0,0,20,0,0,0", true, "above"),
+        ("0,0,-20,0,0,0", false, "below"),
+        ("0,-12,12,0,0,0", true, "at an angle"),
+        ("0,-0.001,20,0,0,0", true, "tilted a little towards -Y"),
+    ] {
+        let out = dir.join(format!("{name}.png"));
+        let r = prespline()
+            .arg("render")
+            .arg(&scene)
+            .arg("--out")
+            .arg(&out)
+            .args(["--size", "200x200", "--msaa", "1", "--camera", camera])
+            .output()
+            .unwrap();
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        let red = centroid(&out, 0).expect("red marker visible");
+        let green = centroid(&out, 1).expect("green marker visible");
+        let blue = centroid(&out, 2).expect("blue marker visible");
+        assert_eq!(red.0 > green.0, red_right, "{name}: red {red:?} green {green:?}");
+        assert!(blue.1 < 100.0 - 20.0, "{name}: +Y must be up, blue at {blue:?}");
+        assert!((red.1 - green.1).abs() < 10.0, "{name}: X axis level");
+    }
+}
