@@ -4,6 +4,7 @@ use super::CliError;
 use super::files::{SampleOverride, load_scene};
 use crate::editor::{Document, Editor, EditorOptions, ListRefused};
 use crate::gpu::{Renderer, RendererDesc};
+use crate::render::image_file::{ImageFormat, write_image};
 use crate::render::maps::SurfaceMap;
 use crate::render::offscreen::{Shot, render_document};
 use crate::render::{OrbitCamera, ViewOptions};
@@ -125,6 +126,8 @@ pub fn run(
     msaa: u32,
 ) -> Result<String, CliError> {
     let start = Instant::now();
+    // An image name that names no format the renderer writes is refused before anything runs.
+    ImageFormat::of(out).map_err(CliError)?;
     let mut renderer = Renderer::new(&RendererDesc {
         app_name: "prespline render".into(),
         validation: validation_mode(),
@@ -151,9 +154,7 @@ pub fn run(
             first.lines().next().unwrap_or("")
         )));
     }
-    pixels
-        .write_png(out)
-        .map_err(|e| CliError(format!("cannot write {}: {e}", out.display())))?;
+    write_image(&pixels, out).map_err(CliError)?;
     Ok(format!(
         "wrote {} ({width}x{height}, {} objects, {device}, {:.0} ms)",
         out.display(),

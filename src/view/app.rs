@@ -473,9 +473,7 @@ fn screenshot(r: &mut Running, path: &Path, hud: bool) -> Result<(), String> {
         .destroy_offscreen(target)
         .map_err(|e| e.to_string())?;
     let pixels = result.map_err(|e| e.to_string())?;
-    pixels
-        .write_png(path)
-        .map_err(|e| format!("cannot write {}: {e}", path.display()))
+    crate::render::image_file::write_image(&pixels, path)
 }
 
 impl ApplicationHandler for App {

@@ -24,6 +24,7 @@
 use super::input::{InputEvent, Key, Modifiers, MouseButton};
 use crate::editor::{Document, Handle};
 use crate::model::{Index2, LocalPath, ModelRef};
+use crate::render::image_file::ImageFormat;
 use serde_json::Value;
 use std::path::PathBuf;
 
@@ -165,14 +166,15 @@ fn parse_event(v: &Value, doc: &Document) -> Result<ScriptEvent, String> {
             Action::Key { key: k, mods }
         }
         "type" => Action::Type(arg.as_str().ok_or("'type' expects a string")?.to_string()),
-        "screenshot" => Action::Screenshot(
-            PathBuf::from(
+        "screenshot" => {
+            let path = PathBuf::from(
                 arg.as_str()
                     .filter(|p| !p.trim().is_empty())
                     .ok_or("'screenshot' expects a file name (a non-empty string)")?,
-            ),
-            flag("hud"),
-        ),
+            );
+            ImageFormat::of(&path).map_err(|e| format!("'screenshot': {e}"))?;
+            Action::Screenshot(path, flag("hud"))
+        }
         "hold" => {
             // {"hold": ["alt", "shift"]} keeps modifiers down for the following events
             // (an Alt+drag); {"hold": []} releases them.
@@ -330,6 +332,10 @@ mod tests {
             (r#"[{"frame": 10000001, "quit": true}]"#, "'frame'"),
             (r#"[{"frame": 1, "wheel": 1e300}]"#, "'wheel'"),
             (r#"[{"frame": 1, "screenshot": ""}]"#, "'screenshot'"),
+            (
+                r#"[{"frame": 1, "screenshot": "x.gif"}]"#,
+                "cannot write .gif",
+            ),
         ] {
             let e = parse(text).expect_err(text);
             assert!(

@@ -226,8 +226,57 @@ fn vertical_cameras_keep_plus_y_up() {
         let red = centroid(&out, 0).expect("red marker visible");
         let green = centroid(&out, 1).expect("green marker visible");
         let blue = centroid(&out, 2).expect("blue marker visible");
-        assert_eq!(red.0 > green.0, red_right, "{name}: red {red:?} green {green:?}");
-        assert!(blue.1 < 100.0 - 20.0, "{name}: +Y must be up, blue at {blue:?}");
+        assert_eq!(
+            red.0 > green.0,
+            red_right,
+            "{name}: red {red:?} green {green:?}"
+        );
+        assert!(
+            blue.1 < 100.0 - 20.0,
+            "{name}: +Y must be up, blue at {blue:?}"
+        );
         assert!((red.1 - green.1).abs() < 10.0, "{name}: X axis level");
+    }
+}
+
+/// `--out` decides the format by its extension: .jpg/.jpeg write JPEG, .png PNG, anything else
+/// is refused in one line and nothing is written.
+#[test]
+fn the_image_format_follows_the_extension() {
+    let scratch = common::Scratch::new("cli-render");
+    let dir = scratch.path();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/bezier_curve.json");
+    let render = |name: &str| {
+        let out = dir.join(name);
+        let r = prespline()
+            .arg("render")
+            .arg(&scene)
+            .arg("--out")
+            .arg(&out)
+            .args(["--size", "96x64"])
+            .output()
+            .unwrap();
+        (r, out)
+    };
+    for (name, magic) in [
+        ("a.jpg", &[0xff, 0xd8, 0xff][..]),
+        ("b.JPEG", &[0xff, 0xd8, 0xff][..]),
+        ("c.png", &[0x89, b'P', b'N', b'G'][..]),
+    ] {
+        let (r, out) = render(name);
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        let bytes = std::fs::read(&out).unwrap();
+        assert!(bytes.starts_with(magic), "{name}: {:x?}", &bytes[..4]);
+    }
+    for name in ["d.gif", "e", "f.jpg.txt"] {
+        let (r, out) = render(name);
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert!(!r.status.success(), "{name}: {err}");
+        assert_eq!(err.lines().count(), 1, "{name}: {err}");
+        assert!(
+            err.contains("(use .png, .jpg or .jpeg)") || err.contains("needs an extension"),
+            "{err}"
+        );
+        assert!(!out.exists(), "{name} written after refusing");
     }
 }
