@@ -24,6 +24,8 @@ pub const LOCAL_PATCH_SAMPLES: usize = 9;
 pub struct DocObject {
     pub name: String,
     pub color: Option<[f64; 3]>,
+    /// What its OBJ source held that prespline does not use, kept through edits for saving.
+    pub obj: crate::scene::obj::carried::Carried,
     pub sampled: SampledObject,
 }
 
@@ -101,6 +103,7 @@ impl Document {
             .map(|o| DocObject {
                 name: o.name.clone(),
                 color: o.color,
+                obj: o.obj.clone(),
                 sampled: SampledObject::new(&o.model, SampleMode::Render),
             })
             .collect();
@@ -117,6 +120,7 @@ impl Document {
                     name: o.name.clone(),
                     model: o.sampled.model().to_model(),
                     color: o.color,
+                    obj: o.obj.clone(),
                 })
                 .collect(),
         }

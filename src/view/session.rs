@@ -1203,11 +1203,15 @@ impl Session {
         self.apply_pending();
         let scene = self.doc.to_scene();
         match crate::scene::obj::save_scene_file(&scene, &self.save_path) {
-            Ok(()) => {
+            Ok(dropped) => {
                 if let Some(a) = self.autosave.as_mut() {
                     a.saved();
                 }
-                self.set_status(format!("saved {}", self.save_path.display()))
+                let mut status = format!("saved {}", self.save_path.display());
+                if !dropped.is_empty() {
+                    status.push_str(&format!(" without: {}", dropped.join("; ")));
+                }
+                self.set_status(status)
             }
             Err(e) => self.set_status(format!("save failed: {e}")),
         }
