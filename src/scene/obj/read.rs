@@ -654,7 +654,7 @@ impl Reader {
                     .push(self.resolve(VertexKind::Parameter, t.text, t)?);
             }
         } else {
-            if s.args.is_empty() || s.args.len() % 3 != 0 {
+            if s.args.is_empty() || !s.args.len().is_multiple_of(3) {
                 return Err(ObjError::new(
                     s.line,
                     format!(
@@ -1056,7 +1056,13 @@ impl Reader {
         for (i, e) in elements.iter_mut().enumerate() {
             self.fill(&mut e.carried, &bodies[i], &locals[i]);
         }
-        for (a, here, b, there) in links {
+        for Link {
+            carrier: a,
+            here,
+            other: b,
+            there,
+        } in links
+        {
             let connection = Connection {
                 curve: CurveRef {
                     range: here.0,
@@ -1072,14 +1078,9 @@ impl Reader {
         }
     }
 
-    /// The `con` statements as (first surface read, its edge, other surface, its edge), each
-    /// edge's `curv2` added to the needs of its surface; a `con` naming a surface that was
-    /// skipped is dropped, with a warning.
-    #[allow(clippy::type_complexity)]
-    fn links(
-        &mut self,
-        needs: &mut [BTreeSet<usize>],
-    ) -> Vec<(usize, ([f64; 2], usize), usize, ([f64; 2], usize))> {
+    /// The `con` statements as links between elements, each edge's `curv2` added to the needs
+    /// of its surface; a `con` naming a surface that was skipped is dropped, with a warning.
+    fn links(&mut self, needs: &mut [BTreeSet<usize>]) -> Vec<Link> {
         let mut links = Vec::new();
         for con in &self.cons {
             let [(s1, q1, c1), (s2, q2, c2)] = con.sides;
@@ -1087,7 +1088,12 @@ impl Reader {
                 (Some(a), Some(b)) => {
                     needs[a].insert(c1.index);
                     needs[b].insert(c2.index);
-                    links.push((a, (q1, c1.index), b, (q2, c2.index)));
+                    links.push(Link {
+                        carrier: a,
+                        here: (q1, c1.index),
+                        other: b,
+                        there: (q2, c2.index),
+                    });
                 }
                 (a, _) => {
                     let skipped = if a.is_none() { s1 } else { s2 };
@@ -1187,6 +1193,15 @@ impl Reader {
         }
         Ok(e)
     }
+}
+
+/// A `con` between two elements read: the first surface (which keeps it) and the other, each
+/// with its edge (q0 q1 and the file-wide `curv2` number).
+struct Link {
+    carrier: usize,
+    here: ([f64; 2], usize),
+    other: usize,
+    there: ([f64; 2], usize),
 }
 
 /// An element's numbering of what it keeps: local index → file-wide index and back.
