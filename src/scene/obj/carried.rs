@@ -295,7 +295,7 @@ pub fn to_json(c: &Carried) -> String {
                 format!(
                     "{{\"curve\": {}, \"surface\": {}, \"surface_curve\": {}}}",
                     curve_ref_json(&k.curve),
-                    serde_json::Value::String(k.surface.clone()),
+                    Value::String(k.surface.clone()),
                     curve_ref_json(&k.surface_curve)
                 )
             })
@@ -308,8 +308,8 @@ pub fn to_json(c: &Carried) -> String {
 fn curve2_json(c: &Curve2) -> String {
     let vertices: Vec<String> = c.vertices.iter().map(ToString::to_string).collect();
     let mut s = format!(
-        "{{\"cstype\": \"{}\", \"degree\": {}, \"vertices\": [{}], \"parm\": {}",
-        c.cstype(),
+        "{{\"cstype\": {}, \"degree\": {}, \"vertices\": [{}], \"parm\": {}",
+        Value::String(c.cstype()),
         c.degree,
         vertices.join(", "),
         numbers(&c.parm)
@@ -341,7 +341,7 @@ fn body_json(body: &[Body]) -> String {
 fn technique_json(t: &Technique) -> String {
     format!(
         "{{\"name\": {}, \"values\": {}}}",
-        serde_json::Value::String(t.name.clone()),
+        Value::String(t.name.clone()),
         numbers(&t.values)
     )
 }
