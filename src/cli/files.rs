@@ -125,7 +125,14 @@ pub fn convert(input: &Path, output: &Path, samples: &SampleOverride) -> Result<
         }
     }
     let scene = load_scene(input, samples)?;
-    save_scene_file(&scene, output).map_err(|e| CliError::in_file(input, e))?;
+    let dropped = save_scene_file(&scene, output).map_err(|e| CliError::in_file(input, e))?;
+    if !dropped.is_empty() {
+        eprintln!(
+            "warning: {}: written without: {}",
+            output.display(),
+            dropped.join("; ")
+        );
+    }
     Ok(format!(
         "wrote {} ({} objects)",
         output.display(),

@@ -19,22 +19,36 @@ use glam::DVec3;
 pub struct DocObject {
     pub name: String,
     pub color: Option<[f64; 3]>,
+    /// What its OBJ source held that prespline does not use, kept through edits for saving.
+    pub obj: crate::scene::obj::carried::Carried,
     pub sampled: SampledObject,
     /// What is drawn and picked besides the samples, kept up to date by every apply.
     pub controls: ControlDisplay,
 }
 
 impl DocObject {
-    /// Pre-evaluates `model` in `mode`.
+    /// Pre-evaluates a scene object in `mode`.
     #[must_use]
-    pub fn new(name: String, color: Option<[f64; 3]>, model: &Model, mode: SampleMode) -> Self {
-        let sampled = SampledObject::new(model, mode);
+    pub fn new(o: &SceneObject, mode: SampleMode) -> Self {
+        let sampled = SampledObject::new(&o.model, mode);
         let controls = ControlDisplay::of(sampled.model());
         Self {
-            name,
-            color,
+            name: o.name.clone(),
+            color: o.color,
+            obj: o.obj.clone(),
             sampled,
             controls,
+        }
+    }
+
+    /// The scene object it stands for now (every applied edit in).
+    #[must_use]
+    pub fn to_scene_object(&self) -> SceneObject {
+        SceneObject {
+            name: self.name.clone(),
+            model: self.sampled.model().to_model(),
+            color: self.color,
+            obj: self.obj.clone(),
         }
     }
 }
@@ -81,7 +95,7 @@ impl Document {
         let objects = scene
             .objects
             .iter()
-            .map(|o| DocObject::new(o.name.clone(), o.color, &o.model, mode))
+            .map(|o| DocObject::new(o, mode))
             .collect();
         Self { objects }
     }
@@ -92,11 +106,7 @@ impl Document {
             objects: self
                 .objects
                 .iter()
-                .map(|o| SceneObject {
-                    name: o.name.clone(),
-                    model: o.sampled.model().to_model(),
-                    color: o.color,
-                })
+                .map(DocObject::to_scene_object)
                 .collect(),
         }
     }

@@ -283,12 +283,7 @@ impl Editor {
         self.flush();
         let mode = self.options.mode;
         for (i, o) in self.doc.objects.iter_mut().enumerate() {
-            *o = super::document::DocObject::new(
-                std::mem::take(&mut o.name),
-                o.color,
-                &o.sampled.model().to_model(),
-                mode,
-            );
+            *o = super::document::DocObject::new(&o.to_scene_object(), mode);
             let [rows, cols] = o.sampled.grid().dims;
             self.applied.record(
                 i,

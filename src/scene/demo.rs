@@ -18,6 +18,7 @@ pub fn demo_scene() -> Scene {
         name: name.into(),
         model,
         color: Some(color),
+        obj: Default::default(),
     };
     let valid = "the demo's sample counts are valid";
     let mut objects = vec![

@@ -49,13 +49,17 @@ pub struct Scene {
     pub objects: Vec<SceneObject>,
 }
 
-/// One named object: its model (geometry with sample counts) and display colour.
+/// One named object: its model (geometry with sample counts), display colour, and what its
+/// OBJ source held that prespline does not use.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SceneObject {
     pub name: String,
     pub model: Model,
     /// Optional display colour (linear RGB in [0, 1]); the viewer picks one per object otherwise.
     pub color: Option<[f64; 3]>,
+    /// Trims, `curv2`, `vp`, `con`, techniques from an OBJ file, kept for every save (the JSON
+    /// field `obj`); empty for everything else.
+    pub obj: obj::carried::Carried,
 }
 
 impl Scene {

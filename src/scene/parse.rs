@@ -37,11 +37,47 @@ pub fn parse_scene(text: &str) -> Result<Scene, SceneError> {
         }
         objects.push(obj);
     }
+    check_connections(&objects)?;
     Ok(Scene { objects })
 }
 
+/// Every kept OBJ `con` joins two surfaces of the scene along curves they keep.
+fn check_connections(objects: &[SceneObject]) -> Result<(), SceneError> {
+    for (i, o) in objects.iter().enumerate() {
+        for (k, c) in o.obj.connections.iter().enumerate() {
+            let at = At(format!("object '{}' (objects[{i}])", o.name));
+            let other = objects
+                .iter()
+                .find(|p| p.name == c.surface)
+                .ok_or_else(|| {
+                    at.err(
+                        "obj",
+                        format!("connections[{k}]: no object named '{}'", c.surface),
+                    )
+                })?;
+            if !other.model.is_surface() {
+                return Err(at.err(
+                    "obj",
+                    format!("connections[{k}]: '{}' is not a surface", c.surface),
+                ));
+            }
+            let curves = other.obj.curves2.len();
+            if c.surface_curve.curve >= curves {
+                return Err(at.err(
+                    "obj",
+                    format!(
+                        "connections[{k}]: '{}' keeps no curve {} ({curves} curves)",
+                        c.surface, c.surface_curve.curve
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Fields every object has besides its geometry.
-const OBJECT_FIELDS: [&str; 4] = ["name", "type", "samples", "color"];
+const OBJECT_FIELDS: [&str; 5] = ["name", "type", "samples", "color", "obj"];
 
 fn parse_object(i: usize, v: &Value) -> Result<SceneObject, SceneError> {
     let at = At(format!("objects[{i}]"));
@@ -142,10 +178,15 @@ fn parse_object(i: usize, v: &Value) -> Result<SceneObject, SceneError> {
         }
     };
     let color = opt(obj, "color").map(|c| parse_color(&at, c)).transpose()?;
+    let kept = opt(obj, "obj")
+        .map(|v| super::obj::carried::from_json(&at, v, model.is_surface()))
+        .transpose()?
+        .unwrap_or_default();
     Ok(SceneObject {
         name: name.to_string(),
         model,
         color,
+        obj: kept,
     })
 }
 

@@ -93,6 +93,9 @@ fn write_object(s: &mut String, o: &SceneObject) {
     if let Some(c) = o.color {
         field(s, "color", &numbers(&c));
     }
+    if !o.obj.is_empty() {
+        field(s, "obj", &super::obj::carried::to_json(&o.obj));
+    }
     s.push('}');
 }
 

@@ -1213,11 +1213,15 @@ impl Session {
     pub fn save(&mut self) {
         let scene = self.to_scene();
         match crate::scene::obj::save_scene_file(&scene, &self.save_path) {
-            Ok(()) => {
+            Ok(dropped) => {
                 if let Some(a) = self.autosave.as_mut() {
                     a.saved();
                 }
-                self.set_status(format!("saved {}", self.save_path.display()))
+                let mut status = format!("saved {}", self.save_path.display());
+                if !dropped.is_empty() {
+                    status.push_str(&format!(" without: {}", dropped.join("; ")));
+                }
+                self.set_status(status)
             }
             Err(e) => self.set_status(format!("save failed: {e}")),
         }

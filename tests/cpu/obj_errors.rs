@@ -200,9 +200,15 @@ const TABLE: &[(&str, &str, usize, &str)] = &[
     ),
     (
         "range outside the domain",
-        "v 0 0 0\nv 1 0 0\ncstype bezier\ndeg 1\ncurv -1 1 1 2\nparm u 0 1\nend\n",
+        "v 0 0 0\nv 1 0 0\ncstype bezier\ndeg 1\ncurv 2 3 1 2\nparm u 0 1\nend\n",
         5,
-        "curv range [-1, 1] reaches outside the domain [0, 1] of parm u (line 6)",
+        "curv range [2, 3] lies outside the domain [0, 1] of parm u (line 6)",
+    ),
+    (
+        "range touching the domain at its end",
+        "v 0 0 0\nv 1 0 0\ncstype bezier\ndeg 1\ncurv 1 2 1 2\nparm u 0 1\nend\n",
+        5,
+        "curv range [1, 2] lies outside the domain [0, 1]",
     ),
     (
         "reversed range",
@@ -369,7 +375,8 @@ fn example(name: &str) -> String {
 }
 
 /// Bases for mutation: the vase (rational surface, curves, relative numbers, continuations),
-/// three teapot patches, and a file with multi-segment Bézier, a cut range and references.
+/// three teapot patches, and a file with multi-segment Bézier, a cut range, references and
+/// kept statements (`vp`, `curv2`, `sp`, `trim`, `con`).
 fn bases() -> Vec<String> {
     let teapot = example("teapot.obj");
     let three: String = teapot
@@ -382,7 +389,9 @@ fn bases() -> Vec<String> {
         three,
         format!(
             "{GOOD}vt 0 0\nvn 0 0 1\ng pair\ncstype rat bezier\ndeg 1 1\nsurf 0 1 0 1 1/1 2/1/1 3//1 4\nparm u 0 1\nparm v 0 1\nend\n\
-             cstype bezier\ndeg 1\ncurv 0.5 2 -4 -3 -2\nparm u 0 1 2\ntrim 0 1 1\nend\nf 1 2 3\n"
+             vp 0 0\nvp 1 0\nvp 1 1\ncstype bspline\ndeg 1\ncurv2 -3 -2 -1 -3\nparm u 0 0 1 2 3 3\nsp 1\nend\n\
+             cstype bezier\ndeg 1\ncurv 0.5 2 -4 -3 -2\nparm u 0 1 2\ntrim 0 1 1\nend\nf 1 2 3\n\
+             con 1 0 1 1 1 1 0 1\n"
         ),
     ]
 }
@@ -439,11 +448,16 @@ const LINES: &[&str] = &[
     "# prespline samples 3 4",
     "# prespline color 1 0 0",
     "trim 0 1 1",
+    "hole 0 1 -1",
+    "sp 1 -1",
+    "con 1 0 1 1 1 0 1 1",
+    "stech cparma 1 2",
     "f 1 2 3",
     "o x",
     "g",
     "v 1 2 3 0",
     "vp 0.5",
+    "vp 0.5 0.5 2",
     "\\",
 ];
 

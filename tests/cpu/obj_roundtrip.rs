@@ -136,6 +136,7 @@ fn random_object(rng: &mut Rng, i: usize) -> SceneObject {
         name: format!("{}{i}", names[rng.range(0, names.len())]),
         model,
         color: (rng.range(0, 2) == 1).then_some([0.25, 1.0, 0.0]),
+        obj: Default::default(),
     }
 }
 
@@ -567,51 +568,7 @@ fn convert_refuses_what_it_cannot_write_and_writes_nothing() {
 /// The OBJ specification's example of trimming with special points: a Bézier curve evaluated
 /// over part of its domain, a trimming curve (`curv2`), and a rational B-spline surface with a
 /// trimming loop and special points.
-const SPEC_TRIMMING_EXAMPLE: &str = "\
-vp 0.500
-vp 0.700
-vp 1.100
-vp 0.200 0.950
-v  0.300 1.500 0.100
-v  0.000  0.000  0.000
-v  1.000  1.000  0.000
-v  2.000  1.000  0.000
-v  3.000  0.000  0.000
-cstype bezier
-deg 3
-curv 0.2 0.9 -4 -3 -2 -1
-sp 1
-parm u 0.00 1.00
-end
-vp -0.675  1.850  3.000
-vp  0.915  1.930
-vp  2.485  0.470  2.000
-vp  2.485 -1.030
-vp  1.605 -1.890 10.700
-vp -0.745 -0.654  0.500
-cstype rat bezier
-curv2 -6 -5 -4 -3 -2 -1 -6
-parm u 0.00 1.00 2.00
-sp 2 3
-end
-v -1.350 -1.030 0.000
-v  0.130 -1.030 0.432 7.600
-v  1.480 -1.030 0.000 2.300
-v -1.460  0.060 0.201
-v  0.120  0.060 0.915 0.500
-v  1.380  0.060 0.454 1.500
-v -1.480  1.030 0.000 2.300
-v  0.120  1.030 0.394 6.100
-v  1.170  1.030 0.000 3.300
-cstype rat bspline
-deg 2 2
-surf -1.0 2.5 -2.0 2.0 -9 -8 -7 -6 -5 -4 -3 -2 -1
-parm u -1.00 -1.00 -1.00 2.50 2.50 2.50
-parm v -2.00 -2.00 -2.00 2.00 2.00 2.00
-trim 0.0 2.0 1
-sp 4
-end
-";
+const SPEC_TRIMMING_EXAMPLE: &str = include_str!("../data/obj_spec_special_points.obj");
 
 #[test]
 fn spec_trimming_example_reads_with_warnings_and_an_exact_cut() {
@@ -630,10 +587,13 @@ fn spec_trimming_example_reads_with_warnings_and_an_exact_cut() {
             ),
             (
                 13,
-                "'sp' ignored (special point; on the curv) (3 times, first here)"
+                "'sp' kept for saving, not applied (special point; on the curv) (3 times, first here)"
             ),
-            (23, "'curv2' (trimming curve) ignored"),
-            (41, "'trim' ignored (outer trimming loop"),
+            (23, "'curv2' (trimming curve) kept for saving, not drawn"),
+            (
+                41,
+                "'trim' kept for saving, not applied (outer trimming loop"
+            ),
         ],
         "{:?}",
         import.warnings

@@ -61,18 +61,21 @@ pub fn directions(b: &Body, warnings: &mut Warnings) -> Result<Vec<Direction>, O
         dirs[0].count = n;
         curve_count(basis, &dirs[0], line)?;
     }
-    for (d, dir) in dirs.iter().enumerate() {
+    for (d, dir) in dirs.iter_mut().enumerate() {
         check_parm(basis, dir, ["u", "v"][d])?;
         check_range(warnings, basis, dir, word, line, ["u", "v"][d])?;
     }
     Ok(dirs)
 }
 
-/// The range must lie in the domain; a proper part of it is cut out on import (warned).
+/// The range must overlap the domain. A range reaching outside it is clamped to it (warned
+/// once per file): Blender 2.7x–2.9x writes `curv 0.0 1.0` over an unclamped knot vector whose
+/// domain [t_d, t_n] is narrower, meaning the whole curve. A proper part of the domain is cut
+/// out on import (warned).
 fn check_range(
     warnings: &mut Warnings,
     basis: Basis,
-    dir: &Direction,
+    dir: &mut Direction,
     word: &str,
     line: usize,
     uv: &str,
@@ -90,15 +93,27 @@ fn check_range(
             format!("{word} {what} [{a}, {b}] is empty or reversed"),
         ));
     }
-    if a < lo || b > hi {
+    let clamped = [a.max(lo), b.min(hi)];
+    if clamped[0] >= clamped[1] {
         return Err(ObjError::new(
             line,
             format!(
-                "{word} {what} [{a}, {b}] reaches outside the domain [{lo}, {hi}] of parm {uv} (line {})",
+                "{word} {what} [{a}, {b}] lies outside the domain [{lo}, {hi}] of parm {uv} (line {})",
                 dir.parm_line
             ),
         ));
     }
+    if clamped != dir.range {
+        let [ca, cb] = clamped;
+        warnings.add("range clamped", line, || {
+            format!(
+                "{word} {what} [{a}, {b}] reaches outside the domain [{lo}, {hi}] of parm {uv} (line {}): clamped to [{ca}, {cb}] (Blender 2.7x–2.9x writes 'curv 0.0 1.0' over unclamped knots)",
+                dir.parm_line
+            )
+        });
+        dir.range = clamped;
+    }
+    let [a, b] = dir.range;
     if dir.is_restricted(basis) {
         warnings.add(&format!("range {line} {uv}"), line, || {
             format!(

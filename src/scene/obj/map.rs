@@ -2,6 +2,7 @@
 //! ([`element_to_object`], [`object_to_element`]); the mapping rules are in docs/obj.md.
 
 use super::ObjError;
+use super::carried::Carried;
 use super::erbs;
 use super::model::{Basis, Direction, FreeForm};
 use crate::geom::error::GeomResult;
@@ -53,6 +54,7 @@ pub fn element_to_object(e: &FreeForm, name: String) -> Result<SceneObject, ObjE
         name,
         model,
         color: e.color,
+        obj: e.carried.clone(),
     })
 }
 
@@ -92,6 +94,7 @@ pub fn object_to_element(o: &SceneObject) -> Result<FreeForm, SceneError> {
         vec![dims[0]]
     });
     e.color = o.color;
+    e.carried = o.obj.clone();
     Ok(e)
 }
 
@@ -207,6 +210,7 @@ fn curve_element(c: &BSplineCurve, basis: Basis) -> FreeForm {
         samples: None,
         color: None,
         line: 0,
+        carried: Carried::default(),
     }
 }
 
@@ -241,6 +245,7 @@ fn surface_element(s: &TensorSurface, basis: Basis) -> FreeForm {
         samples: None,
         color: None,
         line: 0,
+        carried: Carried::default(),
     }
 }
 

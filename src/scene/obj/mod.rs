@@ -2,9 +2,12 @@
 //! with `v` control vertices), the exchange format Rhino, Maya and Ayam write for NURBS and
 //! Bézier geometry. Reading goes text → statements (`lex`) → free-form elements as written
 //! (`read`, [`model::FreeForm`]) → scene objects (`map`); writing goes the other way.
-//! Everything a user can rely on — which constructs map, how exactly, what is refused — is in
+//! What a file holds that prespline does not use (trims, `curv2`, `vp`, `con`, techniques) is
+//! kept with its scene object ([`carried::Carried`]) and written back. Everything a user can
+//! rely on — which constructs map, how exactly, what is kept, what is refused — is in
 //! docs/obj.md.
 
+pub mod carried;
 mod check;
 mod erbs;
 mod lex;
@@ -89,10 +92,10 @@ pub fn parse_obj(text: &str) -> Result<ObjImport, ObjError> {
             ),
         ));
     }
-    let mut used = HashSet::new();
+    // The reader made the names unique (connections name the surfaces they join).
     let objects = elements
         .iter()
-        .map(|e| map::element_to_object(e, unique_name(e, &mut used)))
+        .map(|e| map::element_to_object(e, e.name.clone().unwrap_or_default()))
         .collect::<Result<_, _>>()?;
     Ok(ObjImport {
         scene: Scene { objects },
@@ -105,14 +108,30 @@ pub fn parse_obj_bytes(bytes: &[u8]) -> Result<ObjImport, ObjError> {
     parse_obj(lex::decode(bytes)?)
 }
 
-/// The scene as OBJ text, or the first object that has no exact OBJ form.
-pub fn scene_to_obj(scene: &Scene) -> Result<String, SceneError> {
+/// OBJ text and what it could not hold.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ObjText {
+    pub text: String,
+    /// One entry per kept statement that had to be left out (a `con` whose other surface is no
+    /// longer in the scene, …), naming the object; empty when everything was written.
+    pub dropped: Vec<String>,
+}
+
+/// The scene as OBJ text with what had to be left out, or the first object that has no exact
+/// OBJ form.
+pub fn write_obj(scene: &Scene) -> Result<ObjText, SceneError> {
     let elements = scene
         .objects
         .iter()
         .map(map::object_to_element)
         .collect::<Result<Vec<_>, _>>()?;
-    Ok(write::write(&elements))
+    let (text, dropped) = write::write(&elements);
+    Ok(ObjText { text, dropped })
+}
+
+/// The scene as OBJ text (see [`write_obj`], which also says what had to be left out).
+pub fn scene_to_obj(scene: &Scene) -> Result<String, SceneError> {
+    write_obj(scene).map(|o| o.text)
 }
 
 /// Reads an OBJ file; errors read `FILE:LINE: message`.
@@ -145,18 +164,20 @@ impl Format {
 
 /// Writes the scene in the format the path names — OBJ for `.obj`, the JSON scene format
 /// otherwise — atomically (temporary file + rename), so a failed save never destroys the
-/// previous file. Nothing is written when an object has no OBJ form.
-pub fn save_scene_file(scene: &Scene, path: &Path) -> Result<(), SceneError> {
+/// previous file. Nothing is written when an object has no OBJ form. Returns what the file
+/// could not hold (see [`ObjText::dropped`]; always empty for JSON), for one warning line.
+pub fn save_scene_file(scene: &Scene, path: &Path) -> Result<Vec<String>, SceneError> {
     if Format::of(path) != Some(Format::Obj) {
-        return scene.save(path);
+        return scene.save(path).map(|()| Vec::new());
     }
-    let text = scene_to_obj(scene)?;
-    super::write_durably(path, text.as_bytes())
-        .map_err(|e| SceneError(format!("cannot write {}: {e}", path.display())))
+    let out = write_obj(scene)?;
+    super::write_durably(path, out.text.as_bytes())
+        .map_err(|e| SceneError(format!("cannot write {}: {e}", path.display())))?;
+    Ok(out.dropped)
 }
 
 /// The element's `o`/`g` name (or "curve"/"surface"), made unique with ".2", ".3", ….
-fn unique_name(e: &FreeForm, used: &mut HashSet<String>) -> String {
+pub(crate) fn unique_name(e: &FreeForm, used: &mut HashSet<String>) -> String {
     let base = e
         .name
         .clone()

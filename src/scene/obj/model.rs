@@ -2,6 +2,7 @@
 //! element, with its `cstype`, degrees, parameter ranges, `parm` vectors and control vertices.
 //! Nothing here knows the scene model; `map.rs` is the only bridge.
 
+use super::carried::Carried;
 use glam::DVec3;
 
 /// The polynomial basis named by `cstype` (the supported ones).
@@ -86,7 +87,7 @@ pub struct FreeForm {
     pub points: Vec<DVec3>,
     /// One weight per control vertex (1 where the `v` statement gave none).
     pub weights: Vec<f64>,
-    /// The `o`/`g` name in effect, if any.
+    /// The `o`/`g` name in effect (made unique by the reader: "curve", "surface", ".2", …).
     pub name: Option<String>,
     /// `# prespline samples …` for this element: [m] for curves, [mu, mv] for surfaces.
     pub samples: Option<Vec<usize>>,
@@ -94,6 +95,8 @@ pub struct FreeForm {
     pub color: Option<[f64; 3]>,
     /// Line of the `curv`/`surf` statement.
     pub line: usize,
+    /// What the element holds that prespline does not use, written back on save.
+    pub carried: Carried,
 }
 
 impl FreeForm {

@@ -1,13 +1,18 @@
-//! Statements → [`FreeForm`] elements. The reader keeps the OBJ state (`cstype`, `deg`, the
-//! current name) and checks every element when its `end` arrives; vertex numbers are checked
-//! once the whole file is read, since a positive number may name a vertex written later.
+//! Statements → [`FreeForm`] elements. The reader keeps the OBJ state (`cstype`, `deg`,
+//! `ctech`/`stech`, the current name) and checks every element when its `end` arrives; vertex,
+//! `curv2` and surface numbers are checked once the whole file is read, since a positive number
+//! may name one written later. What prespline does not use — `trim`, `hole`, `scrv`, `sp`,
+//! `curv2`, `vp`, `con`, `ctech`, `stech` — is resolved then and kept with the element it
+//! belongs to ([`Carried`]).
 
+use super::carried::{Body, Carried, Connection, Curve2, CurveRef, Technique};
 use super::check;
 use super::lex::{Statement, Token};
 use super::model::{Basis, FreeForm};
 use super::{ObjError, ObjWarning, Warnings};
 use crate::scene::{MAX_CURVE_SAMPLES, MAX_DEGREE, MAX_SURFACE_SAMPLES};
 use glam::DVec3;
+use std::collections::{BTreeSet, HashMap, HashSet};
 
 /// The elements of a file and what was ignored on the way.
 #[derive(Debug, Clone, PartialEq)]
@@ -31,6 +36,7 @@ enum VertexKind {
     Geometric,
     Texture,
     Normal,
+    Parameter,
 }
 
 impl VertexKind {
@@ -39,6 +45,7 @@ impl VertexKind {
             VertexKind::Geometric => "v",
             VertexKind::Texture => "vt",
             VertexKind::Normal => "vn",
+            VertexKind::Parameter => "vp",
         }
     }
 }
@@ -63,6 +70,50 @@ struct VertexRef {
 enum CsKind {
     Supported(Basis),
     Unsupported(&'static str),
+}
+
+impl CsKind {
+    fn word(self) -> &'static str {
+        match self {
+            CsKind::Supported(b) => b.word(),
+            CsKind::Unsupported(name) => name,
+        }
+    }
+}
+
+/// A `curv2` or `surf` number made absolute (0-based): an element's place among the file's
+/// elements of its kind.
+#[derive(Debug, Clone, Copy)]
+struct ElementRef {
+    index: usize,
+    line: usize,
+}
+
+/// A `trim`, `hole`, `scrv` or `sp` statement with its numbers made absolute.
+#[derive(Debug, Clone)]
+struct BodyRead {
+    keyword: &'static str,
+    curves: Vec<([f64; 2], ElementRef)>,
+    points: Vec<VertexRef>,
+}
+
+/// A `curv2` element, kept as written.
+#[derive(Debug, Clone)]
+struct Curve2Read {
+    line: usize,
+    cstype: CsType,
+    degree: usize,
+    vertices: Vec<VertexRef>,
+    parm: Vec<f64>,
+    body: Vec<BodyRead>,
+    technique: Option<Technique>,
+}
+
+/// A `con` statement: two (surface, edge) sides.
+#[derive(Debug, Clone)]
+struct ConRead {
+    line: usize,
+    sides: [(ElementRef, [f64; 2], ElementRef); 2],
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -102,7 +153,7 @@ impl ElementKind {
     }
 }
 
-/// An element between its `curv`/`surf` and its `end`.
+/// An element between its `curv`/`curv2`/`surf` and its `end`.
 #[derive(Debug, Clone)]
 struct Open {
     kind: ElementKind,
@@ -114,6 +165,10 @@ struct Open {
     degrees: Option<Degrees>,
     name: Option<String>,
     pending: Pending,
+    body: Vec<BodyRead>,
+    technique: Option<Technique>,
+    /// A surface's place among the file's `surf` elements (counting skipped ones).
+    surface: Option<usize>,
 }
 
 /// A checked element whose control vertices are resolved at the end of the file.
@@ -121,19 +176,28 @@ struct Open {
 struct Checked {
     element: FreeForm,
     refs: Vec<VertexRef>,
+    body: Vec<BodyRead>,
 }
 
 #[derive(Debug, Default)]
 struct Reader {
     vertices: Vec<Vertex>,
-    counts: [usize; 3],
+    /// `vp` values.
+    params: Vec<Vec<f64>>,
+    counts: [usize; 4],
     refs: Vec<VertexRef>,
     cstype: Option<CsType>,
     degrees: Option<Degrees>,
+    ctech: Option<Technique>,
+    stech: Option<Technique>,
     name: Option<String>,
     pending: Pending,
     open: Option<Open>,
     done: Vec<Checked>,
+    curves2: Vec<Curve2Read>,
+    /// Per `surf` element in file order: its index in `done`, `None` when it was skipped.
+    surfaces: Vec<Option<usize>>,
+    cons: Vec<ConRead>,
     warnings: Warnings,
 }
 
@@ -164,7 +228,7 @@ impl Reader {
             "surf" => self.open_element(s, ElementKind::Surface),
             "curv2" => self.open_element(s, ElementKind::Curve2),
             "parm" => self.parm(s),
-            "trim" | "hole" | "scrv" | "sp" => self.body_ignored(s),
+            "trim" | "hole" | "scrv" | "sp" => self.body(s),
             "end" => self.end(s),
             "o" | "g" => {
                 let name = join(&s.args);
@@ -180,12 +244,7 @@ impl Reader {
                 });
                 Ok(())
             }
-            "con" => {
-                self.warnings.add("con", s.line, || {
-                    "'con' (surface connectivity) ignored".into()
-                });
-                Ok(())
-            }
+            "con" => self.con(s),
             "bmat" | "step" => {
                 self.warnings.add(s.keyword, s.line, || {
                     format!(
@@ -195,15 +254,7 @@ impl Reader {
                 });
                 Ok(())
             }
-            "ctech" | "stech" => {
-                self.warnings.add(s.keyword, s.line, || {
-                    format!(
-                        "'{}' ignored: sample counts come from '# prespline samples', --samples or the default (docs/obj.md)",
-                        s.keyword
-                    )
-                });
-                Ok(())
-            }
+            "ctech" | "stech" => self.technique(s),
             // Display and render attributes have no meaning for prespline's own display.
             "usemtl" | "mtllib" | "s" | "mg" | "lod" | "bevel" | "c_interp" | "d_interp"
             | "shadow_obj" | "trace_obj" | "maplib" | "usemap" => Ok(()),
@@ -264,13 +315,20 @@ impl Reader {
                 ),
             ));
         }
-        for (i, t) in s.args.iter().enumerate() {
-            number(t, &format!("{}: value {}", s.keyword, i + 1))?;
-        }
+        let values = s
+            .args
+            .iter()
+            .enumerate()
+            .map(|(i, t)| number(t, &format!("{}: value {}", s.keyword, i + 1)))
+            .collect::<Result<Vec<f64>, _>>()?;
         match s.keyword {
             "vt" => self.counts[1] += 1,
             "vn" => self.counts[2] += 1,
-            _ => {} // vp: only trimming curves and special points use it; both are skipped
+            _ => {
+                // Kept for the `curv2` and `sp` statements that name it.
+                self.params.push(values);
+                self.counts[3] += 1;
+            }
         }
         Ok(())
     }
@@ -364,12 +422,26 @@ impl Reader {
             ranges.push([a, b]);
         }
         let mut refs = Vec::new();
-        if kind != ElementKind::Curve2 {
-            for t in &s.args[2 * nranges..] {
+        for t in &s.args[2 * nranges..] {
+            if kind == ElementKind::Curve2 {
+                refs.push(self.resolve(VertexKind::Parameter, t.text, t)?);
+            } else {
                 self.element_ref(kind, t, &mut refs)?;
             }
         }
-        let pending = std::mem::take(&mut self.pending);
+        // `# prespline` settings wait for the curv or surf they describe.
+        let pending = match kind {
+            ElementKind::Curve2 => Pending::default(),
+            _ => std::mem::take(&mut self.pending),
+        };
+        let surface = (kind == ElementKind::Surface).then(|| {
+            self.surfaces.push(None);
+            self.surfaces.len() - 1
+        });
+        let technique = match kind {
+            ElementKind::Surface => self.stech.clone(),
+            _ => self.ctech.clone(),
+        };
         self.open = Some(Open {
             kind,
             line: s.line,
@@ -380,6 +452,9 @@ impl Reader {
             degrees: self.degrees.clone(),
             name: self.name.clone(),
             pending,
+            body: Vec::new(),
+            technique,
+            surface,
         });
         Ok(())
     }
@@ -469,6 +544,39 @@ impl Reader {
         })
     }
 
+    /// A `curv2` or `surf` number made absolute, like a vertex number: 1 is the first element
+    /// of its kind in the file, −1 the latest one so far.
+    fn element_number(what: &str, count: usize, t: &Token) -> Result<ElementRef, ObjError> {
+        let i: i64 = t
+            .text
+            .parse()
+            .map_err(|_| ObjError::new(t.line, format!("'{}' is not a {what} number", t.text)))?;
+        let index = match i {
+            0 => {
+                return Err(ObjError::new(
+                    t.line,
+                    format!("{what} number 0 is invalid: OBJ counts elements from 1 (or back from -1)"),
+                ));
+            }
+            i if i > 0 => usize::try_from(i - 1).unwrap_or(usize::MAX),
+            i => usize::try_from(i.unsigned_abs())
+                .ok()
+                .and_then(|back| count.checked_sub(back))
+                .ok_or_else(|| {
+                    ObjError::new(
+                        t.line,
+                        format!(
+                            "relative {what} number {i} reaches before the first one ({count} defined so far)"
+                        ),
+                    )
+                })?,
+        };
+        Ok(ElementRef {
+            index,
+            line: t.line,
+        })
+    }
+
     fn parm(&mut self, s: &Statement) -> Result<(), ObjError> {
         let Some(open) = &mut self.open else {
             return Err(ObjError::new(
@@ -517,23 +625,130 @@ impl Reader {
         Ok(())
     }
 
-    fn body_ignored(&mut self, s: &Statement) -> Result<(), ObjError> {
+    /// `trim`/`hole`/`scrv` (u0 u1 curv2d triples) or `sp` (vp numbers), kept with the
+    /// element being read.
+    fn body(&mut self, s: &Statement) -> Result<(), ObjError> {
         let Some(open) = &self.open else {
             return Err(ObjError::new(
                 s.line,
-                format!("{} outside a curv or surf body", s.keyword),
+                format!("{} outside a curv, curv2 or surf body", s.keyword),
             ));
         };
-        let what = match s.keyword {
-            "trim" => "outer trimming loop: the surface is imported untrimmed",
-            "hole" => "trimming hole: the surface is imported without it",
+        let keyword = match s.keyword {
+            "trim" => "trim",
+            "hole" => "hole",
+            "scrv" => "scrv",
+            _ => "sp",
+        };
+        let mut body = BodyRead {
+            keyword,
+            curves: Vec::new(),
+            points: Vec::new(),
+        };
+        if keyword == "sp" {
+            if s.args.is_empty() {
+                return Err(ObjError::new(s.line, "sp takes parameter vertex numbers"));
+            }
+            for t in &s.args {
+                body.points
+                    .push(self.resolve(VertexKind::Parameter, t.text, t)?);
+            }
+        } else {
+            if s.args.is_empty() || !s.args.len().is_multiple_of(3) {
+                return Err(ObjError::new(
+                    s.line,
+                    format!(
+                        "{keyword} takes u0 u1 curv2d triples, found {} values",
+                        s.args.len()
+                    ),
+                ));
+            }
+            for a in s.args.chunks(3) {
+                let u0 = number(&a[0], &format!("{keyword}: u0"))?;
+                let u1 = number(&a[1], &format!("{keyword}: u1"))?;
+                let curve = Self::element_number("curv2", self.curves2.len(), &a[2])?;
+                body.curves.push(([u0, u1], curve));
+            }
+        }
+        let what = match keyword {
+            "trim" => "outer trimming loop: the surface is shown untrimmed",
+            "hole" => "trimming hole: the surface is shown without it",
             "scrv" => "special curve",
             _ => "special point",
         };
         let on = open.kind.word();
-        self.warnings.add(s.keyword, s.line, || {
-            format!("'{}' ignored ({what}; on the {on})", s.keyword)
+        self.warnings.add(keyword, s.line, || {
+            format!("'{keyword}' kept for saving, not applied ({what}; on the {on})")
         });
+        if let Some(open) = &mut self.open {
+            open.body.push(body);
+        }
+        Ok(())
+    }
+
+    /// `con surf_1 q0_1 q1_1 curv2d_1 surf_2 q0_2 q1_2 curv2d_2`.
+    fn con(&mut self, s: &Statement) -> Result<(), ObjError> {
+        let a = &s.args;
+        if a.len() != 8 {
+            return Err(ObjError::new(
+                s.line,
+                format!(
+                    "con takes surf_1 q0_1 q1_1 curv2d_1 surf_2 q0_2 q1_2 curv2d_2, found {} values",
+                    a.len()
+                ),
+            ));
+        }
+        let side = |k: usize| -> Result<(ElementRef, [f64; 2], ElementRef), ObjError> {
+            let a = &a[4 * k..4 * k + 4];
+            Ok((
+                Self::element_number("surf", self.surfaces.len(), &a[0])?,
+                [
+                    number(&a[1], &format!("con: q0_{}", k + 1))?,
+                    number(&a[2], &format!("con: q1_{}", k + 1))?,
+                ],
+                Self::element_number("curv2", self.curves2.len(), &a[3])?,
+            ))
+        };
+        let sides = [side(0)?, side(1)?];
+        self.cons.push(ConRead {
+            line: s.line,
+            sides,
+        });
+        self.warnings.add("con", s.line, || {
+            "'con' (surface connectivity) kept for saving, not used".into()
+        });
+        Ok(())
+    }
+
+    /// `ctech` / `stech`: state for the curves (surfaces) that follow.
+    fn technique(&mut self, s: &Statement) -> Result<(), ObjError> {
+        let surface = s.keyword == "stech";
+        let Some((name, values)) = s.args.split_first() else {
+            return Err(ObjError::new(
+                s.line,
+                format!("{} takes a technique and its values", s.keyword),
+            ));
+        };
+        let t = Technique {
+            name: name.text.to_string(),
+            values: values
+                .iter()
+                .enumerate()
+                .map(|(i, v)| number(v, &format!("{} {}: value {}", s.keyword, name.text, i + 1)))
+                .collect::<Result<_, _>>()?,
+        };
+        t.check(surface).map_err(|e| ObjError::new(s.line, e))?;
+        self.warnings.add(s.keyword, s.line, || {
+            format!(
+                "'{}' kept for saving, not used: sample counts come from '# prespline samples', --samples or the default (docs/obj.md)",
+                s.keyword
+            )
+        });
+        if surface {
+            self.stech = Some(t);
+        } else {
+            self.ctech = Some(t);
+        }
         Ok(())
     }
 
@@ -544,10 +759,51 @@ impl Reader {
                 "end without a curv, curv2 or surf before it",
             ));
         };
+        if open.kind == ElementKind::Curve2 {
+            let c = Self::curve2(open)?;
+            self.warnings.add("curv2", c.line, || {
+                "'curv2' (trimming curve) kept for saving, not drawn".into()
+            });
+            self.curves2.push(c);
+            return Ok(());
+        }
+        let surface = open.surface;
         if let Some(c) = self.check(open)? {
+            if let Some(k) = surface {
+                self.surfaces[k] = Some(self.done.len());
+            }
             self.done.push(c);
         }
         Ok(())
+    }
+
+    /// A `curv2` at its `end`: kept as written, so it needs what its `cstype`, `deg` and
+    /// `parm u` lines give; its vertex numbers are checked with the others.
+    fn curve2(open: Open) -> Result<Curve2Read, ObjError> {
+        let line = open.line;
+        if open.refs.is_empty() {
+            return Err(ObjError::new(line, "curv2 takes parameter vertex numbers"));
+        }
+        let cstype = open
+            .cstype
+            .ok_or_else(|| ObjError::new(line, "curv2 without a cstype statement before it"))?;
+        let degree = open
+            .degrees
+            .as_ref()
+            .ok_or_else(|| ObjError::new(line, "curv2 without a deg statement before it"))?
+            .values[0];
+        let [parm, _] = open.parm;
+        let (parm, _) =
+            parm.ok_or_else(|| ObjError::new(line, "curv2 has no parm u before its end"))?;
+        Ok(Curve2Read {
+            line,
+            cstype,
+            degree,
+            vertices: open.refs,
+            parm,
+            body: open.body,
+            technique: open.technique,
+        })
     }
 
     fn extension(&mut self, s: &Statement) -> Result<(), ObjError> {
@@ -606,12 +862,6 @@ impl Reader {
     fn check(&mut self, open: Open) -> Result<Option<Checked>, ObjError> {
         let word = open.kind.word();
         let line = open.line;
-        if open.kind == ElementKind::Curve2 {
-            self.warnings.add("curv2", line, || {
-                "'curv2' (trimming curve) ignored: trimming is not supported".into()
-            });
-            return Ok(None);
-        }
         let cs = open.cstype.ok_or_else(|| {
             ObjError::new(line, format!("{word} without a cstype statement before it"))
         })?;
@@ -676,8 +926,13 @@ impl Reader {
                 samples,
                 color: open.pending.color.map(|(c, _)| c),
                 line,
+                carried: Carried {
+                    technique: open.technique,
+                    ..Carried::default()
+                },
             },
             refs: open.refs,
+            body: open.body,
         }))
     }
 
@@ -704,11 +959,19 @@ impl Reader {
             Ok(())
         };
         self.refs.iter().try_for_each(check)?;
+        self.check_kept(check)?;
         let mut elements = Vec::with_capacity(self.done.len());
-        for c in std::mem::take(&mut self.done) {
+        let mut bodies = Vec::with_capacity(self.done.len());
+        for mut c in std::mem::take(&mut self.done) {
             c.refs.iter().try_for_each(check)?;
+            bodies.push(std::mem::take(&mut c.body));
             elements.push(self.resolve_points(c)?);
         }
+        let mut used = HashSet::new();
+        for e in &mut elements {
+            e.name = Some(super::unique_name(e, &mut used));
+        }
+        self.keep(&mut elements, &bodies);
         if let Some((_, line)) = self.pending.samples {
             self.warnings.add("#samples", line, || {
                 "'# prespline samples' is not followed by a curv or surf; ignored".into()
@@ -723,6 +986,177 @@ impl Reader {
             elements,
             warnings: self.warnings.into_list(),
         })
+    }
+
+    /// Every number in the kept statements names something in the file.
+    fn check_kept(
+        &self,
+        vertex: impl Fn(&VertexRef) -> Result<(), ObjError>,
+    ) -> Result<(), ObjError> {
+        let element = |what: &str, r: &ElementRef, count: usize| {
+            if r.index >= count {
+                return Err(ObjError::new(
+                    r.line,
+                    format!(
+                        "{what} {} does not exist: the file has {count} {what} element(s)",
+                        r.index.saturating_add(1)
+                    ),
+                ));
+            }
+            Ok(())
+        };
+        let curves = self.curves2.len();
+        let bodies = self.done.iter().flat_map(|c| &c.body);
+        for b in bodies.chain(self.curves2.iter().flat_map(|c| &c.body)) {
+            b.points.iter().try_for_each(&vertex)?;
+            for (_, r) in &b.curves {
+                element("curv2", r, curves)?;
+            }
+        }
+        for c in &self.curves2 {
+            c.vertices.iter().try_for_each(&vertex)?;
+        }
+        for con in &self.cons {
+            for (surface, _, curve) in &con.sides {
+                element("surf", surface, self.surfaces.len())?;
+                element("curv2", curve, curves)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Gives every element what belongs with it: the `curv2` elements its body statements and
+    /// `con` statements name (and those nothing names, with the element that follows them),
+    /// the parameter vertices those use, and the `con` statements of which it is the first
+    /// surface read — all with local numbers.
+    fn keep(&mut self, elements: &mut [FreeForm], bodies: &[Vec<BodyRead>]) {
+        if elements.is_empty() {
+            return;
+        }
+        let mut needs: Vec<BTreeSet<usize>> = bodies.iter().map(|b| curves_named(b)).collect();
+        let links = self.links(&mut needs);
+        for set in &mut needs {
+            self.close_over_curves(set);
+        }
+        let named: HashSet<usize> = needs.iter().flatten().copied().collect();
+        for (k, c) in self.curves2.iter().enumerate() {
+            if !named.contains(&k) {
+                let i = elements
+                    .iter()
+                    .position(|e| e.line > c.line)
+                    .unwrap_or(elements.len() - 1);
+                needs[i].insert(k);
+            }
+        }
+        let locals: Vec<Local> = needs
+            .into_iter()
+            .zip(bodies)
+            .map(|(c, b)| self.local(c, b))
+            .collect();
+        for (i, e) in elements.iter_mut().enumerate() {
+            self.fill(&mut e.carried, &bodies[i], &locals[i]);
+        }
+        for Link {
+            carrier: a,
+            here,
+            other: b,
+            there,
+        } in links
+        {
+            let connection = Connection {
+                curve: CurveRef {
+                    range: here.0,
+                    curve: locals[a].curve(here.1),
+                },
+                surface: elements[b].name.clone().unwrap_or_default(),
+                surface_curve: CurveRef {
+                    range: there.0,
+                    curve: locals[b].curve(there.1),
+                },
+            };
+            elements[a].carried.connections.push(connection);
+        }
+    }
+
+    /// The `con` statements as links between elements, each edge's `curv2` added to the needs
+    /// of its surface; a `con` naming a surface that was skipped is dropped, with a warning.
+    fn links(&mut self, needs: &mut [BTreeSet<usize>]) -> Vec<Link> {
+        let mut links = Vec::new();
+        for con in &self.cons {
+            let [(s1, q1, c1), (s2, q2, c2)] = con.sides;
+            match (self.surfaces[s1.index], self.surfaces[s2.index]) {
+                (Some(a), Some(b)) => {
+                    needs[a].insert(c1.index);
+                    needs[b].insert(c2.index);
+                    links.push(Link {
+                        carrier: a,
+                        here: (q1, c1.index),
+                        other: b,
+                        there: (q2, c2.index),
+                    });
+                }
+                (a, _) => {
+                    let skipped = if a.is_none() { s1 } else { s2 };
+                    self.warnings.add("con dropped", con.line, || {
+                        format!(
+                            "'con' dropped: it joins surf {}, which was skipped",
+                            skipped.index + 1
+                        )
+                    });
+                }
+            }
+        }
+        links
+    }
+
+    /// Adds the `curv2` elements named in the bodies of those already in `set`.
+    fn close_over_curves(&self, set: &mut BTreeSet<usize>) {
+        let mut todo: Vec<usize> = set.iter().copied().collect();
+        while let Some(k) = todo.pop() {
+            for c in curves_named(&self.curves2[k].body) {
+                if set.insert(c) {
+                    todo.push(c);
+                }
+            }
+        }
+    }
+
+    /// Local numbers for an element's `curv2` elements (file order) and the parameter
+    /// vertices its body and those curves use (file order).
+    fn local(&self, curves: BTreeSet<usize>, body: &[BodyRead]) -> Local {
+        let mut vertices: BTreeSet<usize> = points_named(body).collect();
+        for &k in &curves {
+            let c = &self.curves2[k];
+            vertices.extend(c.vertices.iter().map(|r| r.index));
+            vertices.extend(points_named(&c.body));
+        }
+        Local::new(curves, vertices)
+    }
+
+    /// Writes the kept data of one element with its local numbers (connections come after).
+    fn fill(&self, carried: &mut Carried, body: &[BodyRead], local: &Local) {
+        carried.parameter_vertices = local
+            .vertices
+            .iter()
+            .map(|&g| self.params[g].clone())
+            .collect();
+        carried.curves2 = local
+            .curves
+            .iter()
+            .map(|&g| {
+                let c = &self.curves2[g];
+                Curve2 {
+                    rational: c.cstype.rational,
+                    basis: c.cstype.kind.word().to_string(),
+                    degree: c.degree,
+                    vertices: c.vertices.iter().map(|r| local.vertex(r.index)).collect(),
+                    parm: c.parm.clone(),
+                    body: local.body(&c.body),
+                    technique: c.technique.clone(),
+                }
+            })
+            .collect();
+        carried.body = local.body(body);
     }
 
     fn resolve_points(&mut self, c: Checked) -> Result<FreeForm, ObjError> {
@@ -759,6 +1193,75 @@ impl Reader {
         }
         Ok(e)
     }
+}
+
+/// A `con` between two elements read: the first surface (which keeps it) and the other, each
+/// with its edge (q0 q1 and the file-wide `curv2` number).
+struct Link {
+    carrier: usize,
+    here: ([f64; 2], usize),
+    other: usize,
+    there: ([f64; 2], usize),
+}
+
+/// An element's numbering of what it keeps: local index → file-wide index and back.
+struct Local {
+    curves: Vec<usize>,
+    curve_of: HashMap<usize, usize>,
+    vertices: Vec<usize>,
+    vertex_of: HashMap<usize, usize>,
+}
+
+impl Local {
+    fn new(curves: BTreeSet<usize>, vertices: BTreeSet<usize>) -> Self {
+        let invert = |v: &[usize]| v.iter().enumerate().map(|(i, &g)| (g, i)).collect();
+        let curves: Vec<usize> = curves.into_iter().collect();
+        let vertices: Vec<usize> = vertices.into_iter().collect();
+        Self {
+            curve_of: invert(&curves),
+            vertex_of: invert(&vertices),
+            curves,
+            vertices,
+        }
+    }
+
+    /// Every file-wide number given to [`Local::new`] has a local one.
+    fn curve(&self, global: usize) -> usize {
+        self.curve_of[&global]
+    }
+
+    fn vertex(&self, global: usize) -> usize {
+        self.vertex_of[&global]
+    }
+
+    fn body(&self, body: &[BodyRead]) -> Vec<Body> {
+        body.iter()
+            .filter_map(|b| {
+                let curves = b
+                    .curves
+                    .iter()
+                    .map(|&(range, r)| CurveRef {
+                        range,
+                        curve: self.curve(r.index),
+                    })
+                    .collect();
+                let points = b.points.iter().map(|r| self.vertex(r.index)).collect();
+                Body::new(b.keyword, curves, points)
+            })
+            .collect()
+    }
+}
+
+/// The `curv2` elements a body names (file-wide numbers).
+fn curves_named(body: &[BodyRead]) -> BTreeSet<usize> {
+    body.iter()
+        .flat_map(|b| b.curves.iter().map(|(_, r)| r.index))
+        .collect()
+}
+
+/// The parameter vertices a body's `sp` statements name (file-wide numbers).
+fn points_named(body: &[BodyRead]) -> impl Iterator<Item = usize> + '_ {
+    body.iter().flat_map(|b| b.points.iter().map(|r| r.index))
 }
 
 /// A finite number; `what` names it in the message.
