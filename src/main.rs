@@ -65,10 +65,14 @@ enum Command {
         /// summary, Chrome trace, SVG plots) into DIR when the window closes.
         #[arg(long, value_name = "DIR")]
         profile: Option<PathBuf>,
-        /// Open the unsaved edits an earlier session left in NAME.autosave.json (beside
-        /// NAME.json; demo.autosave.json for the demo) instead of the scene.
-        #[arg(long)]
-        recover: bool,
+        /// Open unsaved edits an earlier session left instead of the scene: the newest
+        /// autosave, or with =FILE the one named (the start-up note lists those waiting).
+        /// Autosaves are NAME.autosave.json beside NAME.json (demo.autosave.json for the demo),
+        /// earlier sessions' NAME.autosave.YYYYMMDD-HHMMSS.json, or under
+        /// $XDG_STATE_HOME/prespline/ when the scene's directory is read-only. Ctrl+S in the
+        /// recovered session removes the autosave; see docs/autosave.md.
+        #[arg(long, value_name = "FILE", num_args = 0..=1, require_equals = true)]
+        recover: Option<Option<PathBuf>>,
         #[command(flatten)]
         memory: MemoryArgs,
         /// Open with a surface analysis map on: gaussian, mean, kmax, kmin or zebra (M cycles).
@@ -284,7 +288,7 @@ fn main() -> ExitCode {
             profile: profile.as_deref(),
             samples: samples.counts(),
             memory: memory.budget(),
-            recover,
+            recover: recover.as_ref().map(Option::as_deref),
             analysis,
         }),
         Command::Bench {
