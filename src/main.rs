@@ -65,12 +65,12 @@ enum Command {
         /// summary, Chrome trace, SVG plots) into DIR when the window closes.
         #[arg(long, value_name = "DIR")]
         profile: Option<PathBuf>,
-        /// Open unsaved edits an earlier session left instead of the scene: the newest
-        /// autosave, or with =FILE the one named (the start-up note lists those waiting).
-        /// Autosaves are NAME.autosave.json beside NAME.json (demo.autosave.json for the demo),
-        /// earlier sessions' NAME.autosave.YYYYMMDD-HHMMSS.json, or under
-        /// $XDG_STATE_HOME/prespline/ when the scene's directory is read-only. Ctrl+S in the
-        /// recovered session removes the autosave; see docs/autosave.md.
+        /// Open an earlier session's unsaved edits instead of the scene: the newest autosave,
+        /// or =FILE (the start-up note lists those waiting). Autosaves: NAME.autosave.json
+        /// beside NAME.json (demo.autosave.json for the demo), earlier sessions' as
+        /// NAME.autosave.YYYYMMDD-HHMMSS.json, or in $XDG_STATE_HOME/prespline/ when the
+        /// scene's directory cannot take them. Ctrl+S removes the recovered autosave; see
+        /// docs/autosave.md.
         #[arg(long, value_name = "FILE", num_args = 0..=1, require_equals = true)]
         recover: Option<Option<PathBuf>>,
         #[command(flatten)]

@@ -141,15 +141,20 @@ fn recover_file(places: &Places, named: Option<&Path>) -> Result<PathBuf, CliErr
     };
     match named {
         None => waiting.first().cloned().ok_or_else(|| {
-            let state = places
-                .in_state_dir()
-                .map_or("no state directory: neither XDG_STATE_HOME nor HOME is set".into(), |p| {
-                    p.display().to_string()
-                });
+            let looked = match places.in_state_dir() {
+                Some(state) => format!(
+                    "looked for {} and {}, and earlier sessions' beside them",
+                    places.beside().display(),
+                    state.display()
+                ),
+                None => format!(
+                    "looked for {} and earlier sessions' beside it; no state directory: neither XDG_STATE_HOME nor HOME is set",
+                    places.beside().display()
+                ),
+            };
             CliError(format!(
-                "--recover: there is no autosave of {} to open (looked for {} and {state}, and earlier sessions' beside them)",
-                places.scene_name(),
-                places.beside().display()
+                "--recover: there is no autosave of {} to open ({looked})",
+                places.scene_name()
             ))
         }),
         Some(file) => places.find(file).ok_or_else(|| {
