@@ -273,10 +273,17 @@ impl Place {
         found.into_iter().map(|(_, p)| p).collect()
     }
 
-    /// Every autosave here, oldest first: earlier sessions', then the current one.
+    /// Every autosave here, oldest first: one kept by viewers before timestamped names
+    /// (`STEM.autosave.previous.json`), earlier sessions', then the current one.
     fn waiting(&self) -> Vec<PathBuf> {
+        let legacy = self
+            .dir
+            .join(format!("{}.autosave.previous.json", self.stem));
+        let mut all: Vec<PathBuf> = std::iter::once(legacy)
+            .filter(|p| is_regular_file(p))
+            .chain(self.asides())
+            .collect();
         let current = self.current();
-        let mut all = self.asides();
         if is_regular_file(&current) {
             all.push(current);
         }
@@ -968,6 +975,17 @@ mod tests {
             .collect();
         let expected: Vec<f64> = (1..=KEEP + 1).rev().map(|k| k as f64).collect();
         assert_eq!(xs, expected);
+
+        // One kept by viewers before timestamped names waits too, and is never dropped.
+        let legacy = dir.join("scene.autosave.previous.json");
+        scene(0.5).save(&legacy).unwrap();
+        let mut a = Autosave::new(places.clone());
+        a.edited(Instant::now());
+        a.finish(&scene(9.0)).unwrap().unwrap();
+        assert!(legacy.exists());
+        let waiting = places.waiting();
+        assert_eq!(waiting.len(), KEEP + 2, "{waiting:?}");
+        assert_eq!(places.find(&legacy), Some(legacy));
         std::fs::remove_dir_all(dir).unwrap();
     }
 }
