@@ -66,10 +66,14 @@ enum Command {
         /// summary, Chrome trace, SVG plots) into DIR when the window closes.
         #[arg(long, value_name = "DIR")]
         profile: Option<PathBuf>,
-        /// Open the unsaved edits an earlier session left in NAME.autosave.json (beside
-        /// NAME.json; demo.autosave.json for the demo) instead of the scene.
-        #[arg(long)]
-        recover: bool,
+        /// Open an earlier session's unsaved edits instead of the scene: the newest autosave,
+        /// or =FILE (the start-up note lists those waiting). Autosaves: NAME.autosave.json
+        /// beside NAME.json (demo.autosave.json for the demo), earlier sessions' as
+        /// NAME.autosave.YYYYMMDD-HHMMSS.json, or in $XDG_STATE_HOME/prespline/ when the
+        /// scene's directory cannot take them. Ctrl+S removes the recovered autosave; see
+        /// docs/autosave.md.
+        #[arg(long, value_name = "FILE", num_args = 0..=1, require_equals = true)]
+        recover: Option<Option<PathBuf>>,
         #[command(flatten)]
         memory: MemoryArgs,
         /// Open with a surface analysis map on: gaussian, mean, kmax, kmin or zebra (M cycles).
@@ -285,7 +289,7 @@ fn main() -> ExitCode {
             profile: profile.as_deref(),
             samples: samples.counts(),
             memory: memory.budget(),
-            recover,
+            recover: recover.as_ref().map(Option::as_deref),
             analysis,
         }),
         Command::Bench {

@@ -1,7 +1,8 @@
 //! The viewer's session core without a window (lavapipe, validation required): redo, scale and
 //! cancel of ERBS local transforms checked exactly on the model, and the autosave — written at
-//! most a second after an edit, on every way out, removed by a clean save — plus durable
-//! (fsynced) scene writes.
+//! most a second after an edit, on every way out, removed by a clean save, never overwriting an
+//! earlier session's, falling back to the state directory and backing off when it cannot be
+//! written, with its notes on the status line — plus durable (fsynced) scene writes.
 
 mod common;
 
@@ -11,10 +12,10 @@ use prespline::model::{Index2, LocalPath, Model};
 use prespline::sampling::budget::MemoryBudget;
 use prespline::scene::{Scene, parse_scene};
 use prespline::view::Session;
-use prespline::view::autosave::{AUTOSAVE_DELAY, Autosave};
+use prespline::view::autosave::{AUTOSAVE_DELAY, Autosave, Places, RETRY_FIRST};
 use prespline::view::input::{InputEvent, Key, Modifiers, MouseButton};
 use prespline::view::script::Action;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// An ERBS curve with three local Bézier curves, and a B-spline curve.
@@ -270,14 +271,20 @@ fn typed_move(v: &mut Viewer, amount: &str) {
     v.press(Key::Enter);
 }
 
+/// Autosave of the scene `scene` with no state directory.
+fn autosave_beside(scene: &Path) -> Autosave {
+    Autosave::new(Places::new(Some(scene), None))
+}
+
 #[test]
 fn autosave_is_written_within_a_second_of_an_edit_and_removed_by_a_clean_save() {
     let scratch = common::Scratch::new("view-session");
     let path = scratch.join("scene.autosave.json");
     let mut v = Viewer::new(scratch.join("scene.json"));
-    v.session.set_autosave(Some(Autosave::new(path.clone())));
+    v.session
+        .set_autosave(Some(autosave_beside(&scratch.join("scene.json"))));
     assert_eq!(v.session.tick(Instant::now()), None, "nothing to write");
-    assert_eq!(v.session.on_exit(), None, "no edits, no autosave");
+    assert_eq!(v.session.on_exit(), Ok(None), "no edits, no autosave");
     assert!(!path.exists());
 
     typed_move(&mut v, "0.25");
@@ -302,7 +309,7 @@ fn autosave_is_written_within_a_second_of_an_edit_and_removed_by_a_clean_save() 
     v.key('s', true, false);
     assert!(!path.exists(), "a clean save removes the autosave");
     assert_eq!(Scene::load(&scratch.join("scene.json")).unwrap(), model);
-    assert_eq!(v.session.on_exit(), None, "saved: nothing to keep");
+    assert_eq!(v.session.on_exit(), Ok(None), "saved: nothing to keep");
     assert!(!path.exists());
     v.finish();
 }
@@ -313,9 +320,10 @@ fn every_way_out_writes_the_autosave() {
     // Quit (window close, Ctrl+Q, a script's quit, an error exit all end in on_exit): the
     // edit of this very frame, not yet applied, is included.
     for fatal in [false, true] {
+        let scene = scratch.join(format!("scene-{fatal}.json"));
         let path = scratch.join(format!("scene-{fatal}.autosave.json"));
-        let mut v = Viewer::new(scratch.join("scene.json"));
-        v.session.set_autosave(Some(Autosave::new(path.clone())));
+        let mut v = Viewer::new(scene.clone());
+        v.session.set_autosave(Some(autosave_beside(&scene)));
         typed_move(&mut v, "-0.5");
         v.select(local_point(2, 1));
         v.key('g', false, false);
@@ -328,7 +336,13 @@ fn every_way_out_writes_the_autosave() {
         } else {
             v.session.on_exit()
         };
-        assert_eq!(kept.as_ref(), Some(&path), "the path to print");
+        let kept = kept.unwrap().expect("the edits are kept");
+        assert_eq!(kept.path, path, "the path to print");
+        assert_eq!(
+            kept.command,
+            format!("prespline view {} --recover", scene.display()),
+            "the command names the real scene"
+        );
         let model = v.scene();
         assert_eq!(Scene::load(&path).unwrap(), model);
         let p = local_points(&model, 2)[1];
@@ -338,18 +352,112 @@ fn every_way_out_writes_the_autosave() {
     }
 }
 
+/// A session that finds an earlier session's autosave (not recovered) moves it aside to a
+/// timestamped name before writing its own, and says so on the status line; the start-up
+/// note (how many are waiting) is on the status line too.
 #[test]
 fn an_earlier_sessions_autosave_is_kept_aside() {
     let scratch = common::Scratch::new("view-session");
+    let scene = scratch.join("scene.json");
     let path = scratch.join("scene.autosave.json");
     std::fs::write(&path, SCENE).unwrap();
-    let mut v = Viewer::new(scratch.join("scene.json"));
-    v.session.set_autosave(Some(Autosave::new(path.clone())));
+    let mut v = Viewer::new(scene.clone());
+    let places = Places::new(Some(&scene), None);
+    let mut autosave = Autosave::new(places.clone());
+    autosave.notify(places.waiting_note(None).expect("one is waiting"));
+    v.session.set_autosave(Some(autosave));
+    assert!(
+        v.session.status().starts_with("note: 1 autosave of ")
+            && v.session.status().contains(&path.display().to_string()),
+        "{}",
+        v.session.status()
+    );
     typed_move(&mut v, "1");
-    assert!(v.session.on_exit().is_some());
-    let aside = scratch.join("scene.autosave.previous.json");
-    assert_eq!(std::fs::read_to_string(&aside).unwrap(), SCENE);
+    assert!(v.session.on_exit().unwrap().is_some());
+    let waiting = places.waiting();
+    assert_eq!(waiting.len(), 2, "{waiting:?}");
+    assert_eq!(waiting[0], path, "this session's is the newest");
+    let aside = &waiting[1];
+    let name = aside.file_name().unwrap().to_string_lossy();
+    assert!(
+        name.starts_with("scene.autosave.2")
+            && name.len() == "scene.autosave.YYYYMMDD-HHMMSS.json".len(),
+        "{name}"
+    );
+    assert_eq!(std::fs::read_to_string(aside).unwrap(), SCENE);
     assert_eq!(Scene::load(&path).unwrap(), v.scene());
+    assert!(
+        v.session.status().contains("kept the earlier autosave")
+            && v.session.status().contains(&*name),
+        "said on the status line: {}",
+        v.session.status()
+    );
+    v.finish();
+}
+
+/// The scene's directory cannot take the autosave (its name is taken by a directory): the
+/// state directory does, and the status line says so. Then neither can (the state directory
+/// is made a regular file): the first failure is said once, and however often the event loop
+/// asks, no write is tried before the backed-off retry; the way out reports the loss.
+#[test]
+fn an_unwritable_directory_falls_back_then_backs_off() {
+    let scratch = common::Scratch::new("view-session");
+    let scene = scratch.join("scene.json");
+    std::fs::create_dir_all(scratch.join("scene.autosave.json/occupied")).unwrap();
+    let state = scratch.join("state/prespline");
+    let places = Places::new(Some(&scene), Some(&state));
+    let fallback = places.in_state_dir().unwrap();
+    let mut v = Viewer::new(scene.clone());
+    v.session.set_autosave(Some(Autosave::new(places)));
+    typed_move(&mut v, "0.5");
+    v.session.apply_pending();
+    let due = v.session.tick(Instant::now()).unwrap();
+    assert_eq!(v.session.tick(due), None, "written");
+    assert_eq!(Scene::load(&fallback).unwrap(), v.scene());
+    assert!(
+        v.session
+            .status()
+            .contains("cannot autosave beside the scene")
+            && v.session.status().contains(&fallback.display().to_string()),
+        "{}",
+        v.session.status()
+    );
+
+    // Now nothing takes it.
+    std::fs::remove_dir_all(scratch.join("state")).unwrap();
+    std::fs::write(scratch.join("state"), "").unwrap();
+    typed_move(&mut v, "0.5");
+    v.session.apply_pending();
+    let due = v.session.tick(Instant::now()).unwrap();
+    let retry = v.session.tick(due).expect("a retry is due");
+    assert_eq!(retry, due + RETRY_FIRST, "the first retry a second later");
+    assert!(
+        v.session.status().starts_with("autosave failed ("),
+        "{}",
+        v.session.status()
+    );
+    v.session.set_status("");
+    // An event loop that wakes up over and over before the retry (the busy loop of old).
+    for _ in 0..10_000 {
+        assert_eq!(v.session.tick(due), Some(retry));
+    }
+    let a = v.session.autosave().unwrap();
+    assert_eq!(a.failures(), 1, "no write tried before the retry");
+    assert_eq!(v.session.status(), "", "no further note");
+    let lost = v.session.on_exit().unwrap_err();
+    assert_eq!(lost.revisions, 1, "{lost}");
+    assert_eq!(
+        lost.older, None,
+        "the earlier autosave went with the state directory"
+    );
+    let line = lost.to_string();
+    assert!(
+        line.contains(&scene.display().to_string())
+            && line.contains("could not be autosaved")
+            && line.contains(&state.display().to_string())
+            && line.contains("Is a directory"),
+        "{line}"
+    );
     v.finish();
 }
 

@@ -112,13 +112,15 @@ fn scripted_session_saves_exact_edits_and_matches_the_golden() {
     common::assert_golden("view_session", &pixels);
 }
 
-/// `prespline` on lavapipe with the validation layer required, in `dir`.
+/// `prespline` on lavapipe with the validation layer required, in `dir`, with `dir/state` as
+/// XDG_STATE_HOME (never the user's own).
 fn prespline(dir: &Scratch) -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_prespline"));
     let icd = prespline::gpu::LAVAPIPE_ICD;
     c.env("VK_DRIVER_FILES", icd)
         .env("VK_ICD_FILENAMES", icd)
         .env("PRESPLINE_VALIDATION", "required")
+        .env("XDG_STATE_HOME", dir.join("state"))
         .current_dir(dir.path());
     c
 }
@@ -265,8 +267,12 @@ fn unsaved_edits_survive_in_the_autosave_and_come_back_with_recover() {
         "the autosave was not written while the viewer was open ({before_exit:?} before it closed): {err}"
     );
     assert!(
-        err.contains(&format!("unsaved edits kept in {}", autosave.display())),
-        "the autosave's path is not printed on close: {err}"
+        err.contains(&format!(
+            "unsaved edits kept in {} (`prespline view {} --recover` opens them)",
+            autosave.display(),
+            scene.display()
+        )),
+        "the autosave's path and the real command are not printed on close: {err}"
     );
     let kept = Scene::load(&autosave).unwrap();
     assert_ne!(kept, original, "the drag is in the autosave");
@@ -347,7 +353,9 @@ fn the_demo_autosaves_in_the_working_directory() {
     assert!(out.status.success(), "{err}");
     let autosave = dir.join("demo.autosave.json");
     assert!(
-        err.contains("unsaved edits kept in demo.autosave.json"),
+        err.contains(
+            "unsaved edits kept in demo.autosave.json (`prespline view --recover` opens them)"
+        ),
         "{err}"
     );
     let kept = Scene::load(&autosave).unwrap();
@@ -407,39 +415,54 @@ fn without_a_display_strict_runs_fail() {
     }
 }
 
-/// An error that ends the viewer (here a screenshot that cannot be written) still keeps the
-/// unsaved edits and says where.
+/// An error that ends the viewer after an edit (a screenshot that cannot be written, a
+/// scripted `move_to` a point that does not exist) still keeps the unsaved edits, and the one
+/// error line says where.
 #[test]
 fn an_error_exit_keeps_the_unsaved_edits() {
     if !common::display() {
         return;
     }
-    let dir = Scratch::new("view-xvfb");
-    let out = run(prespline(&dir)
-        .args(["view", "--size", "320x240", "--script"])
-        .arg(dir.file(
-            "script.json",
-            r#"[{"frame": 3, "move_to": {"object": "nurbs_circle", "point": 2}},
-                {"frame": 4, "press": "left"}, {"frame": 5, "release": "left"},
-                {"frame": 6, "key": "g"}, {"frame": 7, "key": "x"}, {"frame": 8, "type": "2"},
-                {"frame": 9, "key": "enter"},
-                {"frame": 11, "screenshot": "/nonexistent/directory/shot.png"},
-                {"frame": 30, "quit": true}]"#,
-        )));
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        !out.status.success(),
-        "the screenshot cannot succeed: {err}"
-    );
-    assert!(err.contains("/nonexistent/directory/shot.png"), "{err}");
-    assert!(
-        err.contains("unsaved edits kept in demo.autosave.json"),
-        "{err}"
-    );
-    assert_ne!(
-        Scene::load(&dir.join("demo.autosave.json")).unwrap(),
-        demo_scene()
-    );
+    for (failing, names) in [
+        (
+            r#"{"frame": 11, "screenshot": "/nonexistent/directory/shot.png"}"#,
+            "/nonexistent/directory/shot.png",
+        ),
+        (
+            r#"{"frame": 11, "move_to": {"object": "nurbs_circle", "point": 99}}"#,
+            "error: script: move_to: there is no ",
+        ),
+    ] {
+        let dir = Scratch::new("view-xvfb");
+        let script = format!(
+            r#"[{{"frame": 3, "move_to": {{"object": "nurbs_circle", "point": 2}}}},
+                {{"frame": 4, "press": "left"}}, {{"frame": 5, "release": "left"}},
+                {{"frame": 6, "key": "g"}}, {{"frame": 7, "key": "x"}}, {{"frame": 8, "type": "2"}},
+                {{"frame": 9, "key": "enter"}}, {failing}, {{"frame": 30, "quit": true}}]"#
+        );
+        let out = run(prespline(&dir)
+            .args(["view", "--size", "320x240", "--script"])
+            .arg(dir.file("script.json", &script)));
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "the script cannot succeed: {err}");
+        let lines: Vec<&str> = err
+            .lines()
+            .filter(|l| l.contains(names) || l.contains("unsaved edits"))
+            .collect();
+        assert_eq!(lines.len(), 1, "one line: {err}");
+        assert!(
+            lines[0].starts_with("error: ")
+                && lines[0].contains(names)
+                && lines[0].ends_with(
+                    "; unsaved edits kept in demo.autosave.json (`prespline view --recover` opens them)"
+                ),
+            "{err}"
+        );
+        assert_ne!(
+            Scene::load(&dir.join("demo.autosave.json")).unwrap(),
+            demo_scene()
+        );
+    }
 }
 
 /// Insert a knot at the cursor, drag one of the new control points, save: the net is refined and

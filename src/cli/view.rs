@@ -7,9 +7,9 @@ use crate::sampling::budget::MemoryBudget;
 use crate::scene::Scene;
 use crate::scene::demo::demo_scene;
 use crate::view::app::{self, ViewArgs};
-use crate::view::autosave::{Autosave, autosave_path, newer_autosave, previous_path};
+use crate::view::autosave::{Autosave, Places, state_dir};
 use crate::view::script::parse_script;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Where Ctrl+S writes the demo scene.
 const DEMO_SAVE: &str = "prespline-demo.json";
@@ -27,56 +27,49 @@ pub struct ViewOptions<'a> {
     pub samples: SampleOverride,
     /// What pre-evaluation and the GPU mirrors may take.
     pub memory: MemoryBudget,
-    /// Open the scene's autosave (unsaved edits of an earlier session) instead of the scene.
-    pub recover: bool,
+    /// Open an autosave (unsaved edits of an earlier session) instead of the scene: `Some(None)`
+    /// the newest, `Some(Some(FILE))` the one named.
+    pub recover: Option<Option<&'a Path>>,
     /// A surface analysis map shown from the start (`--analysis`; M cycles it later).
     pub analysis: Option<crate::render::maps::SurfaceMap>,
 }
 
 pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
-    let autosave_file = autosave_path(opts.scene);
-    let (scene, title, default_save) = match opts.scene {
-        _ if opts.recover => {
-            if !autosave_file.exists() {
-                return Err(CliError(format!(
-                    "--recover: there is no autosave {} to open",
-                    autosave_file.display()
-                )));
-            }
-            let mut scene =
-                Scene::load(&autosave_file).map_err(|e| CliError::in_file(&autosave_file, e))?;
-            opts.samples.apply(&mut scene)?;
-            let (title, save) = match opts.scene {
+    let places = Places::new(opts.scene, state_dir().as_deref());
+    let recovered = match opts.recover {
+        Some(named) => Some(recover_file(&places, named)?),
+        None => None,
+    };
+    let (scene, title, default_save) = match (&recovered, opts.scene) {
+        (Some(file), scene) => {
+            let mut loaded = Scene::load(file).map_err(|e| CliError::in_file(file, e))?;
+            opts.samples.apply(&mut loaded)?;
+            let (title, save) = match scene {
                 Some(p) => (p.display().to_string(), p.to_path_buf()),
                 None => ("demo".to_string(), Path::new(DEMO_SAVE).to_path_buf()),
             };
-            (scene, format!("{title} (recovered)"), save)
+            (loaded, format!("{title} (recovered)"), save)
         }
-        Some(p) => (
+        (None, Some(p)) => (
             load_scene(p, &opts.samples)?,
             p.display().to_string(),
             p.to_path_buf(),
         ),
-        None => (
+        (None, None) => (
             demo_scene(),
             "demo".to_string(),
             Path::new(DEMO_SAVE).to_path_buf(),
         ),
     };
-    let autosave = if opts.recover {
-        Autosave::recovered(autosave_file)
-    } else {
-        if let Some(newer) = newer_autosave(opts.scene) {
-            eprintln!(
-                "note: {} holds unsaved edits newer than {}; `--recover` opens them (this session keeps them as {} when it autosaves)",
-                newer.display(),
-                opts.scene
-                    .map_or("the demo".to_string(), |p| p.display().to_string()),
-                previous_path(&newer).display()
-            );
-        }
-        Autosave::new(autosave_file)
+    let note = places.waiting_note(recovered.as_deref());
+    let mut autosave = match recovered {
+        Some(file) => Autosave::recovered(places, file),
+        None => Autosave::new(places),
     };
+    if let Some(note) = note {
+        // Shown by the session, on the status line and stderr.
+        autosave.notify(note);
+    }
     super::render::check_drawable(&scene, Path::new(&title), &opts.memory)?;
     super::render::check_analysis(&scene, opts.analysis, &opts.memory)?;
     if !app::display_available() {
@@ -133,4 +126,44 @@ pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
         );
     }
     Ok(())
+}
+
+/// The autosave `--recover` opens: the newest of the scene's, or the one `named`.
+fn recover_file(places: &Places, named: Option<&Path>) -> Result<PathBuf, CliError> {
+    let waiting = places.waiting();
+    let listed = || {
+        if waiting.is_empty() {
+            "there are none".to_string()
+        } else {
+            let names: Vec<String> = waiting.iter().map(|p| p.display().to_string()).collect();
+            format!("waiting: {}", names.join(", "))
+        }
+    };
+    match named {
+        None => waiting.first().cloned().ok_or_else(|| {
+            let looked = match places.in_state_dir() {
+                Some(state) => format!(
+                    "looked for {} and {}, and earlier sessions' beside them",
+                    places.beside().display(),
+                    state.display()
+                ),
+                None => format!(
+                    "looked for {} and earlier sessions' beside it; no state directory: neither XDG_STATE_HOME nor HOME is set",
+                    places.beside().display()
+                ),
+            };
+            CliError(format!(
+                "--recover: there is no autosave of {} to open ({looked})",
+                places.scene_name()
+            ))
+        }),
+        Some(file) => places.find(file).ok_or_else(|| {
+            CliError(format!(
+                "--recover={}: not an autosave of {} ({})",
+                file.display(),
+                places.scene_name(),
+                listed()
+            ))
+        }),
+    }
 }

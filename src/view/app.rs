@@ -162,6 +162,9 @@ pub fn run(args: ViewArgs) -> Result<ViewRun, String> {
         Ok(outcome) => outcome,
         Err(panic) => {
             app.keep_unsaved_edits();
+            if let Some(e) = &app.error {
+                eprintln!("error: {e}");
+            }
             std::panic::resume_unwind(panic)
         }
     };
@@ -256,15 +259,23 @@ impl App {
         Ok(())
     }
 
-    /// Every way out: the unsaved edits go to the autosave first (CPU only), and its path is
-    /// printed.
+    /// Every way out: the unsaved edits go to the autosave first (CPU only). Where they are
+    /// is printed, or joins the error line when the viewer fails; edits no place could take
+    /// make the run fail with one line saying so.
     fn keep_unsaved_edits(&mut self) {
-        if let Some(path) = self.running.as_mut().and_then(|r| r.session.on_exit()) {
-            eprintln!(
-                "unsaved edits kept in {} (`prespline view SCENE --recover` opens them)",
-                path.display()
-            );
-        }
+        let Some(r) = self.running.as_mut() else {
+            return;
+        };
+        let line = match r.session.on_exit() {
+            Ok(None) => return,
+            Ok(Some(kept)) if self.error.is_none() => return eprintln!("{kept}"),
+            Ok(Some(kept)) => kept.to_string(),
+            Err(lost) => lost.to_string(),
+        };
+        self.error = Some(match self.error.take() {
+            Some(e) => format!("{e}; {line}"),
+            None => line,
+        });
     }
 
     fn shutdown(&mut self, event_loop: &ActiveEventLoop) {
@@ -291,7 +302,8 @@ impl App {
     /// work (a lost device cannot be recovered from, but the document is in main memory).
     fn fail(&mut self, event_loop: &ActiveEventLoop, e: impl ToString) {
         if let Some(r) = self.running.as_mut() {
-            r.session.on_fatal_exit();
+            // Written now; where it went joins the error line in shutdown.
+            let _ = r.session.on_fatal_exit();
         }
         self.error.get_or_insert(e.to_string());
         self.shutdown(event_loop);

@@ -3,7 +3,7 @@
 //! delta path, copy dirty rows, record draws and the overlay). The winit viewer, `--script`
 //! replays and `prespline bench` all drive this same type.
 
-use super::autosave::Autosave;
+use super::autosave::{Autosave, Kept, Lost};
 use super::hud::Hud;
 use super::input::{InputEvent, Key, Modifiers, MouseButton};
 use super::picking::{PICK_RADIUS, Projected, pick, project_all};
@@ -180,9 +180,11 @@ impl Session {
         })
     }
 
-    /// Keeps unsaved edits in an autosave file (see [`super::autosave`]).
+    /// Keeps unsaved edits in an autosave file (see [`super::autosave`]); its start-up notes
+    /// go to the status line and stderr.
     pub fn set_autosave(&mut self, autosave: Option<Autosave>) {
         self.autosave = autosave;
+        self.show_autosave_notes();
     }
 
     pub fn autosave(&self) -> Option<&Autosave> {
@@ -196,37 +198,56 @@ impl Session {
         if due > now {
             return Some(due);
         }
-        self.write_autosave();
+        self.write_autosave(now);
         self.autosave.as_ref()?.deadline()
     }
 
     /// Every way out (window close, Ctrl+Q, a script's quit, an error): writes the autosave if
-    /// edits are unsaved, and returns its path while it holds edits the scene file lacks.
-    pub fn on_exit(&mut self) -> Option<PathBuf> {
-        self.write_autosave();
-        let a = self.autosave.as_ref()?;
-        a.exists().then(|| a.path().to_path_buf())
+    /// edits are unsaved, and says where they are kept, or what no place could take.
+    pub fn on_exit(&mut self) -> Result<Option<Kept>, Lost> {
+        if self.autosave.is_none() {
+            return Ok(None);
+        }
+        self.apply_pending();
+        let scene = self.editor.doc().to_scene();
+        let outcome = self
+            .autosave
+            .as_mut()
+            .map_or(Ok(None), |a| a.finish(&scene));
+        self.show_autosave_notes();
+        outcome
     }
 
     /// The device was lost or the viewer is about to fail: write the autosave now, before
-    /// anything else can go wrong (CPU only; touches no GPU object). Returns its path as
+    /// anything else can go wrong (CPU only; touches no GPU object). Returns what
     /// [`Session::on_exit`] does.
-    pub fn on_fatal_exit(&mut self) -> Option<PathBuf> {
+    pub fn on_fatal_exit(&mut self) -> Result<Option<Kept>, Lost> {
         self.on_exit()
     }
 
     /// Brings the autosave up to date with every queued edit (no-op when nothing is unsaved).
-    fn write_autosave(&mut self) {
+    fn write_autosave(&mut self, now: Instant) {
         if self.autosave.is_none() {
             return;
         }
         self.apply_pending();
         let scene = self.editor.doc().to_scene();
-        if let Some(a) = self.autosave.as_mut()
-            && let Err(e) = a.write(&scene)
-        {
-            eprintln!("autosave failed: {e}");
-            self.set_status(format!("autosave failed: {e}"));
+        if let Some(a) = self.autosave.as_mut() {
+            a.write(&scene, now);
+        }
+        self.show_autosave_notes();
+    }
+
+    /// What the autosave has to say goes to the status line and stderr.
+    fn show_autosave_notes(&mut self) {
+        let notes = self
+            .autosave
+            .as_mut()
+            .map(Autosave::take_notes)
+            .unwrap_or_default();
+        for note in notes {
+            eprintln!("{note}");
+            self.set_status(note);
         }
     }
 
