@@ -69,7 +69,7 @@ pub use csv::{CSV_HEADER, write_frames_csv, write_frames_csv_to};
 pub use histogram::{histogram_svg, write_histogram_svg};
 pub use phase::{Phase, PhaseMap};
 pub use plot::{frame_times_svg, write_frame_times_svg};
-pub use progress::{PROGRESS_INTERVAL, Progress, progress_line};
+pub use progress::Progress;
 pub use recorder::{FrameRecord, Recorder};
 pub use stats::{Stats, percentile, slowest_mean};
 pub use summary::{
