@@ -1,6 +1,9 @@
 //! Plain-text tables for the terminal: [`Summary::table`] and [`compare`].
 
-use super::{Phase, Section, Stats, Summary};
+use super::{
+    GPU_MEANING, LOW_1PCT_MEANING, OTHER_MEANING, PERCENTILE_MEANING, Phase, Section, Stats,
+    Summary,
+};
 use comfy_table::CellAlignment;
 
 /// Rows of cells rendered with the first column left-aligned and the others right-aligned,
@@ -137,6 +140,29 @@ impl Summary {
         }
         out
     }
+}
+
+impl Summary {
+    /// The content of `summary.txt`: [`table`](Self::table), a blank line, then
+    /// [`definitions`].
+    pub fn report(&self) -> String {
+        format!("{}\n{}", self.table(), definitions())
+    }
+}
+
+/// What the rows and columns of [`Summary::table`] mean, one name per line:
+/// `delta    edits applied to the samples`.
+pub fn definitions() -> String {
+    let mut rows: Vec<(&str, &str)> = Phase::ALL.map(|p| (p.name(), p.meaning())).to_vec();
+    rows.extend([
+        ("(other)", OTHER_MEANING),
+        ("gpu", GPU_MEANING),
+        ("p50..p99", PERCENTILE_MEANING),
+        ("1% low", LOW_1PCT_MEANING),
+    ]);
+    rows.iter()
+        .map(|(name, meaning)| format!("{name:<10}{meaning}\n"))
+        .collect()
 }
 
 fn warmup_line(w: &Section) -> String {
