@@ -123,12 +123,13 @@ impl Drop for Progress {
     }
 }
 
-/// `113 frames/s`, `3.4 M samples/s`, `0.50 frames/s`: the rate with an SI suffix above
-/// 1000 and two significant digits below 1.
+/// `113 frames/s`, `3.9 frames/s`, `0.50 frames/s`, `3.4 M samples/s`: two or three
+/// significant digits, with an SI suffix from 1000 on.
 fn rate(per_sec: f64, unit: &str) -> String {
     let value = match per_sec {
         r if !r.is_finite() || r <= 0.0 => "0".to_string(),
         r if r < 1.0 => format!("{r:.2}"),
+        r if r < 100.0 => format!("{r:.1}"),
         r if r < 1000.0 => format!("{r:.0}"),
         r => human_count(r),
     };
@@ -249,6 +250,7 @@ mod tests {
         assert_eq!(rate(113.4, "frames"), "113 frames/s");
         assert_eq!(rate(3.4e6, "samples"), "3.4 M samples/s");
         assert_eq!(rate(0.5, "frames"), "0.50 frames/s");
+        assert_eq!(rate(3.94, "frames"), "3.9 frames/s");
         assert_eq!(rate(f64::NAN, "frames"), "0 frames/s");
     }
 }
