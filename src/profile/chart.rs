@@ -106,18 +106,19 @@ pub(super) const LEFT: Pos = Pos {
     v_pos: VPos::Center,
 };
 
-/// A label drawn over data: a white, slightly transparent box under it keeps it legible.
+/// A label drawn over data, vertically centred on `at.1` and starting, centred or ending at
+/// `at.0` as `h_pos` says: a white, slightly transparent box under it keeps it legible.
 pub(super) fn label_over_data(
     area: &Area,
     s: &str,
     at: (i32, i32),
-    anchor: Pos,
+    h_pos: HPos,
     color: &RGBColor,
 ) -> DrawResult {
     let style = font(12.0, color);
     let (w, h) = area.estimate_text_size(s, &style)?;
     let (w, h) = (w as i32 + 4, h as i32 + 2);
-    let x0 = match anchor.h_pos {
+    let x0 = match h_pos {
         HPos::Left => at.0 - 2,
         HPos::Center => at.0 - w / 2,
         HPos::Right => at.0 - w + 2,
@@ -127,6 +128,10 @@ pub(super) fn label_over_data(
         [(x0, y0), (x0 + w, y0 + h)],
         WHITE.mix(0.8).filled(),
     ))?;
+    let anchor = Pos {
+        h_pos,
+        v_pos: VPos::Center,
+    };
     text(area, s, at, anchor, &style)
 }
 
@@ -343,6 +348,39 @@ mod tests {
         assert_eq!(wrap("aa bb cc", 5), ["aa bb", "cc"]);
         assert_eq!(wrap("a verylongword b", 4), ["a", "verylongword", "b"]);
         assert!(wrap("", 10).is_empty());
+    }
+
+    /// plotters chooses the ticks; with the span a whole number of steps they must be exactly
+    /// the multiples of the step, or the labels (formatted for the step) would lie.
+    #[test]
+    fn ticks_are_the_multiples_of_the_step() {
+        for (top, step) in [
+            (150.0, 50.0),
+            (0.8, 0.2),
+            (30.0, 10.0),
+            (25.0, 5.0),
+            (4.0, 1.0),
+        ] {
+            let svg = render("t", |area| {
+                axes(area, ((1000.0, 1007.0), 1.0), ((0.0, top), step), "x", "y").map(|_| ())
+            })
+            .unwrap();
+            let texts = crate::profile::tests::svg_texts(&svg);
+            let count = (top / step).round() as usize;
+            for i in 0..=count {
+                let label = tick_label(i as f64 * step, step);
+                assert!(
+                    texts.contains(&label),
+                    "{top}/{step}: no {label} in {texts:?}"
+                );
+            }
+            // Negative control: no label between two steps.
+            let between = tick_label(step / 2.0, step / 10.0);
+            assert!(
+                !texts.contains(&between),
+                "{top}/{step}: {between} in {texts:?}"
+            );
+        }
     }
 
     #[test]

@@ -6,7 +6,7 @@ use super::{
     slowest_mean, write_file,
 };
 use plotters::prelude::*;
-use plotters::style::text_anchor::{HPos, Pos, VPos};
+use plotters::style::text_anchor::HPos;
 use std::io::Write;
 use std::path::Path;
 
@@ -116,7 +116,7 @@ fn draw_histogram(area: &Area, title: &str, run: &RunInfo, frames: &[FrameRecord
             (px + 5, HPos::Left)
         };
         let label = format!("{name} {value:.2} ms");
-        chart::label_over_data(area, &label, (lx, y), Pos::new(h_pos, VPos::Center), &color)?;
+        chart::label_over_data(area, &label, (lx, y), h_pos, &color)?;
     }
     chart::legend(
         area,

@@ -8,7 +8,7 @@ use super::{
     FrameRecord, GPU_MEANING, OTHER_MEANING, Phase, ProfileError, RunInfo, percentile, write_file,
 };
 use plotters::prelude::*;
-use plotters::style::text_anchor::{HPos, Pos, VPos};
+use plotters::style::text_anchor::HPos;
 use std::io::Write;
 use std::path::Path;
 
@@ -170,12 +170,11 @@ fn draw_frame_times(area: &Area, title: &str, run: &RunInfo, frames: &[FrameReco
         let line = [(0.0, median), (n, median)];
         plot.draw_series(DashedLineSeries::new(line, DASH.0, DASH.1, style))?;
         let (x, y) = plot.backend_coord(&(n, median));
-        let anchor = Pos::new(HPos::Right, VPos::Bottom);
         chart::label_over_data(
             area,
             &format!("median {median:.2} ms"),
             (x - 4, y - 10),
-            anchor,
+            HPos::Right,
             &MEDIAN,
         )?;
     }
