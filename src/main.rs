@@ -100,7 +100,8 @@ enum Command {
         #[arg(long)]
         window: bool,
         /// Also run the same session the way tools without pre-evaluation work (full re-sampling
-        /// and full upload of edited objects every frame) and compare.
+        /// and full upload of edited objects every frame) and compare: reports in DIR/incremental
+        /// and DIR/naive, the comparison printed and saved as DIR/comparison.txt.
         #[arg(long)]
         naive: bool,
         /// Output directory for the reports.

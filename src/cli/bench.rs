@@ -1,6 +1,12 @@
 //! `prespline bench`: a scripted, reproducible editing session with per-frame phase timing,
 //! headless (offscreen) by default or in a window, optionally followed by the same session in
 //! naive mode (full re-sampling and full upload on every edit) for a same-run comparison.
+//!
+//! Writes the [`crate::profile::write_all`] reports and, headless, `final.png` (the last
+//! frame) into the output folder; with `--naive` into its `incremental/` and `naive/`
+//! subfolders, plus [`COMPARISON_TXT`], the table also printed at the end. While frames run,
+//! a progress bar shows on a terminal (nothing off one); each run's results are headed by a
+//! one-line banner naming scenario, scene, frames, size, mode and target.
 
 use super::CliError;
 use super::render::validation_mode;
@@ -55,26 +61,20 @@ pub fn run(args: &BenchArgs) -> Result<String, CliError> {
     let mut summaries = Vec::new();
     let mut written = Vec::new();
     for &naive in modes {
-        let mode = if naive { "naive" } else { "incremental" };
+        let mode = session_mode(naive);
         let dir = if args.naive {
             args.out.join(mode)
         } else {
             args.out.clone()
         };
-        eprintln!(
-            "bench: {} on {scene_name}, {} frames + {} warm-up, {}x{}, {mode}, {}",
-            args.scenario.name(),
-            args.frames,
-            args.warmup,
-            args.size.0,
-            args.size.1,
-            if args.window { "window" } else { "headless" }
-        );
         let (frames, device) = if args.window {
             run_window(args, &scene, naive)?
         } else {
             run_headless(args, &scene, naive, &dir)?
         };
+        // The banner heads the results rather than announcing the run: printed first, it
+        // would stand above the error of a run that fails to start, making it two lines.
+        eprintln!("{}", banner(args, &scene_name, mode));
         let summary = Summary::from_frames(&frames);
         eprint!("{}", summary.table());
         let mut info = RunInfo {
@@ -96,24 +96,52 @@ pub fn run(args: &BenchArgs) -> Result<String, CliError> {
         summaries.push((mode, summary));
     }
     if let [(a, inc), (b, naive)] = summaries.as_slice() {
-        eprint!("{}", compare(a, inc, b, naive));
-        if let (Some(i), Some(n)) = (&inc.measured, &naive.measured) {
-            let (di, dn) = (i.phase_ms[Phase::Delta].mean, n.phase_ms[Phase::Delta].mean);
-            if di > 0.0 {
-                eprintln!(
-                    "edit cost (delta phase, mean): incremental {:.1} µs, naive {:.1} µs: {:.0}× less with pre-evaluation",
-                    di * 1e3,
-                    dn * 1e3,
-                    dn / di
-                );
-            }
-        }
+        let text = comparison(a, inc, b, naive);
+        eprint!("{text}");
+        let path = args.out.join(COMPARISON_TXT);
+        std::fs::write(&path, &text)
+            .map_err(|e| CliError(format!("cannot write {}: {e}", path.display())))?;
+        written.push(path);
     }
     Ok(format!(
         "bench results in {} ({} files)",
         args.out.display(),
         written.len()
     ))
+}
+
+/// With `--naive`: the side-by-side table of both runs, in the output folder.
+pub const COMPARISON_TXT: &str = "comparison.txt";
+
+/// `bench: drag on demo, 120 frames + 10 warm-up, 1280x720, incremental, headless`.
+fn banner(args: &BenchArgs, scene_name: &str, mode: &str) -> String {
+    format!(
+        "bench: {} on {scene_name}, {} frames + {} warm-up, {}x{}, {mode}, {}",
+        args.scenario.name(),
+        args.frames,
+        args.warmup,
+        args.size.0,
+        args.size.1,
+        if args.window { "window" } else { "headless" }
+    )
+}
+
+/// The content of `comparison.txt`: [`compare`]'s table, then the edit cost of both runs when
+/// the incremental one has one.
+fn comparison(a: &str, inc: &Summary, b: &str, naive: &Summary) -> String {
+    let mut text = compare(a, inc, b, naive);
+    if let (Some(i), Some(n)) = (&inc.measured, &naive.measured) {
+        let (di, dn) = (i.phase_ms[Phase::Delta].mean, n.phase_ms[Phase::Delta].mean);
+        if di > 0.0 {
+            text.push_str(&format!(
+                "edit cost (delta phase, mean): incremental {:.1} µs, naive {:.1} µs: {:.0}× less with pre-evaluation\n",
+                di * 1e3,
+                dn * 1e3,
+                dn / di
+            ));
+        }
+    }
+    text
 }
 
 /// The session in an offscreen target: exactly the viewer's per-frame work without a window.
@@ -155,7 +183,8 @@ fn run_headless(
         let mut driver = ScenarioDriver::new(args.scenario, &session, args.warmup, args.frames)
             .map_err(CliError)?;
         let mut rec = Recorder::with_capacity(args.warmup, total);
-        let mut progress = Progress::new(Some(total));
+        let label = format!("bench {} ({})", args.scenario.name(), session_mode(naive));
+        let progress = Progress::new(&label, Some(total as u64)).unit("frames");
         for k in 0..total {
             let index = rec.begin_frame();
             rec.phase_start(Phase::Input);
@@ -187,9 +216,9 @@ fn run_headless(
                 .hud
                 .push_frame(rec.frames().last().map_or(0.0, |f| f.frame_ms));
             session.hud.gpu_ms = renderer.last_gpu_time_ms();
-            progress.update(k + 1);
+            progress.inc(1);
         }
-        progress.finish(total);
+        progress.finish();
         // The last frames' GPU times arrive when their slots are waited on.
         renderer.wait_idle().map_err(gpu)?;
         std::fs::create_dir_all(dir)
@@ -214,6 +243,10 @@ fn run_headless(
         )));
     }
     Ok((result?.into_frames(), device))
+}
+
+fn session_mode(naive: bool) -> &'static str {
+    if naive { "naive" } else { "incremental" }
 }
 
 fn run_window(

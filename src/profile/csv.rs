@@ -14,29 +14,34 @@ pub fn write_frames_csv(path: &Path, frames: &[FrameRecord]) -> Result<(), Profi
 }
 
 /// Writes the CSV to any writer (stdout, a buffer in tests).
+///
+/// Through the `csv` crate: it quotes any field that needs it and refuses a row whose length
+/// differs from the header's, so a column added to one side only fails loudly instead of
+/// shifting every later column.
 pub fn write_frames_csv_to(w: &mut impl Write, frames: &[FrameRecord]) -> io::Result<()> {
-    writeln!(w, "{CSV_HEADER}")?;
+    let mut out = csv::Writer::from_writer(w);
+    out.write_record(CSV_HEADER.split(','))?;
     for f in frames {
-        // Microsecond start times and 0.1 µs phase times: finer than `Instant` is worth on
-        // most systems, coarse enough to keep the file small.
-        write!(
-            w,
-            "{},{:.6},{},{:.4}",
-            f.index,
-            f.start_s,
-            u8::from(f.warmup),
-            f.frame_ms
-        )?;
-        for phase in Phase::ALL {
-            write!(w, ",{:.4}", f.phase_ms[phase])?;
-        }
-        match f.gpu_ms {
-            Some(gpu) => write!(w, ",{gpu:.4}")?,
-            None => write!(w, ",")?,
-        }
-        writeln!(w, ",{},{}", f.bytes_uploaded, f.samples_touched)?;
+        out.write_record(row(f))?;
     }
-    Ok(())
+    out.flush()
+}
+
+/// The cells of one frame, in [`CSV_HEADER`] order.
+fn row(f: &FrameRecord) -> Vec<String> {
+    // Microsecond start times and 0.1 µs phase times: finer than `Instant` is worth on most
+    // systems, coarse enough to keep the file small.
+    let mut cells = vec![
+        f.index.to_string(),
+        format!("{:.6}", f.start_s),
+        u8::from(f.warmup).to_string(),
+        format!("{:.4}", f.frame_ms),
+    ];
+    cells.extend(Phase::ALL.map(|phase| format!("{:.4}", f.phase_ms[phase])));
+    cells.push(f.gpu_ms.map_or_else(String::new, |gpu| format!("{gpu:.4}")));
+    cells.push(f.bytes_uploaded.to_string());
+    cells.push(f.samples_touched.to_string());
+    cells
 }
 
 #[cfg(test)]

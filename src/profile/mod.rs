@@ -48,11 +48,18 @@
 //!
 //! - `frames.csv`: [`write_frames_csv`]; one row per frame.
 //! - `summary.json`: [`write_summary_json`]; run info and [`Summary`].
-//! - `summary.txt`: [`Summary::table`].
+//! - `summary.txt`: [`Summary::report`]: the table of [`Summary::table`], then what each
+//!   phase, the percentiles and "1% low" mean.
 //! - `trace.json`: [`write_trace_json`]; Chrome trace (chrome://tracing, ui.perfetto.dev).
-//! - `frame_times.svg`: [`write_frame_times_svg`]; frame time over the run, phases stacked.
-//! - `histogram.svg`: [`write_histogram_svg`]; frame-time distribution with p50/p99.
+//! - `frame_times.svg`: [`write_frame_times_svg`]; frame time over the run, phases stacked,
+//!   with a footnote naming what each phase measures.
+//! - `histogram.svg`: [`write_histogram_svg`]; frame-time distribution with p50/p99 marked and
+//!   the 1 % low stated, with a footnote defining them.
+//!
+//! The SVGs are drawn with `plotters` (SVG backend only), `frames.csv` through `csv`, the
+//! tables through `comfy-table`; [`Progress`] draws with `indicatif`.
 
+mod chart;
 mod csv;
 mod histogram;
 mod phase;
@@ -61,21 +68,20 @@ mod progress;
 mod recorder;
 mod stats;
 mod summary;
-mod svg;
 mod table;
 mod trace;
 
 pub use csv::{CSV_HEADER, write_frames_csv, write_frames_csv_to};
 pub use histogram::{histogram_svg, write_histogram_svg};
-pub use phase::{Phase, PhaseMap};
+pub use phase::{GPU_MEANING, OTHER_MEANING, Phase, PhaseMap};
 pub use plot::{frame_times_svg, write_frame_times_svg};
-pub use progress::{PROGRESS_INTERVAL, Progress, progress_line};
+pub use progress::Progress;
 pub use recorder::{FrameRecord, Recorder};
-pub use stats::{Stats, percentile, slowest_mean};
+pub use stats::{LOW_1PCT_MEANING, PERCENTILE_MEANING, Stats, percentile, slowest_mean};
 pub use summary::{
     RunInfo, Section, Summary, SummaryFile, read_summary_json, summary_json, write_summary_json,
 };
-pub use table::compare;
+pub use table::{compare, definitions};
 pub use trace::{write_trace_json, write_trace_json_to};
 
 use std::fs::File;
@@ -97,6 +103,8 @@ pub enum ProfileError {
     Write { path: PathBuf, source: io::Error },
     #[error("cannot read {}: {source}", path.display())]
     Read { path: PathBuf, source: io::Error },
+    #[error("cannot draw {title}: {message}")]
+    Plot { title: String, message: String },
     #[error("{}: not a profile summary: {source}", path.display())]
     Parse {
         path: PathBuf,
@@ -128,7 +136,7 @@ pub fn write_all(
     ];
     write_frames_csv(&paths[0], frames)?;
     write_summary_json(&paths[1], run, &summary)?;
-    write_file(&paths[2], |w| w.write_all(summary.table().as_bytes()))?;
+    write_file(&paths[2], |w| w.write_all(summary.report().as_bytes()))?;
     write_trace_json(&paths[3], run, frames)?;
     write_frame_times_svg(&paths[4], run, frames)?;
     write_histogram_svg(&paths[5], run, frames)?;

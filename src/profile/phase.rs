@@ -46,6 +46,27 @@ impl Phase {
     }
 }
 
+impl Phase {
+    /// What the phase measures, in a few words, for the footnotes of `summary.txt` and the
+    /// plots.
+    pub const fn meaning(self) -> &'static str {
+        match self {
+            Phase::Input => "events turned into edits",
+            Phase::Delta => "edits applied to the samples",
+            Phase::Upload => "dirty ranges copied to the GPU",
+            Phase::Record => "command recording",
+            Phase::Submit => "queue submission",
+            Phase::Present => "wait for the swapchain image or frame slot (the GPU or rasteriser)",
+        }
+    }
+}
+
+/// The meaning of "other" (see [`FrameRecord::other_ms`](super::FrameRecord::other_ms)), next
+/// to [`Phase::meaning`].
+pub const OTHER_MEANING: &str = "frame time in no phase (idle or not instrumented)";
+/// The meaning of the GPU time, for footnotes.
+pub const GPU_MEANING: &str = "GPU execution time (timestamp queries)";
+
 impl fmt::Display for Phase {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())

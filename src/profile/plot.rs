@@ -1,23 +1,44 @@
 //! `frame_times.svg`: frame time over the run with the CPU phases stacked underneath.
 
-use super::svg::{
-    Axes, HALO, Mark, PLOT_HEIGHT, PLOT_LEFT, PLOT_TOP, PLOT_WIDTH, Svg, heading, legend,
-    nice_step, no_data, subtitle, tick_label, title,
+use super::chart::{
+    self, Area, Chart, DrawResult, GREY_TEXT, Mark, PLOT_TOP, PLOT_WIDTH, TEXT, TOP_LEFT, font,
+    nice_step, tick_label,
 };
-use super::{FrameRecord, Phase, ProfileError, RunInfo, percentile, write_file};
+use super::{
+    FrameRecord, GPU_MEANING, OTHER_MEANING, Phase, ProfileError, RunInfo, percentile, write_file,
+};
+use plotters::prelude::*;
+use plotters::style::text_anchor::HPos;
 use std::io::Write;
 use std::path::Path;
 
 /// Fill colours of the stacked phases (Okabe–Ito, distinguishable with colour-vision
 /// deficiencies); `present` is grey because it is mostly waiting.
-pub(super) const PHASE_COLORS: [&str; Phase::COUNT] = [
-    "#E69F00", "#56B4E9", "#009E73", "#F0E442", "#0072B2", "#BBBBBB",
+pub(super) const PHASE_COLORS: [RGBColor; Phase::COUNT] = [
+    RGBColor(0xE6, 0x9F, 0x00),
+    RGBColor(0x56, 0xB4, 0xE9),
+    RGBColor(0x00, 0x9E, 0x73),
+    RGBColor(0xF0, 0xE4, 0x42),
+    RGBColor(0x00, 0x72, 0xB2),
+    RGBColor(0xBB, 0xBB, 0xBB),
 ];
-const GPU_STROKE: &str = "stroke=\"#CC79A7\" stroke-width=\"1.5\" stroke-dasharray=\"4 2\"";
-const FRAME_STROKE: &str = "stroke=\"#000000\" stroke-width=\"1\"";
-const FRAME_MAX_STROKE: &str = "stroke=\"#888888\" stroke-width=\"0.75\"";
-const MEDIAN_STROKE: &str = "stroke=\"#D55E00\" stroke-width=\"1.5\" stroke-dasharray=\"6 3\"";
-const WARMUP_FILL: &str = "fill=\"#000000\" fill-opacity=\"0.08\"";
+const GPU: RGBColor = RGBColor(0xCC, 0x79, 0xA7);
+const FRAME_MAX: RGBColor = RGBColor(0x88, 0x88, 0x88);
+const MEDIAN: RGBColor = RGBColor(0xD5, 0x5E, 0x00);
+/// Dash and gap lengths in pixels.
+const DASH: (u32, u32) = (5, 3);
+
+/// What the phases, "other" and "gpu" mean, as one paragraph for the footnote.
+fn phase_footnote() -> String {
+    let phases: Vec<String> = Phase::ALL
+        .iter()
+        .map(|p| format!("{p} = {}", p.meaning()))
+        .collect();
+    format!(
+        "Phases: {}; other = {OTHER_MEANING}; gpu = {GPU_MEANING}.",
+        phases.join("; ")
+    )
+}
 
 /// The y axis stops at this multiple of the measured p99 (clipping, with a note) so that one
 /// warm-up stall or hitch does not flatten every other frame to the x axis.
@@ -99,9 +120,12 @@ fn y_axis(frames: &[FrameRecord], measured_p99: Option<f64>) -> (f64, f64, Strin
 }
 
 /// The SVG text of `frame_times.svg`.
-pub fn frame_times_svg(run: &RunInfo, frames: &[FrameRecord]) -> String {
-    let title = title("Frame time", run);
-    let mut svg = Svg::new(&title);
+pub fn frame_times_svg(run: &RunInfo, frames: &[FrameRecord]) -> Result<String, ProfileError> {
+    let title = chart::title("Frame time", run);
+    chart::render(&title, |area| draw_frame_times(area, &title, run, frames))
+}
+
+fn draw_frame_times(area: &Area, title: &str, run: &RunInfo, frames: &[FrameRecord]) -> DrawResult {
     let mut measured: Vec<f64> = frames
         .iter()
         .filter(|f| !f.warmup && f.frame_ms.is_finite())
@@ -116,82 +140,97 @@ pub fn frame_times_svg(run: &RunInfo, frames: &[FrameRecord]) -> String {
         ),
     };
     let (y_top, y_step, note) = y_axis(frames, p99);
-    heading(&mut svg, &title, &subtitle(run, frames, &note));
+    let [description, counts] = chart::subtitles(run, frames, &[note]);
+    chart::heading(area, title, [&description, &counts])?;
+    chart::footnote(area, &phase_footnote())?;
     if frames.is_empty() {
-        no_data(&mut svg);
-        return svg.finish();
+        return chart::no_data(area);
     }
 
-    let n = frames.len();
-    let axes = Axes {
-        x_range: (0.0, n as f64),
-        y_range: (0.0, y_top),
-    };
-    let warmup_end = frames.iter().take_while(|f| f.warmup).count();
-    let (x0, x1) = (axes.x(0.0), axes.x(warmup_end as f64));
-    if warmup_end > 0 {
-        svg.rect(x0, PLOT_TOP, x1 - x0, PLOT_HEIGHT, WARMUP_FILL);
-    }
-    axes.draw(
-        &mut svg,
-        nice_step(n as f64, 8).max(1.0),
-        y_step,
+    let n = frames.len() as f64;
+    let x_step = nice_step(n, 8).max(1.0);
+    let mut plot = chart::axes(
+        area,
+        ((0.0, n), x_step),
+        ((0.0, y_top), y_step),
         "frame",
         "ms",
-    );
-
+    )?;
+    let warmup_end = frames.iter().take_while(|f| f.warmup).count() as f64;
+    if warmup_end > 0.0 {
+        let shade = BLACK.mix(0.08).filled();
+        plot.draw_series([Rectangle::new([(0.0, 0.0), (warmup_end, y_top)], shade)])?;
+    }
     let points = points(frames);
-    draw_stack(&mut svg, &axes, &points);
-    let bucketed = points.len() < n;
-    draw_lines(&mut svg, &axes, &points, bucketed);
-    let label_attrs = format!("fill=\"#D55E00\" {HALO}");
+    draw_stack(&mut plot, &points, y_top)?;
+    let bucketed = points.len() < frames.len();
+    draw_lines(&mut plot, &points, bucketed, y_top)?;
     if let Some(median) = median {
-        let y = axes.y(median);
-        svg.line(PLOT_LEFT, y, PLOT_LEFT + PLOT_WIDTH, y, MEDIAN_STROKE);
-        let label = format!("median {median:.2} ms");
-        svg.text(
-            PLOT_LEFT + PLOT_WIDTH - 4.0,
-            y - 5.0,
-            "end",
-            &label_attrs,
-            &label,
-        );
+        let style = MEDIAN.stroke_width(2);
+        let line = [(0.0, median), (n, median)];
+        plot.draw_series(DashedLineSeries::new(line, DASH.0, DASH.1, style))?;
+        let (x, y) = plot.backend_coord(&(n, median));
+        chart::label_over_data(
+            area,
+            &format!("median {median:.2} ms"),
+            (x - 4, y - 10),
+            HPos::Right,
+            &MEDIAN,
+        )?;
     }
     // Labels last, so that data never covers them.
-    if x1 - x0 > 60.0 {
-        let attrs = format!("fill=\"#666666\" {HALO}");
-        svg.text(x0 + 4.0, PLOT_TOP + 14.0, "start", &attrs, "warm-up");
+    let (x0, x1) = (
+        plot.backend_coord(&(0.0, 0.0)).0,
+        plot.backend_coord(&(warmup_end, 0.0)).0,
+    );
+    if x1 - x0 > 60 {
+        chart::text(
+            area,
+            "warm-up",
+            (x0 + 4, PLOT_TOP + 4),
+            TOP_LEFT,
+            &font(12.0, &GREY_TEXT),
+        )?;
     }
+    chart::legend(
+        area,
+        &legend_items(frames, bucketed, median.is_some(), warmup_end > 0.0),
+    )
+}
 
-    let fills = PHASE_COLORS.map(|c| format!("fill=\"{c}\""));
+fn legend_items(
+    frames: &[FrameRecord],
+    bucketed: bool,
+    median: bool,
+    warmup: bool,
+) -> Vec<(Mark, &'static str)> {
     let mut items: Vec<(Mark, &str)> = Phase::ALL
         .iter()
-        .zip(&fills)
+        .zip(PHASE_COLORS)
         .rev() // top of the stack first, as drawn
-        .map(|(p, fill)| (Mark::Swatch(fill), p.name()))
+        .map(|(p, color)| (Mark::Swatch(color.mix(0.85)), p.name()))
         .collect();
     match bucketed {
         true => items.extend([
-            (Mark::Line(FRAME_STROKE), "frame (mean)"),
-            (Mark::Line(FRAME_MAX_STROKE), "frame (max)"),
+            (Mark::Line(TEXT.stroke_width(1)), "frame (mean)"),
+            (Mark::Line(FRAME_MAX.stroke_width(1)), "frame (max)"),
         ]),
-        false => items.push((Mark::Line(FRAME_STROKE), "frame")),
+        false => items.push((Mark::Line(TEXT.stroke_width(1)), "frame")),
     }
     if frames.iter().any(|f| f.gpu_ms.is_some()) {
-        items.push((Mark::Line(GPU_STROKE), "gpu"));
+        items.push((Mark::Dashed(GPU.stroke_width(2)), "gpu"));
     }
-    if median.is_some() {
-        items.push((Mark::Line(MEDIAN_STROKE), "median"));
+    if median {
+        items.push((Mark::Dashed(MEDIAN.stroke_width(2)), "median"));
     }
-    if warmup_end > 0 {
-        items.push((Mark::Swatch(WARMUP_FILL), "warm-up"));
+    if warmup {
+        items.push((Mark::Swatch(BLACK.mix(0.08)), "warm-up"));
     }
-    legend(&mut svg, &items);
-    svg.finish()
+    items
 }
 
-/// The phases as stacked areas, `input` at the bottom.
-fn draw_stack(svg: &mut Svg, axes: &Axes, points: &[Point]) {
+/// The phases as stacked areas, `input` at the bottom; values above the axis are clipped.
+fn draw_stack(plot: &mut Chart, points: &[Point], y_top: f64) -> DrawResult {
     let mut below = vec![0.0; points.len()];
     for (k, color) in PHASE_COLORS.iter().enumerate() {
         let above: Vec<f64> = points
@@ -199,37 +238,39 @@ fn draw_stack(svg: &mut Svg, axes: &Axes, points: &[Point]) {
             .zip(&below)
             .map(|(p, b)| b + p.phase_ms[k])
             .collect();
-        let to_svg = |(p, v): (&Point, &f64)| (axes.x(p.x), axes.y(*v));
-        let mut outline: Vec<(f64, f64)> = points.iter().zip(&above).map(to_svg).collect();
-        outline.extend(points.iter().zip(&below).rev().map(to_svg));
-        svg.area(&outline, &format!("fill=\"{color}\" fill-opacity=\"0.85\""));
+        let clip = |(p, v): (&Point, &f64)| (p.x, v.min(y_top));
+        let mut outline: Vec<(f64, f64)> = points.iter().zip(&above).map(clip).collect();
+        outline.extend(points.iter().zip(&below).rev().map(clip));
+        plot.draw_series([Polygon::new(outline, color.mix(0.85).filled())])?;
         below = above;
     }
+    Ok(())
 }
 
 /// Frame time (mean, and max per point when frames are averaged) and GPU time.
-fn draw_lines(svg: &mut Svg, axes: &Axes, points: &[Point], bucketed: bool) {
-    let line = |get: fn(&Point) -> f64| -> Vec<(f64, f64)> {
-        points
-            .iter()
-            .map(|p| (axes.x(p.x), axes.y(get(p))))
-            .collect()
-    };
+fn draw_lines(plot: &mut Chart, points: &[Point], bucketed: bool, y_top: f64) -> DrawResult {
+    let line = |get: fn(&Point) -> f64| points.iter().map(move |p| (p.x, get(p).min(y_top)));
     if bucketed {
-        svg.polyline(&line(|p| p.frame_max_ms), FRAME_MAX_STROKE);
+        plot.draw_series(LineSeries::new(
+            line(|p| p.frame_max_ms),
+            FRAME_MAX.stroke_width(1),
+        ))?;
     }
-    svg.polyline(&line(|p| p.frame_ms), FRAME_STROKE);
+    plot.draw_series(LineSeries::new(line(|p| p.frame_ms), TEXT.stroke_width(1)))?;
     for mut segment in gpu_segments(points) {
         // A lone point draws nothing; widen it to a one-frame dash.
         if let [(x, v)] = segment[..] {
             segment = vec![(x - 0.5, v), (x + 0.5, v)];
         }
-        let svg_points: Vec<(f64, f64)> = segment
-            .iter()
-            .map(|&(x, v)| (axes.x(x), axes.y(v)))
-            .collect();
-        svg.polyline(&svg_points, GPU_STROKE);
+        let clipped = segment.into_iter().map(|(x, v)| (x, v.min(y_top)));
+        plot.draw_series(DashedLineSeries::new(
+            clipped,
+            DASH.0,
+            DASH.1,
+            GPU.stroke_width(2),
+        ))?;
     }
+    Ok(())
 }
 
 /// Runs of consecutive points that have a GPU time; frames without one break the line.
@@ -254,6 +295,6 @@ pub fn write_frame_times_svg(
     run: &RunInfo,
     frames: &[FrameRecord],
 ) -> Result<(), ProfileError> {
-    let text = frame_times_svg(run, frames);
+    let text = frame_times_svg(run, frames)?;
     write_file(path, |w| w.write_all(text.as_bytes()))
 }

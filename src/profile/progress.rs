@@ -1,156 +1,256 @@
-//! Throttled progress line for long runs: `frame 1200/5000 (24%), 8.3 ms/frame`.
+//! Progress of long runs on stderr, through `indicatif`: on a terminal an in-place bar (or a
+//! spinner when the total is unknown) with the count, the current rate and the time left;
+//! off a terminal (a pipe, a file, CI) nothing at all, like other Rust command-line tools.
+//!
+//! ```no_run
+//! use prespline::profile::Progress;
+//!
+//! let progress = Progress::new("pre-evaluating", Some(262_144)).unit("samples");
+//! for _ in 0..64 {
+//!     progress.inc(4096);
+//! }
+//! progress.finish();
+//! ```
 
-use std::io::{self, IsTerminal, Stderr, Write};
-use std::time::{Duration, Instant};
+use super::table::human_count;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressState, ProgressStyle};
 
-/// Default time between two progress lines.
-pub const PROGRESS_INTERVAL: Duration = Duration::from_millis(250);
+/// Redraws per second at most; each [`inc`](Progress::inc) in between costs an atomic add and
+/// a clock read.
+const REFRESH_HZ: u8 = 10;
 
-/// Prints a progress line at most every `interval` (4 per second by default).
+/// A progress line for one piece of work, e.g. `Progress::new("bench drag", Some(130))
+/// .unit("frames")`, drawn as
+/// `bench drag [=========>          ] 52/130 frames (40%), 113 frames/s, 1s left`.
 ///
-/// On a terminal the line is redrawn in place (`\r`); otherwise each update is a new line, so
-/// a forced progress in a log stays readable. Write errors are ignored: progress is cosmetic
-/// and must never stop a run.
-pub struct Progress<W: Write = Stderr> {
-    out: Option<W>,
-    in_place: bool,
-    total: Option<usize>,
-    interval: Duration,
-    last_print: Instant,
-    last_done: usize,
-    last_len: usize,
+/// Dropping it unfinished (an error ended the work) clears the line, so that the error
+/// message stands alone.
+pub struct Progress {
+    bar: ProgressBar,
+    finished: bool,
 }
 
-impl Progress<Stderr> {
-    /// Prints to stderr only when stderr is a terminal. `total` is the number of frames, if
-    /// known.
-    pub fn new(total: Option<usize>) -> Self {
-        let terminal = io::stderr().is_terminal();
-        Self::stderr(total, terminal)
+impl Progress {
+    /// Draws on stderr when stderr is a terminal, and never otherwise. `label` names the
+    /// work; `total` is the count at completion, if known.
+    #[must_use]
+    pub fn new(label: &str, total: Option<u64>) -> Self {
+        Self::with_target(label, total, ProgressDrawTarget::stderr_with_hz(REFRESH_HZ))
     }
 
-    /// Prints to stderr when `enabled` (e.g. a `--progress` flag), in place on a terminal.
-    pub fn stderr(total: Option<usize>, enabled: bool) -> Self {
-        let in_place = io::stderr().is_terminal();
-        Progress::to_writer(enabled.then(io::stderr), total, in_place)
-    }
-}
-
-impl<W: Write> Progress<W> {
-    /// Prints to `out` (nothing when `None`), redrawing in place when `in_place`.
-    pub fn to_writer(out: Option<W>, total: Option<usize>, in_place: bool) -> Self {
-        Progress {
-            out,
-            in_place,
-            total,
-            interval: PROGRESS_INTERVAL,
-            last_print: Instant::now(),
-            last_done: 0,
-            last_len: 0,
-        }
+    /// Never draws: for callers that want no progress whatever stderr is.
+    #[must_use]
+    pub fn hidden(label: &str, total: Option<u64>) -> Self {
+        Self::with_target(label, total, ProgressDrawTarget::hidden())
     }
 
-    pub fn with_interval(mut self, interval: Duration) -> Self {
-        self.interval = interval;
+    fn with_target(label: &str, total: Option<u64>, target: ProgressDrawTarget) -> Self {
+        let bar = ProgressBar::with_draw_target(total, target).with_prefix(label.to_string());
+        let progress = Progress {
+            bar,
+            finished: false,
+        };
+        progress.set_style("items");
+        progress
+    }
+
+    /// Names what is counted (plural: "frames", "objects", "samples"); "items" by default.
+    #[must_use]
+    pub fn unit(self, unit: &str) -> Self {
+        self.set_style(unit);
         self
     }
 
-    /// Reports that `done` frames are complete. Cheap when it does not print: one clock read.
-    pub fn update(&mut self, done: usize) {
-        if self.out.is_none() {
-            return;
-        }
-        let now = Instant::now();
-        if now.duration_since(self.last_print) >= self.interval {
-            self.print(done, now);
-        }
-    }
-
-    /// Prints the final state and ends the line.
-    pub fn finish(&mut self, done: usize) {
-        if self.out.is_none() {
-            return;
-        }
-        if done != self.last_done || self.last_len == 0 {
-            self.print(done, Instant::now());
-        }
-        if self.in_place
-            && let Some(out) = &mut self.out
-        {
-            let _ = writeln!(out);
-            let _ = out.flush();
-        }
-        self.out = None;
-    }
-
-    fn print(&mut self, done: usize, now: Instant) {
-        // Rate over the last interval rather than the whole run: shows the current pace.
-        let frames = done.saturating_sub(self.last_done);
-        let ms_per_frame = (frames > 0)
-            .then(|| now.duration_since(self.last_print).as_secs_f64() * 1e3 / frames as f64);
-        let line = progress_line(done, self.total, ms_per_frame);
-        let Some(out) = &mut self.out else { return };
-        let _ = if self.in_place {
-            let pad = self.last_len.saturating_sub(line.len());
-            write!(out, "\r{line}{:pad$}", "")
-        } else {
-            writeln!(out, "{line}")
+    fn set_style(&self, unit: &str) {
+        let template = match self.bar.length() {
+            Some(_) => {
+                "{prefix} [{bar:30}] {human_pos}/{human_len} {unit} ({percent}%), {rate}, {eta} left"
+            }
+            None => "{spinner} {prefix} {human_pos} {unit}, {rate}, {elapsed}",
         };
-        let _ = out.flush();
-        self.last_len = line.len();
-        self.last_print = now;
-        self.last_done = done;
+        let (unit, rate_unit) = (unit.to_string(), unit.to_string());
+        // The template is a constant with known keys, so it always parses.
+        let style = ProgressStyle::with_template(template)
+            .expect("valid progress template")
+            .progress_chars("=> ")
+            .with_key(
+                "unit",
+                move |_: &ProgressState, w: &mut dyn std::fmt::Write| {
+                    let _ = w.write_str(&unit);
+                },
+            )
+            .with_key(
+                "rate",
+                move |s: &ProgressState, w: &mut dyn std::fmt::Write| {
+                    let _ = write!(w, "{}", rate(s.per_sec(), &rate_unit));
+                },
+            );
+        self.bar.set_style(style);
+    }
+
+    /// Adds `n` to the count done.
+    pub fn inc(&self, n: u64) {
+        self.bar.inc(n);
+    }
+
+    /// Sets the count done.
+    pub fn set(&self, done: u64) {
+        self.bar.set_position(done);
+    }
+
+    /// The count done so far.
+    pub fn done(&self) -> u64 {
+        self.bar.position()
+    }
+
+    /// Whether nothing is drawn (stderr is no terminal, or [`hidden`](Self::hidden)).
+    pub fn is_hidden(&self) -> bool {
+        self.bar.is_hidden()
+    }
+
+    /// Draws the final state and leaves it on screen.
+    pub fn finish(mut self) {
+        self.finished = true;
+        self.bar.finish();
     }
 }
 
-/// `frame 1200/5000 (24%), 8.3 ms/frame`; parts that are unknown are left out.
-pub fn progress_line(done: usize, total: Option<usize>, ms_per_frame: Option<f64>) -> String {
-    let mut line = format!("frame {done}");
-    if let Some(total) = total.filter(|&t| t > 0) {
-        let percent = done.min(total) * 100 / total;
-        line.push_str(&format!("/{total} ({percent}%)"));
+impl Drop for Progress {
+    fn drop(&mut self) {
+        if !self.finished {
+            self.bar.finish_and_clear();
+        }
     }
-    if let Some(ms) = ms_per_frame {
-        line.push_str(&format!(", {ms:.1} ms/frame"));
-    }
-    line
+}
+
+/// `113 frames/s`, `3.9 frames/s`, `0.50 frames/s`, `3.4 M samples/s`: two or three
+/// significant digits, with an SI suffix from 1000 on.
+fn rate(per_sec: f64, unit: &str) -> String {
+    let value = match per_sec {
+        r if !r.is_finite() || r <= 0.0 => "0".to_string(),
+        r if r < 1.0 => format!("{r:.2}"),
+        r if r < 100.0 => format!("{r:.1}"),
+        r if r < 1000.0 => format!("{r:.0}"),
+        r => human_count(r),
+    };
+    format!("{value} {unit}/s")
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use indicatif::TermLike;
+    use std::io;
+    use std::sync::{Arc, Mutex};
 
-    #[test]
-    fn line_format() {
-        assert_eq!(
-            progress_line(1200, Some(5000), Some(8.31)),
-            "frame 1200/5000 (24%), 8.3 ms/frame"
-        );
-        assert_eq!(progress_line(7, None, None), "frame 7");
-    }
+    /// A one-line terminal: writes append to the line, clearing empties it. What it holds at
+    /// the end is what a person would see.
+    #[derive(Debug, Default, Clone)]
+    struct Screen(Arc<Mutex<String>>);
 
-    #[test]
-    fn throttles_and_finishes() {
-        let mut buf = Vec::new();
-        {
-            let mut p = Progress::to_writer(Some(&mut buf), Some(100), false)
-                .with_interval(Duration::from_secs(3600));
-            for done in 1..=100 {
-                p.update(done);
-            }
-            p.finish(100);
+    impl Screen {
+        fn current(&self) -> String {
+            self.0.lock().unwrap().trim_end().to_string()
         }
-        let text = String::from_utf8(buf).unwrap();
-        // The hour-long interval suppresses every update; only `finish` prints.
-        assert_eq!(text.lines().count(), 1, "{text}");
-        assert!(text.starts_with("frame 100/100 (100%)"), "{text}");
+    }
+
+    impl TermLike for Screen {
+        fn width(&self) -> u16 {
+            120
+        }
+        fn move_cursor_up(&self, _: usize) -> io::Result<()> {
+            Ok(())
+        }
+        fn move_cursor_down(&self, _: usize) -> io::Result<()> {
+            Ok(())
+        }
+        fn move_cursor_right(&self, _: usize) -> io::Result<()> {
+            Ok(())
+        }
+        fn move_cursor_left(&self, _: usize) -> io::Result<()> {
+            Ok(())
+        }
+        fn write_line(&self, s: &str) -> io::Result<()> {
+            self.write_str(s)
+        }
+        fn write_str(&self, s: &str) -> io::Result<()> {
+            self.0.lock().unwrap().push_str(s);
+            Ok(())
+        }
+        fn clear_line(&self) -> io::Result<()> {
+            self.0.lock().unwrap().clear();
+            Ok(())
+        }
+        fn flush(&self) -> io::Result<()> {
+            Ok(())
+        }
+    }
+
+    fn on_screen(label: &str, total: Option<u64>) -> (Progress, Screen) {
+        let screen = Screen::default();
+        let target = ProgressDrawTarget::term_like(Box::new(screen.clone()));
+        (Progress::with_target(label, total, target), screen)
     }
 
     #[test]
-    fn disabled_prints_nothing() {
-        let mut p = Progress::<Vec<u8>>::to_writer(None, Some(10), false);
-        p.update(5);
-        p.finish(10);
-        assert!(p.out.is_none());
+    fn bar_shows_count_percent_and_rate() {
+        let (p, screen) = on_screen("bench drag", Some(130));
+        let p = p.unit("frames");
+        assert!(!p.is_hidden());
+        p.inc(52);
+        assert!(
+            screen.current().contains("] 52/130 frames (40%), "),
+            "{}",
+            screen.current()
+        );
+        p.finish();
+        let line = screen.current();
+        assert!(line.starts_with("bench drag ["), "{line}");
+        assert!(line.contains("] 130/130 frames (100%), "), "{line}");
+        assert!(line.contains(" frames/s, "), "{line}");
+    }
+
+    #[test]
+    fn spinner_without_total() {
+        let (p, screen) = on_screen("parsing", None);
+        let p = p.unit("objects");
+        p.inc(3);
+        p.inc(4);
+        assert_eq!(p.done(), 7);
+        p.finish();
+        let line = screen.current();
+        assert!(line.contains("parsing 7 objects, "), "{line}");
+        assert!(line.contains(" objects/s, "), "{line}");
+    }
+
+    #[test]
+    fn dropping_unfinished_clears_the_line() {
+        let (p, screen) = on_screen("bench", Some(10));
+        p.set(5);
+        drop(p);
+        assert_eq!(screen.current(), "");
+        // Negative control: a finished bar stays.
+        let (p, screen) = on_screen("bench", Some(10));
+        p.set(10);
+        p.finish();
+        assert!(screen.current().contains("10/10"), "{}", screen.current());
+    }
+
+    #[test]
+    fn hidden_draws_nothing_but_counts() {
+        let p = Progress::hidden("bench", Some(10));
+        assert!(p.is_hidden());
+        p.inc(4);
+        assert_eq!(p.done(), 4);
+        p.finish();
+    }
+
+    #[test]
+    fn rate_units() {
+        assert_eq!(rate(113.4, "frames"), "113 frames/s");
+        assert_eq!(rate(3.4e6, "samples"), "3.4 M samples/s");
+        assert_eq!(rate(0.5, "frames"), "0.50 frames/s");
+        assert_eq!(rate(3.94, "frames"), "3.9 frames/s");
+        assert_eq!(rate(f64::NAN, "frames"), "0 frames/s");
     }
 }

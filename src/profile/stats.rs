@@ -2,6 +2,12 @@
 
 use serde::{Deserialize, Serialize};
 
+/// The meaning of the percentile columns, for footnotes.
+pub const PERCENTILE_MEANING: &str =
+    "nearest-rank percentiles: at least p % of the frames took no longer";
+/// The meaning of "1% low", for footnotes.
+pub const LOW_1PCT_MEANING: &str = "mean of the slowest 1 % of the frames (lower is better)";
+
 /// Statistics of a set of times in ms. See the module documentation of
 /// [`crate::profile`] for the percentile method and the definition of `low_1pct`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

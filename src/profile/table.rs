@@ -1,53 +1,48 @@
 //! Plain-text tables for the terminal: [`Summary::table`] and [`compare`].
 
-use super::{Phase, Section, Stats, Summary};
+use super::{
+    GPU_MEANING, LOW_1PCT_MEANING, OTHER_MEANING, PERCENTILE_MEANING, Phase, Section, Stats,
+    Summary,
+};
+use comfy_table::CellAlignment;
 
-/// Rows of cells rendered with the first column left-aligned and the others right-aligned.
+/// Rows of cells rendered with the first column left-aligned and the others right-aligned,
+/// two spaces apart, a dashed rule under the header and no borders (comfy-table with every
+/// border component but the header rule removed).
 struct TextTable {
-    rows: Vec<Vec<String>>,
+    table: comfy_table::Table,
 }
+
+/// comfy-table's 19 border components, in its order; a space means "not drawn". Only
+/// `HeaderLines` (the sixth) is set: the rule under the header.
+const HEADER_RULE_ONLY: &str = "     -             ";
 
 impl TextTable {
     fn new(header: &[&str]) -> Self {
-        TextTable {
-            rows: vec![header.iter().map(|s| s.to_string()).collect()],
+        let mut table = comfy_table::Table::new();
+        table
+            .load_preset(HEADER_RULE_ONLY)
+            .set_header(header.to_vec());
+        for column in table.column_iter_mut() {
+            // The gap before a column is its left padding: none before the first.
+            let (padding, alignment) = match column.index {
+                0 => ((0, 0), CellAlignment::Left),
+                _ => ((2, 0), CellAlignment::Right),
+            };
+            column.set_padding(padding);
+            column.set_cell_alignment(alignment);
         }
+        TextTable { table }
     }
 
     fn row(&mut self, cells: Vec<String>) {
-        self.rows.push(cells);
+        self.table.add_row(cells);
     }
 
+    /// The table, each line without trailing spaces and ending in a newline.
     fn render(&self) -> String {
-        let columns = self.rows.iter().map(Vec::len).max().unwrap_or(0);
-        let width = |c: usize| {
-            self.rows
-                .iter()
-                .filter_map(|r| r.get(c))
-                .map(|s| s.chars().count())
-                .max()
-                .unwrap_or(0)
-        };
-        let widths: Vec<usize> = (0..columns).map(width).collect();
-        let mut out = String::new();
-        for (i, row) in self.rows.iter().enumerate() {
-            let mut line = String::new();
-            for (c, cell) in row.iter().enumerate() {
-                let w = widths[c];
-                if c == 0 {
-                    line.push_str(&format!("{cell:<w$}"));
-                } else {
-                    line.push_str(&format!("  {cell:>w$}"));
-                }
-            }
-            out.push_str(line.trim_end());
-            out.push('\n');
-            if i == 0 {
-                let total = widths.iter().sum::<usize>() + 2 * columns.saturating_sub(1);
-                out.push_str(&"-".repeat(total));
-                out.push('\n');
-            }
-        }
+        let mut out = self.table.trim_fmt();
+        out.push('\n');
         out
     }
 }
@@ -145,6 +140,29 @@ impl Summary {
         }
         out
     }
+}
+
+impl Summary {
+    /// The content of `summary.txt`: [`table`](Self::table), a blank line, then
+    /// [`definitions`].
+    pub fn report(&self) -> String {
+        format!("{}\n{}", self.table(), definitions())
+    }
+}
+
+/// What the rows and columns of [`Summary::table`] mean, one name per line:
+/// `delta    edits applied to the samples`.
+pub fn definitions() -> String {
+    let mut rows: Vec<(&str, &str)> = Phase::ALL.map(|p| (p.name(), p.meaning())).to_vec();
+    rows.extend([
+        ("(other)", OTHER_MEANING),
+        ("gpu", GPU_MEANING),
+        ("p50..p99", PERCENTILE_MEANING),
+        ("1% low", LOW_1PCT_MEANING),
+    ]);
+    rows.iter()
+        .map(|(name, meaning)| format!("{name:<10}{meaning}\n"))
+        .collect()
 }
 
 fn warmup_line(w: &Section) -> String {

@@ -78,6 +78,26 @@ pub(super) fn assert_well_formed(xml: &str) {
     assert!(stack.is_empty(), "unclosed tags: {stack:?}");
 }
 
+/// The content of every `<text>` element, unescaped and trimmed (plotters writes it on a line
+/// of its own).
+pub(super) fn svg_texts(svg: &str) -> Vec<String> {
+    let mut texts = vec![];
+    let mut rest = svg;
+    while let Some(open) = rest.find("<text") {
+        let start = rest[open..].find('>').expect("text tag ends") + open + 1;
+        let end = rest[start..].find("</text>").expect("text closes") + start;
+        let unescaped = rest[start..end]
+            .replace("&lt;", "<")
+            .replace("&gt;", ">")
+            .replace("&quot;", "\"")
+            .replace("&apos;", "'")
+            .replace("&amp;", "&");
+        texts.push(unescaped.trim().to_string());
+        rest = &rest[end..];
+    }
+    texts
+}
+
 fn assert_entities(text: &str) {
     for (i, _) in text.match_indices('&') {
         let entity_ok = ["&amp;", "&lt;", "&gt;", "&quot;", "&apos;"]
@@ -194,8 +214,8 @@ fn summary_of_warmup_only_and_empty_runs() {
     let s = Summary::from_frames(&[]);
     assert!(s.measured.is_none() && s.warmup.is_none());
     // Writers cope with nothing to show.
-    assert_well_formed(&frame_times_svg(&RunInfo::default(), &[]));
-    assert_well_formed(&histogram_svg(&RunInfo::default(), &frames));
+    assert_well_formed(&frame_times_svg(&RunInfo::default(), &[]).unwrap());
+    assert_well_formed(&histogram_svg(&RunInfo::default(), &frames).unwrap());
 }
 
 #[test]
@@ -300,7 +320,18 @@ fn write_all_writes_every_file() {
     assert_eq!(back.summary, Summary::from_frames(&frames));
     assert_eq!(back.run, run);
 
-    assert_eq!(read(SUMMARY_TXT), Summary::from_frames(&frames).table());
+    // summary.txt: the terminal table, then what its names mean.
+    let summary = Summary::from_frames(&frames);
+    let text = read(SUMMARY_TXT);
+    assert_eq!(text, summary.report());
+    assert_eq!(text, format!("{}\n{}", summary.table(), definitions()));
+    for phase in Phase::ALL {
+        let line = format!("{:<10}{}", phase.name(), phase.meaning());
+        assert!(text.lines().any(|l| l == line), "{text}");
+    }
+    for name in ["(other)", "gpu", "p50..p99", "1% low"] {
+        assert!(text.lines().any(|l| l.starts_with(name)), "{name}: {text}");
+    }
 
     // trace.json: X events with ts/dur/name on named threads.
     let trace: Value = serde_json::from_str(&read(TRACE_JSON)).unwrap();
@@ -348,13 +379,38 @@ fn write_all_writes_every_file() {
         assert!(svg.len() < 200_000, "{name} is {} bytes", svg.len());
     }
     let plot = read(FRAME_TIMES_SVG);
-    for label in ["median", "warm-up", "delta", "gpu", ">frame<", ">ms<"] {
+    for label in ["median", "warm-up", "delta", "gpu"] {
         assert!(plot.contains(label), "frame_times.svg lacks {label}");
     }
-    let hist = read(HISTOGRAM_SVG);
-    for label in [">p50 ", ">p99 ", "frame time (ms)"] {
-        assert!(hist.contains(label), "histogram.svg lacks {label}");
+    // Axis names are whole text elements.
+    let texts = svg_texts(&plot);
+    for label in ["frame", "ms"] {
+        assert!(
+            texts.iter().any(|t| t == label),
+            "no text {label:?} in {texts:?}"
+        );
     }
+    // The footnote names every phase with its meaning.
+    let footnote = texts.join(" ");
+    for phase in Phase::ALL {
+        let entry = format!("{phase} = {}", phase.meaning());
+        assert!(
+            footnote.contains(&entry),
+            "footnote lacks {entry:?}: {footnote}"
+        );
+    }
+    assert!(footnote.contains(OTHER_MEANING), "{footnote}");
+    let hist = read(HISTOGRAM_SVG);
+    let texts = svg_texts(&hist);
+    for label in ["p50 ", "p99 ", "frame time (ms)"] {
+        assert!(
+            texts.iter().any(|t| t.starts_with(label)),
+            "histogram.svg lacks {label}: {texts:?}"
+        );
+    }
+    let footnote = texts.join(" ");
+    assert!(footnote.contains(LOW_1PCT_MEANING), "{footnote}");
+    assert!(footnote.contains(PERCENTILE_MEANING), "{footnote}");
     std::fs::remove_dir_all(dir.parent().unwrap()).unwrap();
 }
 
@@ -368,7 +424,7 @@ fn long_runs_are_downsampled() {
             ..base[5 + i % 30].clone()
         })
         .collect();
-    let svg = frame_times_svg(&RunInfo::default(), &frames);
+    let svg = frame_times_svg(&RunInfo::default(), &frames).unwrap();
     assert_well_formed(&svg);
     assert!(svg.len() < 400_000, "{} bytes", svg.len());
     assert!(svg.contains("frame (max)"));

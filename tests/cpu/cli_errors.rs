@@ -670,3 +670,28 @@ fn control_characters_in_user_text_are_escaped() {
         );
     }
 }
+
+/// `bench` on a malformed scene fails in one line before any GPU work, and writes nothing.
+#[test]
+fn bench_on_a_malformed_scene_prints_one_line() {
+    let dir = Scratch::new("cli-errors");
+    let scene = dir.file("scene.json", "{\"objects\": [");
+    let out = Command::new(env!("CARGO_BIN_EXE_prespline"))
+        .arg("bench")
+        .arg(&scene)
+        .args(["--scenario", "drag", "--frames", "3", "--out"])
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(stderr.lines().count(), 1, "expected one line:\n{stderr}");
+    assert!(
+        stderr.starts_with("error: ") && stderr.contains("invalid JSON"),
+        "{stderr}"
+    );
+    assert!(
+        !dir.join("out").exists(),
+        "nothing written for a failed run"
+    );
+}

@@ -9,7 +9,7 @@ use std::path::Path;
 
 fn record_run(frames: usize, warmup: usize, work: u64) -> Vec<prespline::profile::FrameRecord> {
     let mut rec = Recorder::with_capacity(warmup, frames);
-    let mut progress = Progress::stderr(Some(frames), false);
+    let progress = Progress::hidden("record", Some(frames as u64)).unit("frames");
     for i in 0..frames {
         rec.begin_frame();
         rec.phase_start(Phase::Input);
@@ -26,9 +26,10 @@ fn record_run(frames: usize, warmup: usize, work: u64) -> Vec<prespline::profile
         if i >= 2 {
             assert!(rec.set_gpu_ms(i - 2, 0.1));
         }
-        progress.update(i + 1);
+        progress.inc(1);
     }
-    progress.finish(frames);
+    assert_eq!(progress.done(), frames as u64);
+    progress.finish();
     rec.into_frames()
 }
 

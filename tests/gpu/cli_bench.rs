@@ -68,6 +68,13 @@ fn check_reports(dir: &Path, frames: usize, warmup: usize) {
             .iter()
             .any(|e| e["ph"] == "X" && e["dur"].is_number())
     );
+    let summary_txt = std::fs::read_to_string(dir.join("summary.txt")).unwrap();
+    for line in ["1% low    ", "present   ", "delta     "] {
+        assert!(
+            summary_txt.lines().any(|l| l.starts_with(line)),
+            "summary.txt does not define {line:?}:\n{summary_txt}"
+        );
+    }
     for svg in ["frame_times.svg", "histogram.svg"] {
         let text = std::fs::read_to_string(dir.join(svg)).unwrap();
         assert!(
@@ -108,6 +115,14 @@ fn bench_writes_every_report_for_both_modes() {
         "terminal table missing:\n{err}"
     );
     assert!(err.contains("edit cost"), "comparison missing:\n{err}");
+    // The comparison is also kept, exactly as printed.
+    let saved = std::fs::read_to_string(out.join("comparison.txt")).unwrap();
+    assert!(saved.starts_with("A = incremental, B = naive\n"), "{saved}");
+    assert!(saved.contains("edit cost"), "{saved}");
+    assert!(
+        err.contains(&saved),
+        "comparison.txt differs from the printed table:\n{saved}"
+    );
     assert!(
         err.lines().last().unwrap().contains(out.to_str().unwrap()),
         "the last line says where the results are:\n{err}"
@@ -150,4 +165,45 @@ fn every_scenario_runs_headless() {
         .unwrap();
     assert!(!r.status.success());
     assert!(String::from_utf8_lossy(&r.stderr).contains("unknown scenario 'spin'"));
+}
+
+/// A bench that cannot run says so in one line, `error: …`, with nothing before it: here the
+/// scene has no ERBS object for `erbs-rotate`, which shows only once the renderer and the
+/// session are up (the run's banner used to come first).
+#[test]
+fn failing_bench_prints_one_line() {
+    let scratch = common::Scratch::new("cli-bench");
+    let out = scratch.join("out");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/bezier_surface.json");
+    let r = prespline()
+        .arg("bench")
+        .arg(&scene)
+        .args(["--scenario", "erbs-rotate", "--frames", "3", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(!r.status.success());
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(err.lines().count(), 1, "expected one line:\n{err}");
+    assert!(
+        err.starts_with("error: ") && err.contains("needs an ERBS curve or surface"),
+        "{err}"
+    );
+    assert!(
+        !out.join("summary.json").exists(),
+        "no reports for a failed run"
+    );
+    // Negative control: the same scene with a scenario it supports runs, banner and all.
+    let r = prespline()
+        .arg("bench")
+        .arg(&scene)
+        .args(["--scenario", "drag", "--frames", "3", "--warmup", "4"])
+        .args(["--size", "160x100", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(r.status.success(), "{err}");
+    assert!(err.lines().count() > 1, "{err}");
+    assert!(err.starts_with("bench: drag on "), "{err}");
 }
