@@ -1,4 +1,4 @@
-//! Pre-evaluation benchmarks on the reference workload (README "Performance"):
+//! Pre-evaluation benchmarks on the reference workload (docs/performance.md):
 //! a bicubic clamped uniform surface with 100×100 control points sampled 512×512 with S, Su, Sv
 //! and normals; a cubic curve with 1000 control points sampled 100 000 times with C, C'; edits of
 //! one interior point, one boundary point, ten random points, and an ERBS local-patch rotation;

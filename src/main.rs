@@ -28,7 +28,7 @@ struct Cli {
 enum Command {
     /// Sample every object of a scene and print positions and derivatives as JSON on stdout.
     Sample {
-        /// Scene file (JSON, see README "Scene files"; or Wavefront OBJ, see docs/obj.md).
+        /// Scene file (JSON, see docs/scene-format.md; or Wavefront OBJ, see docs/obj.md).
         scene: PathBuf,
         /// Highest derivative order N: curves get c..c^(N), surfaces every ∂^{a+b}S with a, b ≤ N.
         #[arg(long, short = 'd', default_value_t = 1, value_name = "N")]
@@ -43,9 +43,13 @@ enum Command {
         memory: MemoryArgs,
     },
     /// Open the interactive viewer on a scene (the built-in demo scene without SCENE).
+    ///
+    /// docs/viewer.md describes the mouse, the keys, the editing modes and the --script
+    /// format; H or F1 in the viewer lists the keys.
     View {
         /// Scene file (JSON, or Wavefront OBJ by its .obj extension); without it, the demo:
-        /// B-spline surface, ERBS surface and curve, NURBS circle, Utah teapot.
+        /// B-spline surface, ERBS surface and curve, NURBS circle, closed ERBS torus, Utah
+        /// teapot.
         scene: Option<PathBuf>,
         /// Window size.
         #[arg(long, default_value = "1280x720", value_parser = cli::render::parse_size, value_name = "WxH")]
@@ -53,7 +57,7 @@ enum Command {
         /// Present without vsync (MAILBOX or IMMEDIATE) to measure frame times.
         #[arg(long)]
         no_vsync: bool,
-        /// Replay timed input events from a JSON script (see README "Scripts").
+        /// Replay timed input events from a JSON script (format: docs/viewer.md, "Scripts").
         #[arg(long, value_name = "SCRIPT.json")]
         script: Option<PathBuf>,
         /// Where Ctrl+S writes (default: the scene file, or prespline-demo.json for the demo);
@@ -108,7 +112,7 @@ enum Command {
         #[arg(long, default_value = "bench-out", value_name = "DIR")]
         out: PathBuf,
         /// MSAA samples (1, 2, 4, 8); 0 picks the device's default: 1 on CPU rasterisers such
-        /// as lavapipe, 4 on GPUs (see README "Interactive frames").
+        /// as lavapipe, 4 on GPUs (see docs/performance.md, "Frames").
         #[arg(long, default_value_t = 0)]
         msaa: u32,
         #[command(flatten)]

@@ -423,7 +423,7 @@ fn closed_torus_refines_across_its_seam_and_inside_a_detail_there() {
     v.finish();
 }
 
-/// The README's detail example: the refinements move nothing outside the refined strips
+/// The detail example of docs/viewer.md: the refinements move nothing outside the refined strips
 /// u ∈ (2, 3) and v ∈ (2, 3), X keeps the surface, and the level-2 local patch raised by 0.5 raises the surface by
 /// exactly 0.5 at its centre and nothing outside its support [2.5, 3]².
 #[test]

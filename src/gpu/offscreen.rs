@@ -156,7 +156,7 @@ impl Pixels {
 
 impl Renderer {
     /// The MSAA sample count used when a target asks for 0, chosen per device type by
-    /// measurement (README, "Interactive frames"): 1 on CPU rasterisers (lavapipe), where 4×
+    /// measurement (docs/performance.md, "Frames"): 1 on CPU rasterisers (lavapipe), where 4×
     /// multisampling multiplies the cost of every triangle's rasterisation and of the resolve,
     /// and 4 on GPUs, where it is cheap. Falls back to 1 where 4 is not supported.
     pub fn default_samples(&self) -> u32 {

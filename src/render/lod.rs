@@ -43,9 +43,9 @@ pub struct LodTolerance {
 
 impl LodTolerance {
     /// The default for an image with `samples` MSAA samples per pixel, chosen by measurement
-    /// (README, "Display level of detail"): one pixel without multisampling, where a pixel
-    /// is either covered or not, and a quarter pixel with 4× MSAA, whose coverage steps are
-    /// that fine; cells up to 32 pixels. At the default views the image stays within the
+    /// (docs/performance.md, "Display level of detail"): one pixel without multisampling, where
+    /// a pixel is either covered or not, and a quarter pixel with 4× MSAA, whose coverage steps
+    /// are that fine; cells up to 32 pixels. At the default views the image stays within the
     /// golden-image tolerance of the full draw.
     #[must_use]
     pub fn for_samples(samples: u32) -> Self {

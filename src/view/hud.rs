@@ -11,7 +11,8 @@ const TEXT: [u8; 4] = [230, 232, 238, 255];
 const DIM: [u8; 4] = [150, 155, 165, 255];
 const PANEL: [u8; 4] = [10, 12, 16, 190];
 
-/// Every key binding, as shown by the help overlay (H or F1) and the README.
+/// Every key binding, as shown by the help overlay (H or F1); docs/viewer.md and the README's key
+/// table describe the same keys.
 pub const KEY_HELP: &[(&str, &str)] = &[
     (
         "left drag on a point",

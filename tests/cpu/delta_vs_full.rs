@@ -29,7 +29,7 @@ fn case(kind: Kind, seed: u64, count: usize, max_samples: usize) -> (Scene, Vec<
     (scene, edits)
 }
 
-/// What README.md claims, relative to each derivative order's own magnitude in the object
+/// What docs/testing.md claims, relative to each derivative order's own magnitude in the object
 /// (no floor): after a few hundred random edits the delta path equals full re-sampling to
 /// 1e-13 (measured worst 5.4e-14); after 100 000 edits without the periodic exact rebuild the
 /// drift stays below 5e-13 (measured worst 2.0e-13, an ERBS curve), and the rebuild every 4096

@@ -20,9 +20,9 @@ use serde_json::{Value, json};
 use std::process::Command;
 
 /// Geometry agrees with the independent evaluator to this, relative to each derivative order's
-/// own magnitude over the compared samples (the README's 1e-12 claim).
+/// own magnitude over the compared samples (the 1e-12 claim of docs/testing.md).
 const TOL: f64 = 1e-12;
-/// The delta path equals full re-sampling to this (README, tests/delta_vs_full.rs).
+/// The delta path equals full re-sampling to this (docs/testing.md, tests/cpu/delta_vs_full.rs).
 const DELTA_TOL: f64 = 1e-13;
 
 // --- running the product ----------------------------------------------------------------------

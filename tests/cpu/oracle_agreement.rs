@@ -8,8 +8,8 @@
 //!   derivative order: r for curves, (a, b) for surfaces (no floor: a small object is held to
 //!   its own size; see `oracle::compare`),
 //!
-//! with tol = 1e-13, what README.md claims, without edits, with `--full` and for the
-//! incremental edit path alike (measured worst 3.4e-14 over 500 seeds per test). The
+//! with tol = 1e-13, what README.md and docs/testing.md claim, without edits, with `--full`
+//! and for the incremental edit path alike (measured worst 3.4e-14 over 500 seeds per test). The
 //! parameters themselves must match the contract formula to within 4 ulp of the domain size.
 //! What the renderer samples (S, Su, Sv and unit normals, C and C', through the shading fast
 //! path where it applies) is compared in-process the same way.
@@ -38,8 +38,8 @@ use oracle::rng::Rng;
 use oracle::scene::{Edit, Scene, apply_edits};
 use serde_json::Value;
 
-/// README.md: `prespline sample` agrees with the independent evaluator to 1e-13 of each
-/// derivative order's magnitude, through the delta path too.
+/// README.md and docs/testing.md: `prespline sample` agrees with the independent evaluator to
+/// 1e-13 of each derivative order's magnitude, through the delta path too.
 const TOL: f64 = 1e-13;
 
 fn product_binary() -> PathBuf {

@@ -222,7 +222,7 @@ fn comparison_catches_nan_and_perturbation() {
     assert!(worst_relative(a.grid(), &b, k).is_nan());
 }
 
-/// The claim of the README and the issue: sampling after a refinement equals sampling before
+/// The claim of docs/testing.md and the issue: sampling after a refinement equals sampling before
 /// it to about 1e-13, positions and derivatives.
 const SHAPE_TOLERANCE: f64 = 1e-13;
 
