@@ -11,6 +11,7 @@ pub mod bfunction;
 pub mod bspline;
 pub mod catmull_rom;
 pub mod continuity;
+mod control;
 pub mod differential;
 pub mod erbs;
 pub mod error;
