@@ -2,6 +2,7 @@
 
 use super::basis::hermite_into;
 use super::bspline::BSplineCurve;
+use super::control::{check_points, check_weights, combine_rows};
 use super::error::{GeomError, GeomResult};
 use super::knots::KnotVector;
 use super::point::{Point, homogeneous, rational_curve_derivs};
@@ -237,56 +238,6 @@ fn split_de_casteljau<P: Point>(points: &[P], s: f64) -> (Vec<P>, Vec<P>) {
         right[n - 1 - k] = c[n - 1 - k];
     }
     (left, right)
-}
-
-/// Σ_k M[r][k] P_k for r = 0..=n (rows above the degree are zero).
-pub(crate) fn combine_rows<P: Point>(m: &[f64], degree: usize, points: &[P], n: usize) -> Vec<P> {
-    let w = degree + 1;
-    (0..=n)
-        .map(|r| {
-            if r > degree {
-                return P::default();
-            }
-            let mut acc = P::default();
-            for k in 0..w {
-                acc += points[k] * m[r * w + k];
-            }
-            acc
-        })
-        .collect()
-}
-
-pub(crate) fn check_points(points: &[DVec3]) -> GeomResult<()> {
-    if points.is_empty() {
-        return Err(GeomError::new("points", "no control points"));
-    }
-    for (i, p) in points.iter().enumerate() {
-        if !p.is_finite() {
-            return Err(GeomError::new(
-                "points",
-                format!("point {i} {p:?} is not finite"),
-            ));
-        }
-    }
-    Ok(())
-}
-
-pub(crate) fn check_weights(weights: &[f64], n: usize) -> GeomResult<()> {
-    if weights.len() != n {
-        return Err(GeomError::new(
-            "weights",
-            format!("{} weights for {n} control points", weights.len()),
-        ));
-    }
-    for (i, &w) in weights.iter().enumerate() {
-        if !(w.is_finite() && w > 0.0) {
-            return Err(GeomError::new(
-                "weights",
-                format!("weight {i} is {w}; weights must be positive and finite"),
-            ));
-        }
-    }
-    Ok(())
 }
 
 #[cfg(test)]

@@ -1,7 +1,7 @@
 //! B-spline curves and NURBS.
 
 use super::basis::hermite_into;
-use super::bezier::{check_points, check_weights, combine_rows};
+use super::control::{check_points, check_weights, combine_rows};
 use super::error::{GeomError, GeomResult};
 use super::knots::KnotVector;
 use super::point::{Point, homogeneous, rational_curve_derivs};

@@ -12,6 +12,7 @@ pub mod bounds;
 pub mod bspline;
 pub mod catmull_rom;
 pub mod continuity;
+mod control;
 pub mod differential;
 pub mod erbs;
 pub mod error;

@@ -2,8 +2,8 @@
 //! with a fallback where Su × Sv vanishes, Gaussian and mean curvature.
 
 use super::basis::hermite_into;
-use super::bezier::{check_points, check_weights};
 use super::bspline::de_boor;
+use super::control::{check_points, check_weights};
 use super::error::{GeomError, GeomResult};
 use super::knots::KnotVector;
 use super::point::{Point, binomial, homogeneous, to_homogeneous};

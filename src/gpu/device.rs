@@ -47,6 +47,38 @@ impl DeviceCaps {
                 .sample_counts
                 .contains(vk::SampleCountFlags::from_raw(samples))
     }
+
+    /// The MSAA sample count used when a target asks for 0, chosen per device type by
+    /// measurement (docs/performance.md, "Frames"): 1 on CPU rasterisers (lavapipe), where 4×
+    /// multisampling multiplies the cost of every triangle's rasterisation and of the resolve,
+    /// and 4 on GPUs, where it is cheap. Falls back to 1 where 4 is not supported.
+    pub fn default_samples(&self) -> u32 {
+        let preferred = match self.device_type {
+            vk::PhysicalDeviceType::CPU => 1,
+            _ => 4,
+        };
+        if self.supports_samples(preferred) {
+            preferred
+        } else {
+            1
+        }
+    }
+
+    /// The sample count of a target asking for `requested` (0: [`Self::default_samples`]).
+    pub(crate) fn resolve_samples(&self, requested: u32) -> GpuResult<vk::SampleCountFlags> {
+        let n = if requested == 0 {
+            self.default_samples()
+        } else {
+            requested
+        };
+        if !n.is_power_of_two() || !self.supports_samples(n) {
+            return Err(GpuError::InvalidArgument(format!(
+                "{n}x MSAA is not supported by {}",
+                self.name
+            )));
+        }
+        Ok(vk::SampleCountFlags::from_raw(n))
+    }
 }
 
 /// The logical device, its single graphics queue and the allocator.

@@ -8,7 +8,7 @@
 //! glyph table (uploaded once by the renderer), so a line of text costs two triangles per
 //! character rather than one quad per lit run of font pixels.
 
-use super::draw::OverlayVertex;
+use super::vertex::OverlayVertex;
 
 /// Glyph width in font pixels.
 pub const GLYPH_WIDTH: u32 = 5;

@@ -1,166 +1,35 @@
-//! Per-frame contexts (one per frame in flight) and the [`Frame`] being recorded: slot,
-//! mirror writes, camera, clear and viewport state. Draw calls live in `draw.rs`, the
-//! begin/submit protocol in `submit.rs`.
+//! The [`Frame`] being recorded: its slot, mirror writes, camera, clear and viewport state,
+//! and the end of the frame protocol (end, flush, submit with synchronization2, present).
+//! The draw calls are in `draw.rs`; the renderer begins frames.
 
 use ash::vk;
 
+use super::barrier;
 use super::device::Device;
-use super::draw::{Camera, DrawStats};
-use super::error::{GpuError, GpuResult, VkResultExt};
-use super::memory::Buffer;
+use super::error::{GpuError, GpuResult};
+use super::grid::GridCache;
 use super::mirror::{Mirror, MirrorWriter};
 use super::offscreen::OffscreenTarget;
 use super::pipeline::PipelineSet;
-use super::renderer::Renderer;
+use super::slot::{FrameRing, FrameSlot};
+use super::style::Camera;
 use super::swapchain::Swapchain;
-use super::timestamp::GpuTimer;
-use super::transient::TransientBuffer;
+use super::target::TargetView;
+use super::upload::Uploader;
 
-/// Everything one frame slot owns. The slot is reused every `FRAMES_IN_FLIGHT` frames, after
-/// its fence says the GPU finished the previous use.
-pub(crate) struct FrameSlot {
-    pool: vk::CommandPool,
-    pub cmd: vk::CommandBuffer,
-    pub fence: vk::Fence,
-    /// Signalled by `vkAcquireNextImageKHR`, waited by this slot's submission.
-    pub acquire: vk::Semaphore,
-    pub timer: Option<GpuTimer>,
-    /// Buffers to destroy once this slot's fence next signals.
-    pub release: Vec<Buffer>,
-    pub transient: TransientBuffer,
-    /// GPU time of the previous use of this slot.
-    pub gpu_ms: Option<f64>,
-    /// Whether a submission signalling `fence` is pending. Only such a fence is waited for:
-    /// the fence is reset just before submitting, so after a failed submission it would
-    /// never signal, and waiting for it would hang the slot forever.
-    pub in_flight: bool,
-}
+/// Clear colour of a frame until [`Frame::set_clear_color`] (linear RGBA).
+const DEFAULT_CLEAR: [f32; 4] = [0.02, 0.02, 0.025, 1.0];
 
-impl FrameSlot {
-    pub(crate) fn new(device: &Device, always_flush: bool) -> GpuResult<Self> {
-        let raw = &device.raw;
-        let mut slot = Self {
-            pool: vk::CommandPool::null(),
-            cmd: vk::CommandBuffer::null(),
-            fence: vk::Fence::null(),
-            acquire: vk::Semaphore::null(),
-            timer: None,
-            release: Vec::new(),
-            transient: TransientBuffer::new(always_flush),
-            gpu_ms: None,
-            in_flight: false,
-        };
-        let result = (|| {
-            let info = vk::CommandPoolCreateInfo::default()
-                .flags(vk::CommandPoolCreateFlags::TRANSIENT)
-                .queue_family_index(device.queue_family);
-            // SAFETY: valid device and create infos for each object below.
-            unsafe {
-                slot.pool = raw
-                    .create_command_pool(&info, None)
-                    .vk("vkCreateCommandPool")?;
-                let alloc = vk::CommandBufferAllocateInfo::default()
-                    .command_pool(slot.pool)
-                    .level(vk::CommandBufferLevel::PRIMARY)
-                    .command_buffer_count(1);
-                slot.cmd = raw
-                    .allocate_command_buffers(&alloc)
-                    .vk("vkAllocateCommandBuffers")?[0];
-                // Signalled, so the first wait on a fresh slot returns at once.
-                let fence = vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED);
-                slot.fence = raw.create_fence(&fence, None).vk("vkCreateFence")?;
-                slot.acquire = raw
-                    .create_semaphore(&vk::SemaphoreCreateInfo::default(), None)
-                    .vk("vkCreateSemaphore")?;
-            }
-            slot.timer = GpuTimer::new(device)?;
-            Ok(())
-        })();
-        match result {
-            Ok(()) => Ok(slot),
-            Err(e) => {
-                // SAFETY: created just above and never used by the GPU.
-                unsafe { slot.destroy(device) };
-                Err(e)
-            }
-        }
-    }
-
-    /// Waits for the slot's previous submission (if it was submitted), then recycles what it
-    /// used. A failed wait leaves everything in place, so a later call may try again.
-    pub(crate) fn wait_and_recycle(&mut self, device: &Device) -> GpuResult<()> {
-        if self.in_flight {
-            device.wait_fence(self.fence)?;
-            self.in_flight = false;
-            if let Some(t) = self.timer.as_mut() {
-                self.gpu_ms = t.read(device).or(self.gpu_ms);
-            }
-        }
-        for b in self.release.drain(..) {
-            // SAFETY: released buffers were last used by this slot's previous submission,
-            // whose fence was just waited for (or which never happened).
-            unsafe { device.destroy_buffer(b) };
-        }
-        self.transient.reset();
-        Ok(())
-    }
-
-    /// Resets the command pool and begins the command buffer.
-    pub(crate) fn begin_commands(&mut self, device: &Device) -> GpuResult<()> {
-        // SAFETY: the fence has signalled, so the command buffer is not pending.
-        unsafe {
-            device
-                .raw
-                .reset_command_pool(self.pool, vk::CommandPoolResetFlags::empty())
-                .vk("vkResetCommandPool")?;
-            let begin = vk::CommandBufferBeginInfo::default()
-                .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
-            device
-                .raw
-                .begin_command_buffer(self.cmd, &begin)
-                .vk("vkBeginCommandBuffer")?;
-        }
-        if let Some(t) = self.timer.as_mut() {
-            t.begin(device, self.cmd);
-        }
-        Ok(())
-    }
-
-    /// Destroys everything.
-    ///
-    /// # Safety
-    /// No submitted GPU work that uses these objects may still be pending (the device is idle
-    /// or lost, or they were never used).
-    pub(crate) unsafe fn destroy(mut self, device: &Device) {
-        // SAFETY: the caller guarantees nothing pending uses them (this function's contract).
-        unsafe {
-            for b in self.release.drain(..) {
-                device.destroy_buffer(b);
-            }
-            if let Some(t) = self.timer.take() {
-                t.destroy(device);
-            }
-            self.transient.destroy(device);
-        }
-        // SAFETY: idle device; null handles (from a failed `new`) are ignored by Vulkan.
-        unsafe {
-            device.raw.destroy_semaphore(self.acquire, None);
-            device.raw.destroy_fence(self.fence, None);
-            device.raw.destroy_command_pool(self.pool, None);
-        }
-    }
-}
-
-/// Attachments of the target of one frame, resolved at begin.
-#[derive(Clone, Copy)]
-pub(crate) struct TargetView {
-    pub image: vk::Image,
-    pub view: vk::ImageView,
-    pub msaa: Option<(vk::Image, vk::ImageView)>,
-    pub depth: (vk::Image, vk::ImageView),
-    pub extent: vk::Extent2D,
-    pub format: vk::Format,
-    pub samples: vk::SampleCountFlags,
+/// What a frame recorded so far: draws and state changes (state already bound is not bound
+/// again).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct DrawStats {
+    /// Draw calls recorded.
+    pub draws: u32,
+    /// Pipeline binds recorded.
+    pub pipeline_binds: u32,
+    /// Triangles submitted by surface draws (after level of detail).
+    pub surface_triangles: u64,
 }
 
 /// State bound in the frame's command buffer, so draws skip binding it again.
@@ -173,6 +42,7 @@ pub(crate) struct Bound {
     pub depth_test: Option<bool>,
 }
 
+/// The target a frame renders into.
 pub(crate) enum FrameTarget<'a> {
     Offscreen(&'a mut OffscreenTarget),
     Swapchain {
@@ -181,21 +51,35 @@ pub(crate) enum FrameTarget<'a> {
     },
 }
 
-/// One frame being recorded. Obtained from [`Renderer::begin_offscreen`] or
-/// [`Renderer::begin_swapchain`]; submit with [`Frame::finish`] (dropping an unfinished frame
+/// What a frame borrows from its renderer while it records: the device, the frame slots,
+/// the index-buffer cache and its uploader, and the fixed drawing state.
+pub(crate) struct FrameContext<'a> {
+    pub device: &'a Device,
+    pub ring: &'a mut FrameRing,
+    pub grids: &'a mut GridCache,
+    pub uploader: &'a mut Uploader,
+    pub layout: vk::PipelineLayout,
+    pub pipelines: PipelineSet,
+    /// Device address of the overlay font's glyph table (0: none).
+    pub font: vk::DeviceAddress,
+    /// Flush host writes even to coherent memory (see `RendererDesc::always_flush`).
+    pub always_flush: bool,
+}
+
+/// One frame being recorded. Obtained from [`super::Renderer::begin_offscreen`] or
+/// [`super::Renderer::begin_swapchain`]; submit with [`Frame::finish`] (dropping an unfinished frame
 /// submits it too, ignoring errors).
 ///
 /// Mirror writes for this frame go through [`Frame::write_mirror`], which targets this
 /// frame's slot. Rendering (clear included) starts lazily at the first draw, so
 /// [`Frame::set_clear_color`] before any draw is free.
 pub struct Frame<'a> {
-    pub(crate) renderer: &'a mut Renderer,
+    pub(crate) ctx: FrameContext<'a>,
     pub(crate) target: FrameTarget<'a>,
     pub(crate) view: TargetView,
     pub(crate) slot: usize,
     pub(crate) number: u64,
     pub(crate) cmd: vk::CommandBuffer,
-    pub(crate) pipelines: PipelineSet,
     pub(crate) rendering: bool,
     pub(crate) clear: [f32; 4],
     pub(crate) camera: Camera,
@@ -209,6 +93,37 @@ pub struct Frame<'a> {
 }
 
 impl<'a> Frame<'a> {
+    /// A frame on `slot`, whose command buffer was begun and its barriers recorded.
+    pub(crate) fn new(
+        ctx: FrameContext<'a>,
+        target: FrameTarget<'a>,
+        view: TargetView,
+        slot: usize,
+    ) -> Self {
+        let cmd = ctx.ring.slots[slot].cmd;
+        let number = ctx.ring.number;
+        Frame {
+            ctx,
+            target,
+            view,
+            slot,
+            number,
+            cmd,
+            rendering: false,
+            clear: DEFAULT_CLEAR,
+            camera: Camera::default(),
+            viewport: vk::Rect2D {
+                offset: vk::Offset2D::default(),
+                extent: view.extent,
+            },
+            flushes: Vec::new(),
+            finished: false,
+            bound: Bound::default(),
+            stats: DrawStats::default(),
+            capture: false,
+        }
+    }
+
     /// The frame slot this frame records into (`0..FRAMES_IN_FLIGHT`): the caller must bring
     /// this slot of each mirror up to date.
     pub fn slot(&self) -> usize {
@@ -233,14 +148,14 @@ impl<'a> Frame<'a> {
     /// GPU time in milliseconds of the previous frame recorded in this slot (`None` before
     /// the slot's first completion or without timestamp support).
     pub fn gpu_time_ms(&self) -> Option<f64> {
-        self.renderer.frames[self.slot].gpu_ms
+        self.ctx.ring.slots[self.slot].gpu_ms
     }
 
     /// Write access to this frame's slot of `mirror`. Safe by construction: the slot's
     /// previous GPU use has completed (begin waited for its fence).
     pub fn write_mirror<'m>(&'m mut self, mirror: &'m mut Mirror) -> MirrorWriter<'m> {
-        let atom = self.renderer.device.caps.non_coherent_atom_size;
-        let track = self.renderer.always_flush || mirror.slot(self.slot).buffer.needs_flush();
+        let atom = self.ctx.device.caps.non_coherent_atom_size;
+        let track = self.ctx.always_flush || mirror.slot(self.slot).buffer.needs_flush();
         mirror.writer(self.slot, atom, track, &mut self.flushes)
     }
 
@@ -262,20 +177,11 @@ impl<'a> Frame<'a> {
     /// A new mirror holding `data` (at least one float) in every slot. Never waits: the new
     /// buffers have never been used by the GPU, so all their slots may be written now.
     pub fn create_mirror(&mut self, name: &str, data: &[f32]) -> GpuResult<Mirror> {
-        let len = data.len().max(1);
-        let mut fresh = Mirror::new(&self.renderer.device, name, len)?;
-        let atom = self.renderer.device.caps.non_coherent_atom_size;
-        let mut flushes = Vec::new();
-        for slot in 0..super::FRAMES_IN_FLIGHT {
-            let track = self.renderer.always_flush || fresh.slot(slot).buffer.needs_flush();
-            let written = fresh.writer(slot, atom, track, &mut flushes).write(0, data);
-            if let Err(e) = written {
-                self.renderer.destroy_mirror(fresh);
-                return Err(e);
-            }
-        }
-        if let Err(e) = self.renderer.device.flush_ranges(&flushes) {
-            self.renderer.destroy_mirror(fresh);
+        let mut fresh = Mirror::new(self.ctx.device, name, data.len().max(1))?;
+        // SAFETY: the new buffers have never been used by the GPU.
+        let filled = unsafe { fresh.fill(self.ctx.device, 0, data, self.ctx.always_flush) };
+        if let Err(e) = filled {
+            self.destroy_mirror(fresh);
             return Err(e);
         }
         Ok(fresh)
@@ -284,11 +190,11 @@ impl<'a> Frame<'a> {
     /// Gives a mirror back; each slot's buffer is released when that slot's fence next
     /// signals (this frame's included), so this never waits.
     pub fn destroy_mirror(&mut self, mirror: Mirror) {
-        self.renderer.destroy_mirror(mirror);
+        self.ctx.ring.release_mirror(self.ctx.device, mirror);
     }
 
     /// Offscreen frames: also copy the finished image into the target's readback buffer, for
-    /// [`Renderer::read_pixels`]. Frames that are not captured copy nothing (an image read
+    /// [`super::Renderer::read_pixels`]. Frames that are not captured copy nothing (an image read
     /// back every frame costs a full-image copy nobody looks at). No effect on swapchains.
     pub fn capture(&mut self) {
         self.capture = true;
@@ -330,7 +236,7 @@ impl<'a> Frame<'a> {
             }];
             // SAFETY: inside a rendering scope with these attachments; rect within the target.
             unsafe {
-                self.renderer
+                self.ctx
                     .device
                     .raw
                     .cmd_clear_attachments(self.cmd, &attachments, &rect)
@@ -377,7 +283,7 @@ impl<'a> Frame<'a> {
         };
         // SAFETY: recording command buffer; values validated in `set_viewport`.
         unsafe {
-            let raw = &self.renderer.device.raw;
+            let raw = &self.ctx.device.raw;
             raw.cmd_set_viewport(self.cmd, 0, &[viewport]);
             raw.cmd_set_scissor(self.cmd, 0, &[r]);
         }
@@ -431,12 +337,7 @@ impl<'a> Frame<'a> {
             .color_attachments(&colors)
             .depth_attachment(&depth);
         // SAFETY: recording command buffer; attachments were transitioned at begin.
-        unsafe {
-            self.renderer
-                .device
-                .raw
-                .cmd_begin_rendering(self.cmd, &info)
-        };
+        unsafe { self.ctx.device.raw.cmd_begin_rendering(self.cmd, &info) };
         self.rendering = true;
         self.apply_viewport();
     }
@@ -447,6 +348,81 @@ impl<'a> Frame<'a> {
         self.finished = true;
         self.finish_inner()?;
         Ok(self.number)
+    }
+
+    /// Records the end of the frame, flushes host writes, submits and presents.
+    ///
+    /// If anything fails before the submission is accepted, the slot stays usable: its fence
+    /// is only waited for when a submission will signal it, and a swapchain image's acquire
+    /// semaphore, already signalled, is consumed by an empty submission so the slot can
+    /// acquire again.
+    fn finish_inner(&mut self) -> GpuResult<()> {
+        match self.record_and_submit() {
+            Ok(()) => {
+                self.ctx.ring.number += 1;
+                match &mut self.target {
+                    FrameTarget::Swapchain {
+                        swapchain,
+                        image_index,
+                    } => {
+                        let wait = swapchain.render_finished[*image_index as usize];
+                        swapchain.present(self.ctx.device, *image_index, wait)
+                    }
+                    FrameTarget::Offscreen(_) => Ok(()),
+                }
+            }
+            Err(e) => {
+                self.recover_unsubmitted();
+                Err(e)
+            }
+        }
+    }
+
+    /// Ends recording and submits; the offscreen image is copied out when captured.
+    fn record_and_submit(&mut self) -> GpuResult<()> {
+        // Begin rendering even for an empty frame so the clear happens.
+        self.ensure_rendering();
+        let (cmd, slot, device) = (self.cmd, self.slot, self.ctx.device);
+        // SAFETY: `cmd` is recording inside the rendering scope begun above.
+        unsafe { device.raw.cmd_end_rendering(cmd) };
+        let signal = match &mut self.target {
+            FrameTarget::Offscreen(target) => {
+                // Until this submission is accepted, no pixels are readable.
+                target.last_slot = None;
+                if self.capture {
+                    // SAFETY: recording outside rendering; the slot's readback buffer is not
+                    // read by the host until this submission's fence signals.
+                    unsafe { target.record_readback(device, cmd, slot) };
+                }
+                None
+            }
+            FrameTarget::Swapchain {
+                swapchain,
+                image_index,
+            } => {
+                // SAFETY: recording outside rendering; the image is this frame's.
+                unsafe { barrier::record(&device.raw, cmd, &[barrier::to_present(&self.view)]) };
+                Some(swapchain.render_finished[*image_index as usize])
+            }
+        };
+        let ring: &mut FrameRing = self.ctx.ring;
+        let frame_slot: &mut FrameSlot = &mut ring.slots[slot];
+        frame_slot.submit(device, &mut self.flushes, signal, &mut ring.submit_fault)?;
+        if let FrameTarget::Offscreen(target) = &mut self.target {
+            target.last_slot = self.capture.then_some(slot);
+        }
+        Ok(())
+    }
+
+    /// After a failure before submission: a swapchain frame's acquire semaphore is signalled
+    /// and would make the slot's next acquire invalid, so it is consumed, and the swapchain
+    /// is rebuilt at the next begin, which releases the image that will not be presented.
+    fn recover_unsubmitted(&mut self) {
+        let FrameTarget::Swapchain { swapchain, .. } = &mut self.target else {
+            return;
+        };
+        swapchain.stale = true;
+        self.ctx.ring.slots[self.slot].consume_acquire(self.ctx.device);
     }
 }
 

@@ -123,6 +123,28 @@ impl Mirror {
         &self.slots[slot % FRAMES_IN_FLIGHT]
     }
 
+    /// Writes `data` at `offset` into every slot and flushes what needs flushing.
+    ///
+    /// # Safety
+    /// No pending GPU work may use any slot of this mirror (every frame slot was waited for,
+    /// or the mirror was never used).
+    pub(crate) unsafe fn fill(
+        &mut self,
+        device: &Device,
+        offset: usize,
+        data: &[f32],
+        always_flush: bool,
+    ) -> GpuResult<()> {
+        let atom = device.caps.non_coherent_atom_size;
+        let mut flushes = Vec::new();
+        for slot in 0..FRAMES_IN_FLIGHT {
+            let track = always_flush || self.slot(slot).buffer.needs_flush();
+            self.writer(slot, atom, track, &mut flushes)
+                .write(offset, data)?;
+        }
+        device.flush_ranges(&flushes)
+    }
+
     /// A writer for slot `slot` that appends the flush ranges it produces to `flushes`.
     pub(crate) fn writer<'a>(
         &'a mut self,

@@ -60,6 +60,7 @@
 //! (`destroy_*`); dropping the renderer destroys everything else. With validation on,
 //! anything leaked is reported by the layer at teardown.
 
+mod barrier;
 mod device;
 mod draw;
 mod error;
@@ -73,14 +74,18 @@ mod mirror;
 mod offscreen;
 mod pipeline;
 mod pod;
+mod region;
 mod renderer;
 mod shader;
-mod submit;
+mod slot;
+mod style;
 mod swapchain;
+mod target;
 mod timestamp;
 mod transient;
 mod upload;
 mod validation;
+mod vertex;
 
 /// Frames the CPU may record ahead of the GPU; also the number of slots of every mirror.
 pub const FRAMES_IN_FLIGHT: usize = 2;
@@ -91,12 +96,8 @@ pub const WAIT_LIMIT: std::time::Duration = std::time::Duration::from_secs(30);
 
 pub use ash::vk;
 pub use device::{Device, DeviceCaps, GPU_ENV};
-pub use draw::{
-    Camera, DrawStats, LineVertex, MapStyle, OverlayVertex, PointRun, PointStyle, PolylineStyle,
-    SurfaceBatch, SurfaceGrid, SurfaceStyle,
-};
 pub use error::{GpuError, GpuResult};
-pub use frame::Frame;
+pub use frame::{DrawStats, Frame};
 pub use grid::{
     GridShape, GridStride, grid_lines, grid_lines_strided, grid_triangles, grid_triangles_strided,
 };
@@ -105,9 +106,12 @@ pub use memory::{Buffer, BufferDesc};
 pub use mirror::{Mirror, MirrorBuffer, MirrorWriter};
 pub use offscreen::{OFFSCREEN_FORMAT, OffscreenDesc, OffscreenTarget, Pixels};
 pub use pipeline::DEPTH_FORMAT;
+pub use region::{PointRun, SurfaceBatch, SurfaceGrid};
 pub use renderer::{Fault, Renderer, RendererDesc};
+pub use style::{Camera, MapStyle, PointStyle, PolylineStyle, SurfaceStyle};
 pub use swapchain::{Swapchain, SwapchainDesc};
 pub use validation::{Severity, ValidationMessage, ValidationSink};
+pub use vertex::{LineVertex, OverlayVertex};
 
 /// ICD manifest of Mesa's lavapipe (software Vulkan) on Debian/Ubuntu, used by tests.
 pub const LAVAPIPE_ICD: &str = "/usr/share/vulkan/icd.d/lvp_icd.x86_64.json";

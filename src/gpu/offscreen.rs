@@ -7,29 +7,30 @@ use ash::vk;
 use gpu_allocator::MemoryLocation;
 
 use super::FRAMES_IN_FLIGHT;
+use super::barrier::image_barrier;
 use super::device::Device;
 use super::error::{GpuError, GpuResult};
-use super::frame::TargetView;
 use super::image::{Attachments, Image, ImageDesc};
 use super::memory::{Buffer, BufferDesc};
-use super::renderer::{Orphan, Renderer};
+use super::target::TargetView;
 
 /// Colour format of offscreen targets. sRGB, so shaders output linear colour and the PNG
 /// bytes read back are display-ready.
 pub const OFFSCREEN_FORMAT: vk::Format = vk::Format::R8G8B8A8_SRGB;
 
-/// Parameters for [`Renderer::create_offscreen`].
+/// Parameters for [`super::Renderer::create_offscreen`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct OffscreenDesc {
     /// Width in pixels (> 0).
     pub width: u32,
     /// Height in pixels (> 0).
     pub height: u32,
-    /// MSAA sample count: 1, 2, 4, 8...; 0 picks [`Renderer::default_samples`].
+    /// MSAA sample count: 1, 2, 4, 8...; 0 picks [`super::Renderer::default_samples`].
     pub samples: u32,
 }
 
-/// An image to render into and read back. Destroy with [`Renderer::destroy_offscreen`].
+/// An image to render into and read back. Destroy with
+/// [`super::Renderer::destroy_offscreen`].
 pub struct OffscreenTarget {
     pub(crate) color: Image,
     pub(crate) attachments: Attachments,
@@ -42,6 +43,97 @@ pub struct OffscreenTarget {
 }
 
 impl OffscreenTarget {
+    /// Creates the colour image, attachments and one readback buffer per frame slot, for a
+    /// non-empty `desc` (the renderer checks it) with `samples` resolved from it.
+    pub(crate) fn new(
+        device: &Device,
+        desc: &OffscreenDesc,
+        samples: vk::SampleCountFlags,
+    ) -> GpuResult<Self> {
+        let extent = vk::Extent2D {
+            width: desc.width,
+            height: desc.height,
+        };
+        let color = Image::new(
+            device,
+            &ImageDesc {
+                name: "offscreen colour",
+                extent,
+                format: OFFSCREEN_FORMAT,
+                samples: vk::SampleCountFlags::TYPE_1,
+                usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
+            },
+        )?;
+        let attachments = match Attachments::new(device, extent, OFFSCREEN_FORMAT, samples) {
+            Ok(a) => a,
+            Err(e) => {
+                // SAFETY: created just above and never used by the GPU.
+                unsafe { color.destroy(device) };
+                return Err(e);
+            }
+        };
+        let mut target = OffscreenTarget {
+            color,
+            attachments,
+            readback: Vec::new(),
+            extent,
+            last_slot: None,
+        };
+        let bytes = u64::from(desc.width) * u64::from(desc.height) * 4;
+        for _ in 0..FRAMES_IN_FLIGHT {
+            let buffer = device.create_buffer(&BufferDesc {
+                name: "offscreen readback",
+                size: bytes,
+                usage: vk::BufferUsageFlags::TRANSFER_DST,
+                location: MemoryLocation::GpuToCpu,
+            });
+            match buffer {
+                Ok(b) => target.readback.push(b),
+                Err(e) => {
+                    // SAFETY: created just above and never used by the GPU.
+                    unsafe { target.destroy(device) };
+                    return Err(e);
+                }
+            }
+        }
+        Ok(target)
+    }
+
+    /// The frame slot whose readback buffer holds the last frame rendered here; an error
+    /// when that frame was not captured.
+    pub(crate) fn captured_slot(&self) -> GpuResult<usize> {
+        self.last_slot.ok_or_else(|| {
+            GpuError::InvalidArgument(
+                "read_pixels: the last frame rendered into this target was not captured \
+                 (call Frame::capture before finish)"
+                    .into(),
+            )
+        })
+    }
+
+    /// Copies the pixels out of `slot`'s readback buffer. The caller has waited for the
+    /// submission that filled it ([`OffscreenTarget::captured_slot`]).
+    pub(crate) fn read_back(&self, device: &Device, slot: usize) -> GpuResult<Pixels> {
+        let buffer = &self.readback[slot];
+        let len = buffer.size() as usize;
+        if buffer.needs_flush() {
+            let atom = device.caps.non_coherent_atom_size;
+            device.invalidate_ranges(&[buffer.mapped_range(0..len as u64, atom)])?;
+        }
+        let src = buffer
+            .mapped()
+            .ok_or_else(|| GpuError::Internal("readback buffer is not mapped".into()))?;
+        let mut rgba = vec![0u8; len];
+        // SAFETY: the buffer is mapped host-readable (GpuToCpu) memory of `len` bytes whose
+        // writes completed (fence) and were made host-visible (barrier + invalidate).
+        unsafe { std::ptr::copy_nonoverlapping(src.as_ptr(), rgba.as_mut_ptr(), len) };
+        Ok(Pixels {
+            width: self.extent.width,
+            height: self.extent.height,
+            rgba,
+        })
+    }
+
     /// Size in pixels.
     pub fn extent(&self) -> [u32; 2] {
         [self.extent.width, self.extent.height]
@@ -61,6 +153,81 @@ impl OffscreenTarget {
             extent: self.extent,
             format: OFFSCREEN_FORMAT,
             samples: self.attachments.samples,
+        }
+    }
+
+    /// Records the copy of the image into `slot`'s readback buffer and makes it visible to
+    /// the host.
+    ///
+    /// # Safety
+    /// `cmd` must be recording outside a rendering scope after this target's frame was drawn,
+    /// and the host must not read `slot`'s buffer until the submission's fence signals.
+    pub(crate) unsafe fn record_readback(
+        &self,
+        device: &Device,
+        cmd: vk::CommandBuffer,
+        slot: usize,
+    ) {
+        let view = self.view();
+        let readback = &self.readback[slot];
+        use vk::AccessFlags2 as A;
+        use vk::PipelineStageFlags2 as S;
+        let raw = &device.raw;
+        let to_src = [image_barrier(
+            view.image,
+            view.format,
+            (S::COLOR_ATTACHMENT_OUTPUT, A::COLOR_ATTACHMENT_WRITE),
+            (S::COPY, A::TRANSFER_READ),
+            (
+                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+            ),
+        )];
+        let region = vk::BufferImageCopy {
+            buffer_offset: 0,
+            buffer_row_length: 0,
+            buffer_image_height: 0,
+            image_subresource: vk::ImageSubresourceLayers {
+                aspect_mask: vk::ImageAspectFlags::COLOR,
+                mip_level: 0,
+                base_array_layer: 0,
+                layer_count: 1,
+            },
+            image_offset: vk::Offset3D::default(),
+            image_extent: vk::Extent3D {
+                width: view.extent.width,
+                height: view.extent.height,
+                depth: 1,
+            },
+        };
+        let to_host = [vk::BufferMemoryBarrier2::default()
+            .src_stage_mask(S::COPY)
+            .src_access_mask(A::TRANSFER_WRITE)
+            .dst_stage_mask(S::HOST)
+            .dst_access_mask(A::HOST_READ)
+            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .buffer(readback.raw)
+            .offset(0)
+            .size(vk::WHOLE_SIZE)];
+        // SAFETY: the caller guarantees a recording command buffer outside rendering and no host
+        // read of the buffer before the fence.
+        unsafe {
+            raw.cmd_pipeline_barrier2(
+                cmd,
+                &vk::DependencyInfo::default().image_memory_barriers(&to_src),
+            );
+            raw.cmd_copy_image_to_buffer(
+                cmd,
+                view.image,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                readback.raw,
+                &[region],
+            );
+            raw.cmd_pipeline_barrier2(
+                cmd,
+                &vk::DependencyInfo::default().buffer_memory_barriers(&to_host),
+            );
         }
     }
 
@@ -151,154 +318,5 @@ impl Pixels {
             height: info.height,
             rgba,
         })
-    }
-}
-
-impl Renderer {
-    /// The MSAA sample count used when a target asks for 0, chosen per device type by
-    /// measurement (docs/performance.md, "Frames"): 1 on CPU rasterisers (lavapipe), where 4×
-    /// multisampling multiplies the cost of every triangle's rasterisation and of the resolve,
-    /// and 4 on GPUs, where it is cheap. Falls back to 1 where 4 is not supported.
-    pub fn default_samples(&self) -> u32 {
-        let preferred = match self.device.caps.device_type {
-            vk::PhysicalDeviceType::CPU => 1,
-            _ => 4,
-        };
-        if self.device.caps.supports_samples(preferred) {
-            preferred
-        } else {
-            1
-        }
-    }
-
-    pub(crate) fn resolve_samples(&self, requested: u32) -> GpuResult<vk::SampleCountFlags> {
-        let n = if requested == 0 {
-            self.default_samples()
-        } else {
-            requested
-        };
-        if !n.is_power_of_two() || !self.device.caps.supports_samples(n) {
-            return Err(GpuError::InvalidArgument(format!(
-                "{n}x MSAA is not supported by {}",
-                self.device.caps.name
-            )));
-        }
-        Ok(vk::SampleCountFlags::from_raw(n))
-    }
-
-    /// Creates an offscreen target.
-    pub fn create_offscreen(&mut self, desc: &OffscreenDesc) -> GpuResult<OffscreenTarget> {
-        if desc.width == 0 || desc.height == 0 {
-            return Err(GpuError::InvalidArgument(format!(
-                "offscreen target {}x{} is empty",
-                desc.width, desc.height
-            )));
-        }
-        let samples = self.resolve_samples(desc.samples)?;
-        let device = &*self.device;
-        let extent = vk::Extent2D {
-            width: desc.width,
-            height: desc.height,
-        };
-        let color = Image::new(
-            device,
-            &ImageDesc {
-                name: "offscreen colour",
-                extent,
-                format: OFFSCREEN_FORMAT,
-                samples: vk::SampleCountFlags::TYPE_1,
-                usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
-            },
-        )?;
-        let attachments = match Attachments::new(device, extent, OFFSCREEN_FORMAT, samples) {
-            Ok(a) => a,
-            Err(e) => {
-                // SAFETY: created just above and never used by the GPU.
-                unsafe { color.destroy(device) };
-                return Err(e);
-            }
-        };
-        let mut target = OffscreenTarget {
-            color,
-            attachments,
-            readback: Vec::new(),
-            extent,
-            last_slot: None,
-        };
-        let bytes = u64::from(desc.width) * u64::from(desc.height) * 4;
-        for _ in 0..FRAMES_IN_FLIGHT {
-            let buffer = device.create_buffer(&BufferDesc {
-                name: "offscreen readback",
-                size: bytes,
-                usage: vk::BufferUsageFlags::TRANSFER_DST,
-                location: MemoryLocation::GpuToCpu,
-            });
-            match buffer {
-                Ok(b) => target.readback.push(b),
-                Err(e) => {
-                    // SAFETY: created just above and never used by the GPU.
-                    unsafe { target.destroy(device) };
-                    return Err(e);
-                }
-            }
-        }
-        Ok(target)
-    }
-
-    /// Waits for the last frame rendered into `target` and returns its pixels. That frame
-    /// must have been captured ([`super::Frame::capture`]).
-    pub fn read_pixels(&mut self, target: &OffscreenTarget) -> GpuResult<Pixels> {
-        let slot = target.last_slot.ok_or_else(|| {
-            GpuError::InvalidArgument(
-                "read_pixels: the last frame rendered into this target was not captured \
-                 (call Frame::capture before finish)"
-                    .into(),
-            )
-        })?;
-        let device = &*self.device;
-        // A slot not in flight finished its last accepted submission (it was waited for).
-        if self.frames[slot].in_flight {
-            device.wait_fence(self.frames[slot].fence)?;
-        }
-        let buffer = &target.readback[slot];
-        let len = buffer.size() as usize;
-        if buffer.needs_flush() {
-            let atom = device.caps.non_coherent_atom_size;
-            device.invalidate_ranges(&[buffer.mapped_range(0..len as u64, atom)])?;
-        }
-        let src = buffer
-            .mapped()
-            .ok_or_else(|| GpuError::Internal("readback buffer is not mapped".into()))?;
-        let mut rgba = vec![0u8; len];
-        // SAFETY: the buffer is mapped host-readable (GpuToCpu) memory of `len` bytes whose
-        // writes completed (fence) and were made host-visible (barrier + invalidate).
-        unsafe { std::ptr::copy_nonoverlapping(src.as_ptr(), rgba.as_mut_ptr(), len) };
-        Ok(Pixels {
-            width: target.extent.width,
-            height: target.extent.height,
-            rgba,
-        })
-    }
-
-    /// Destroys an offscreen target, after waiting for the GPU to finish with it. If that
-    /// wait fails for another reason than a lost device (work may still run), the target is
-    /// kept until the renderer is dropped and the error returned.
-    pub fn destroy_offscreen(&mut self, target: OffscreenTarget) -> GpuResult<()> {
-        match self.wait_idle() {
-            Ok(()) => {
-                // SAFETY: the device is idle.
-                unsafe { target.destroy(&self.device) };
-                Ok(())
-            }
-            Err(e) if e.is_device_lost() => {
-                // SAFETY: nothing executes on a lost device; its objects may be destroyed.
-                unsafe { target.destroy(&self.device) };
-                Err(e)
-            }
-            Err(e) => {
-                self.orphans.push(Orphan::Target(target));
-                Err(e)
-            }
-        }
     }
 }

@@ -274,55 +274,86 @@ impl Pipelines {
     }
 }
 
-fn build_set(
-    device: &Device,
-    shaders: &Shaders,
-    layout: vk::PipelineLayout,
-    key: PipelineKey,
-) -> GpuResult<PipelineSet> {
-    use vk::Format as F;
-    let surface_binding = binding(24);
-    let surface_attrs = [
-        attribute(0, F::R32G32B32_SFLOAT, 0),
-        attribute(1, F::R32G32B32_SFLOAT, 12),
-    ];
-    // Analysis maps: the surface vertices plus one f32 per vertex from a second buffer.
-    let map_bindings = [
-        surface_binding[0],
-        vk::VertexInputBindingDescription {
+/// The vertex buffer layouts of the pipelines that read vertex buffers (polylines and points
+/// pull theirs through device addresses instead).
+struct VertexInputs {
+    /// Surface vertices: position and normal, 6 floats.
+    surface: [vk::VertexInputBindingDescription; 1],
+    surface_attrs: [vk::VertexInputAttributeDescription; 2],
+    /// Analysis maps: the surface vertices plus one f32 per vertex from a second buffer.
+    map: [vk::VertexInputBindingDescription; 2],
+    map_attrs: [vk::VertexInputAttributeDescription; 3],
+    /// `LineVertex`: position and RGBA8 colour.
+    lines: [vk::VertexInputBindingDescription; 1],
+    lines_attrs: [vk::VertexInputAttributeDescription; 2],
+    /// `OverlayVertex`: pixel position, RGBA8 colour, font coordinates.
+    overlay: [vk::VertexInputBindingDescription; 1],
+    overlay_attrs: [vk::VertexInputAttributeDescription; 3],
+}
+
+impl VertexInputs {
+    fn new() -> Self {
+        use vk::Format as F;
+        let surface = binding(24);
+        let surface_attrs = [
+            attribute(0, F::R32G32B32_SFLOAT, 0),
+            attribute(1, F::R32G32B32_SFLOAT, 12),
+        ];
+        let scalar = vk::VertexInputBindingDescription {
             binding: 1,
             stride: 4,
             input_rate: vk::VertexInputRate::VERTEX,
-        },
-    ];
-    let map_attrs = [
-        surface_attrs[0],
-        surface_attrs[1],
-        vk::VertexInputAttributeDescription {
+        };
+        let scalar_attr = vk::VertexInputAttributeDescription {
             location: 2,
             binding: 1,
             format: F::R32_SFLOAT,
             offset: 0,
-        },
-    ];
-    let lines_binding = binding(16);
-    let lines_attrs = [
-        attribute(0, F::R32G32B32_SFLOAT, 0),
-        attribute(1, F::R8G8B8A8_UNORM, 12),
-    ];
-    let overlay_binding = binding(20);
-    let overlay_attrs = [
-        attribute(0, F::R32G32_SFLOAT, 0),
-        attribute(1, F::R8G8B8A8_UNORM, 8),
-        attribute(2, F::R32G32_SFLOAT, 12),
-    ];
+        };
+        Self {
+            surface,
+            surface_attrs,
+            map: [surface[0], scalar],
+            map_attrs: [surface_attrs[0], surface_attrs[1], scalar_attr],
+            lines: binding(16),
+            lines_attrs: [
+                attribute(0, F::R32G32B32_SFLOAT, 0),
+                attribute(1, F::R8G8B8A8_UNORM, 12),
+            ],
+            overlay: binding(20),
+            overlay_attrs: [
+                attribute(0, F::R32G32_SFLOAT, 0),
+                attribute(1, F::R8G8B8A8_UNORM, 8),
+                attribute(2, F::R32G32_SFLOAT, 12),
+            ],
+        }
+    }
+}
+
+/// The pipelines of a set, in the order of [`set_specs`].
+const SET_SIZE: usize = 8;
+
+/// What each pipeline of a set is made of, in the order [`PipelineSet::from_built`] reads:
+/// surface, wire, polyline, points, thin lines, 3D lines, overlay, surface map.
+fn set_specs(inputs: &VertexInputs, large_points: bool) -> [Spec<'_>; SET_SIZE] {
     let tri = vk::PrimitiveTopology::TRIANGLE_LIST;
-    let specs = [
+    let lines = vk::PrimitiveTopology::LINE_LIST;
+    // Polylines and points pull their vertices through buffer device addresses.
+    let pulled = |vs, fs, topology| Spec {
+        vs,
+        fs,
+        bindings: &[],
+        attributes: &[],
+        topology,
+        depth: Depth::Dynamic,
+        blend: false,
+    };
+    [
         Spec {
             vs: ShaderId::SurfaceVert,
             fs: ShaderId::SurfaceFrag,
-            bindings: &surface_binding,
-            attributes: &surface_attrs,
+            bindings: &inputs.surface,
+            attributes: &inputs.surface_attrs,
             topology: tri,
             depth: Depth::Biased,
             blend: false,
@@ -330,58 +361,38 @@ fn build_set(
         Spec {
             vs: ShaderId::WireVert,
             fs: ShaderId::FlatFrag,
-            bindings: &surface_binding,
-            attributes: &surface_attrs[..1],
-            topology: vk::PrimitiveTopology::LINE_LIST,
+            bindings: &inputs.surface,
+            attributes: &inputs.surface_attrs[..1],
+            topology: lines,
             depth: Depth::On,
             blend: false,
         },
-        Spec {
-            vs: ShaderId::PolylineVert,
-            fs: ShaderId::FlatFrag,
-            bindings: &[],
-            attributes: &[],
-            topology: tri,
-            depth: Depth::Dynamic,
-            blend: false,
-        },
-        Spec {
-            vs: ShaderId::PointsVert,
-            fs: ShaderId::PointsFrag,
-            bindings: &[],
-            attributes: &[],
-            // Large point primitives: a sixth of the vertex work of quads.
-            topology: if device.caps.large_points {
+        pulled(ShaderId::PolylineVert, ShaderId::FlatFrag, tri),
+        // Large point primitives: a sixth of the vertex work of quads.
+        pulled(
+            ShaderId::PointsVert,
+            ShaderId::PointsFrag,
+            if large_points {
                 vk::PrimitiveTopology::POINT_LIST
             } else {
                 tri
             },
-            depth: Depth::Dynamic,
-            blend: false,
-        },
-        Spec {
-            vs: ShaderId::PolylineVert,
-            fs: ShaderId::FlatFrag,
-            bindings: &[],
-            attributes: &[],
-            topology: vk::PrimitiveTopology::LINE_LIST,
-            depth: Depth::Dynamic,
-            blend: false,
-        },
+        ),
+        pulled(ShaderId::PolylineVert, ShaderId::FlatFrag, lines),
         Spec {
             vs: ShaderId::Lines3dVert,
             fs: ShaderId::ColorFrag,
-            bindings: &lines_binding,
-            attributes: &lines_attrs,
-            topology: vk::PrimitiveTopology::LINE_LIST,
+            bindings: &inputs.lines,
+            attributes: &inputs.lines_attrs,
+            topology: lines,
             depth: Depth::On,
             blend: false,
         },
         Spec {
             vs: ShaderId::OverlayVert,
             fs: ShaderId::OverlayFrag,
-            bindings: &overlay_binding,
-            attributes: &overlay_attrs,
+            bindings: &inputs.overlay,
+            attributes: &inputs.overlay_attrs,
             topology: tri,
             depth: Depth::Off,
             blend: true,
@@ -389,19 +400,68 @@ fn build_set(
         Spec {
             vs: ShaderId::MapVert,
             fs: ShaderId::MapFrag,
-            bindings: &map_bindings,
-            attributes: &map_attrs,
+            bindings: &inputs.map,
+            attributes: &inputs.map_attrs,
             topology: tri,
             depth: Depth::Biased,
             blend: false,
         },
-    ];
-    let mut pipelines = Vec::with_capacity(specs.len());
-    for spec in &specs {
+    ]
+}
+
+impl PipelineSet {
+    /// Names the pipelines built from [`set_specs`], in its order.
+    fn from_built(p: [vk::Pipeline; SET_SIZE]) -> Self {
+        let [
+            surface,
+            wire,
+            polyline,
+            points,
+            thin_lines,
+            lines3d,
+            overlay,
+            surface_map,
+        ] = p;
+        Self {
+            surface,
+            wire,
+            polyline,
+            thin_lines,
+            points,
+            lines3d,
+            overlay,
+            surface_map,
+        }
+    }
+}
+
+/// Every pipeline of the set for `key`.
+fn build_set(
+    device: &Device,
+    shaders: &Shaders,
+    layout: vk::PipelineLayout,
+    key: PipelineKey,
+) -> GpuResult<PipelineSet> {
+    let inputs = VertexInputs::new();
+    let specs = set_specs(&inputs, device.caps.large_points);
+    let built = build_all(device, shaders, layout, key, &specs)?;
+    Ok(PipelineSet::from_built(built))
+}
+
+/// One pipeline per spec; on failure, those built so far are destroyed.
+fn build_all(
+    device: &Device,
+    shaders: &Shaders,
+    layout: vk::PipelineLayout,
+    key: PipelineKey,
+    specs: &[Spec<'_>; SET_SIZE],
+) -> GpuResult<[vk::Pipeline; SET_SIZE]> {
+    let mut built = [vk::Pipeline::null(); SET_SIZE];
+    for (i, spec) in specs.iter().enumerate() {
         match build_one(device, shaders, layout, key, spec) {
-            Ok(p) => pipelines.push(p),
+            Ok(p) => built[i] = p,
             Err(e) => {
-                for p in pipelines {
+                for &p in &built[..i] {
                     // SAFETY: freshly created, never used.
                     unsafe { device.raw.destroy_pipeline(p, None) };
                 }
@@ -409,16 +469,7 @@ fn build_set(
             }
         }
     }
-    Ok(PipelineSet {
-        surface: pipelines[0],
-        wire: pipelines[1],
-        polyline: pipelines[2],
-        points: pipelines[3],
-        lines3d: pipelines[5],
-        overlay: pipelines[6],
-        thin_lines: pipelines[4],
-        surface_map: pipelines[7],
-    })
+    Ok(built)
 }
 
 fn build_one(
@@ -446,19 +497,7 @@ fn build_one(
     let viewport = vk::PipelineViewportStateCreateInfo::default()
         .viewport_count(1)
         .scissor_count(1);
-    let mut raster = vk::PipelineRasterizationStateCreateInfo::default()
-        .polygon_mode(vk::PolygonMode::FILL)
-        .cull_mode(vk::CullModeFlags::NONE)
-        .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
-        .line_width(1.0);
-    if spec.depth == Depth::Biased {
-        // Push filled surfaces back by a couple of depth units plus a slope term, so lines
-        // lying exactly on the surface (isolines, wireframe, curves on it) pass LESS_OR_EQUAL.
-        raster = raster
-            .depth_bias_enable(true)
-            .depth_bias_constant_factor(2.0)
-            .depth_bias_slope_factor(1.5);
-    }
+    let raster = rasterization(spec.depth);
     let multisample =
         vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(key.samples);
     let depth_on = spec.depth != Depth::Off;
@@ -466,32 +505,10 @@ fn build_one(
         .depth_test_enable(depth_on)
         .depth_write_enable(depth_on)
         .depth_compare_op(vk::CompareOp::LESS_OR_EQUAL);
-    let blend_attachment = if spec.blend {
-        vk::PipelineColorBlendAttachmentState::default()
-            .blend_enable(true)
-            .src_color_blend_factor(vk::BlendFactor::SRC_ALPHA)
-            .dst_color_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
-            .color_blend_op(vk::BlendOp::ADD)
-            .src_alpha_blend_factor(vk::BlendFactor::ONE)
-            .dst_alpha_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
-            .alpha_blend_op(vk::BlendOp::ADD)
-            .color_write_mask(vk::ColorComponentFlags::RGBA)
-    } else {
-        vk::PipelineColorBlendAttachmentState::default()
-            .color_write_mask(vk::ColorComponentFlags::RGBA)
-    };
-    let blend_attachments = [blend_attachment];
+    let blend_attachments = [blend_attachment(spec.blend)];
     let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
-    let dynamic_states: &[vk::DynamicState] = if spec.depth == Depth::Dynamic {
-        &[
-            vk::DynamicState::VIEWPORT,
-            vk::DynamicState::SCISSOR,
-            vk::DynamicState::DEPTH_TEST_ENABLE,
-        ]
-    } else {
-        &[vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR]
-    };
-    let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(dynamic_states);
+    let dynamic =
+        vk::PipelineDynamicStateCreateInfo::default().dynamic_states(dynamic_states(spec.depth));
     let color_formats = [key.color_format];
     let mut rendering = vk::PipelineRenderingCreateInfo::default()
         .color_attachment_formats(&color_formats)
@@ -517,5 +534,53 @@ fn build_one(
     match result {
         Ok(p) => Ok(p[0]),
         Err((_, e)) => Err(e).vk("vkCreateGraphicsPipelines"),
+    }
+}
+
+/// Filled polygons, no culling; surfaces ([`Depth::Biased`]) pushed back in depth.
+fn rasterization(depth: Depth) -> vk::PipelineRasterizationStateCreateInfo<'static> {
+    let raster = vk::PipelineRasterizationStateCreateInfo::default()
+        .polygon_mode(vk::PolygonMode::FILL)
+        .cull_mode(vk::CullModeFlags::NONE)
+        .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
+        .line_width(1.0);
+    if depth != Depth::Biased {
+        return raster;
+    }
+    // Push filled surfaces back by a couple of depth units plus a slope term, so lines lying
+    // exactly on the surface (isolines, wireframe, curves on it) pass LESS_OR_EQUAL.
+    raster
+        .depth_bias_enable(true)
+        .depth_bias_constant_factor(2.0)
+        .depth_bias_slope_factor(1.5)
+}
+
+/// Straight-alpha "over" blending when `blend`, else plain writes.
+fn blend_attachment(blend: bool) -> vk::PipelineColorBlendAttachmentState {
+    let plain = vk::PipelineColorBlendAttachmentState::default()
+        .color_write_mask(vk::ColorComponentFlags::RGBA);
+    if !blend {
+        return plain;
+    }
+    plain
+        .blend_enable(true)
+        .src_color_blend_factor(vk::BlendFactor::SRC_ALPHA)
+        .dst_color_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
+        .color_blend_op(vk::BlendOp::ADD)
+        .src_alpha_blend_factor(vk::BlendFactor::ONE)
+        .dst_alpha_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
+        .alpha_blend_op(vk::BlendOp::ADD)
+}
+
+/// Viewport and scissor are always dynamic; the depth test too for [`Depth::Dynamic`].
+fn dynamic_states(depth: Depth) -> &'static [vk::DynamicState] {
+    if depth == Depth::Dynamic {
+        &[
+            vk::DynamicState::VIEWPORT,
+            vk::DynamicState::SCISSOR,
+            vk::DynamicState::DEPTH_TEST_ENABLE,
+        ]
+    } else {
+        &[vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR]
     }
 }

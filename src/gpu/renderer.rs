@@ -1,23 +1,29 @@
-//! The [`Renderer`]: owns the instance, device, pipelines, frame slots and caches.
+//! The [`Renderer`]: owns the instance, device, pipelines, frame slots and caches, and
+//! composes them: it creates and destroys targets, swapchains and mirrors, and begins frames
+//! (waits for the slot, acquires, transitions the attachments).
 
 use std::mem::ManuallyDrop;
+use std::sync::Arc;
 
 use ash::vk;
-use raw_window_handle::RawDisplayHandle;
+use raw_window_handle::{HasDisplayHandle, HasWindowHandle, RawDisplayHandle};
 
 use super::FRAMES_IN_FLIGHT;
+use super::barrier;
 use super::device::{Device, DeviceCaps};
 use super::error::{GpuError, GpuResult};
-use super::frame::FrameSlot;
+use super::frame::{Frame, FrameContext, FrameTarget};
 use super::grid::GridCache;
 use super::instance::{Instance, InstanceDesc, ValidationMode};
 use super::memory::Buffer;
 use super::mirror::Mirror;
-use super::offscreen::OffscreenTarget;
-use super::pipeline::Pipelines;
+use super::offscreen::{OffscreenDesc, OffscreenTarget, Pixels};
+use super::pipeline::{PipelineKey, PipelineSet, Pipelines};
 use super::pod::slice_bytes;
 use super::shader::Shaders;
-use super::swapchain::Swapchain;
+use super::slot::{FrameRing, FrameSlot};
+use super::swapchain::{Swapchain, SwapchainDesc};
+use super::target::TargetView;
 use super::upload::Uploader;
 use super::validation::ValidationSink;
 
@@ -54,7 +60,7 @@ pub enum Fault {
 }
 
 /// A resource given back while the GPU might still use it (a wait for it failed).
-pub(crate) enum Orphan {
+enum Orphan {
     Target(OffscreenTarget),
     Swapchain(Swapchain),
 }
@@ -65,23 +71,20 @@ pub(crate) enum Orphan {
 /// matching `destroy_*` method before the renderer is dropped; the validation layer reports
 /// anything left over as a leak.
 pub struct Renderer {
-    pub(crate) frames: Vec<FrameSlot>,
-    pub(crate) frame_number: u64,
-    pub(crate) pipelines: Pipelines,
-    pub(crate) shaders: Shaders,
-    pub(crate) grids: GridCache,
-    pub(crate) uploader: Uploader,
+    frames: FrameRing,
+    pipelines: Pipelines,
+    shaders: Shaders,
+    grids: GridCache,
+    uploader: Uploader,
     /// The HUD font's glyph rows in device memory (read by `overlay.frag` through its address).
-    pub(crate) font: Option<Buffer>,
-    pub(crate) always_flush: bool,
-    /// A failure to report at the next matching call (error-path tests).
-    pub(crate) fault: Option<Fault>,
+    font: Option<Buffer>,
+    always_flush: bool,
     /// Objects whose GPU use could not be shown to have ended when they were given back;
     /// destroyed after the final wait in `Drop`.
-    pub(crate) orphans: Vec<Orphan>,
+    orphans: Vec<Orphan>,
     // Dropped by hand, in order, after everything above (see `Drop`).
-    pub(crate) device: ManuallyDrop<Device>,
-    pub(crate) instance: ManuallyDrop<Instance>,
+    device: ManuallyDrop<Device>,
+    instance: ManuallyDrop<Instance>,
 }
 
 impl Renderer {
@@ -107,15 +110,13 @@ impl Renderer {
         };
         // From here on, Drop cleans up whatever was created.
         let mut renderer = Self {
-            frames: Vec::new(),
-            frame_number: 0,
+            frames: FrameRing::default(),
             pipelines: Pipelines::default(),
             shaders: Shaders::default(),
             grids: GridCache::default(),
             uploader: Uploader::default(),
             font: None,
             always_flush: desc.always_flush,
-            fault: None,
             orphans: Vec::new(),
             device: ManuallyDrop::new(device),
             instance: ManuallyDrop::new(instance),
@@ -133,7 +134,7 @@ impl Renderer {
         )?);
         for _ in 0..FRAMES_IN_FLIGHT {
             let slot = FrameSlot::new(&renderer.device, desc.always_flush)?;
-            renderer.frames.push(slot);
+            renderer.frames.slots.push(slot);
         }
         Ok(renderer)
     }
@@ -156,16 +157,12 @@ impl Renderer {
 
     /// Number of frames begun so far (the next frame's number).
     pub fn frame_number(&self) -> u64 {
-        self.frame_number
+        self.frames.number
     }
 
     /// GPU time (ms) of the most recent frame whose timing is known.
     pub fn last_gpu_time_ms(&self) -> Option<f64> {
-        let prev = (self.frame_number + FRAMES_IN_FLIGHT as u64 - 1) as usize % FRAMES_IN_FLIGHT;
-        self.frames
-            .get(prev)
-            .and_then(|f| f.gpu_ms)
-            .or_else(|| self.frames.iter().find_map(|f| f.gpu_ms))
+        self.frames.last_gpu_time_ms()
     }
 
     /// Makes the next matching call fail with `fault` instead of reaching the driver. For
@@ -174,7 +171,7 @@ impl Renderer {
     #[doc(hidden)]
     pub fn inject_fault(&mut self, fault: Fault) {
         match fault {
-            Fault::Submit(_) => self.fault = Some(fault),
+            Fault::Submit(result) => self.frames.submit_fault = Some(result),
             Fault::UploadWait(result) => self.uploader.fail_next_wait(result),
         }
     }
@@ -199,30 +196,15 @@ impl Renderer {
         offset: usize,
         data: &[f32],
     ) -> GpuResult<()> {
-        for f in &mut self.frames {
-            f.wait_and_recycle(&self.device)?;
-        }
-        let atom = self.device.caps.non_coherent_atom_size;
-        let mut flushes = Vec::new();
-        for slot in 0..FRAMES_IN_FLIGHT {
-            let track = self.always_flush || mirror.slot(slot).buffer.needs_flush();
-            let mut w = mirror.writer(slot, atom, track, &mut flushes);
-            w.write(offset, data)?;
-        }
-        self.device.flush_ranges(&flushes)
+        self.frames.wait_all(&self.device)?;
+        // SAFETY: every frame slot was just waited for, so no GPU work uses the mirror.
+        unsafe { mirror.fill(&self.device, offset, data, self.always_flush) }
     }
 
     /// Destroys a mirror. Each slot's buffer is released when that slot's fence next
     /// signals, so this never waits.
     pub fn destroy_mirror(&mut self, mirror: Mirror) {
-        for (i, b) in mirror.slots.into_iter().enumerate() {
-            match self.frames.get_mut(i) {
-                Some(f) => f.release.push(b.buffer),
-                // No slot, so no frame ever used this buffer.
-                // SAFETY: a buffer without a frame slot was never bound by a submission.
-                None => unsafe { self.device.destroy_buffer(b.buffer) },
-            }
-        }
+        self.frames.release_mirror(&self.device, mirror);
     }
 
     /// Fails with a clear message when the validation layer recorded errors (handy in tests
@@ -243,6 +225,189 @@ impl Renderer {
             )))
         }
     }
+
+    /// The MSAA sample count used when a target asks for 0 ([`DeviceCaps::default_samples`]:
+    /// 1 on CPU rasterisers such as lavapipe, 4 on GPUs).
+    pub fn default_samples(&self) -> u32 {
+        self.device.caps.default_samples()
+    }
+
+    /// Creates an offscreen target.
+    pub fn create_offscreen(&mut self, desc: &OffscreenDesc) -> GpuResult<OffscreenTarget> {
+        if desc.width == 0 || desc.height == 0 {
+            return Err(GpuError::InvalidArgument(format!(
+                "offscreen target {}x{} is empty",
+                desc.width, desc.height
+            )));
+        }
+        let samples = self.device.caps.resolve_samples(desc.samples)?;
+        OffscreenTarget::new(&self.device, desc, samples)
+    }
+
+    /// Waits for the last frame rendered into `target` and returns its pixels. That frame
+    /// must have been captured ([`Frame::capture`]).
+    pub fn read_pixels(&mut self, target: &OffscreenTarget) -> GpuResult<Pixels> {
+        let slot = target.captured_slot()?;
+        self.frames.wait_slot(&self.device, slot)?;
+        target.read_back(&self.device, slot)
+    }
+
+    /// Destroys an offscreen target, after waiting for the GPU to finish with it. If that
+    /// wait fails for another reason than a lost device (work may still run), the target is
+    /// kept until the renderer is dropped and the error returned.
+    pub fn destroy_offscreen(&mut self, target: OffscreenTarget) -> GpuResult<()> {
+        self.destroy_when_idle(Orphan::Target(target))
+    }
+
+    /// Creates a surface for `window` and its swapchain. The renderer must have been created
+    /// with `RendererDesc::display` set to the window's display. The swapchain keeps `window`
+    /// alive (the surface must not outlive its window).
+    pub fn create_swapchain<W>(
+        &mut self,
+        window: Arc<W>,
+        desc: &SwapchainDesc,
+    ) -> GpuResult<Swapchain>
+    where
+        W: HasDisplayHandle + HasWindowHandle + Send + Sync + 'static,
+    {
+        Swapchain::new(&self.instance, &self.device, window, desc)
+    }
+
+    /// Destroys the swapchain and its surface (waits for the GPU first).
+    pub fn destroy_swapchain(&mut self, swapchain: Swapchain) -> GpuResult<()> {
+        self.destroy_when_idle(Orphan::Swapchain(swapchain))
+    }
+
+    /// Destroys `orphan` once the device is idle. A lost device executes nothing, so its
+    /// objects go at once (and the error is returned); if the wait fails otherwise, work may
+    /// still use it, so it is kept until the renderer is dropped.
+    fn destroy_when_idle(&mut self, orphan: Orphan) -> GpuResult<()> {
+        let waited = self.wait_idle();
+        match waited {
+            Err(e) if !e.is_device_lost() => {
+                self.orphans.push(orphan);
+                Err(e)
+            }
+            _ => {
+                // SAFETY: the device is idle or lost, so no GPU work uses the object.
+                unsafe { self.destroy_orphan(orphan) };
+                waited
+            }
+        }
+    }
+
+    /// # Safety
+    /// The device must be idle or lost.
+    unsafe fn destroy_orphan(&self, orphan: Orphan) {
+        // SAFETY: the caller guarantees an idle or lost device.
+        unsafe {
+            match orphan {
+                Orphan::Target(t) => t.destroy(&self.device),
+                Orphan::Swapchain(s) => s.destroy(&self.instance, &self.device),
+            }
+        }
+    }
+
+    /// Begins a frame rendering into `target`. Waits for the slot's previous use.
+    pub fn begin_offscreen<'a>(
+        &'a mut self,
+        target: &'a mut OffscreenTarget,
+    ) -> GpuResult<Frame<'a>> {
+        let slot = self.frames.next_slot(&self.device)?;
+        let view = target.view();
+        let pipelines = self.prepare(view, slot, false)?;
+        Ok(Frame::new(
+            self.frame_context(pipelines),
+            FrameTarget::Offscreen(target),
+            view,
+            slot,
+        ))
+    }
+
+    /// Begins a frame on the next swapchain image. Returns `None` when there is nothing to
+    /// draw to right now (window minimised, or the swapchain just went out of date); simply
+    /// try again next frame.
+    pub fn begin_swapchain<'a>(
+        &'a mut self,
+        swapchain: &'a mut Swapchain,
+    ) -> GpuResult<Option<Frame<'a>>> {
+        swapchain.collect_retired(&self.device, self.frames.number, false);
+        if swapchain.stale
+            && !swapchain.rebuild(&self.instance, &self.device, self.frames.number)?
+        {
+            return Ok(None);
+        }
+        // Build the pipelines before acquiring: once an image is acquired, the frame must be
+        // submitted, or the slot's acquire semaphore stays signalled.
+        if let Some(view) = swapchain.view(0) {
+            self.pipelines
+                .get(&self.device, &self.shaders, pipeline_key(&view))?;
+        }
+        let slot = self.frames.next_slot(&self.device)?;
+        let acquire = self.frames.slots[slot].acquire;
+        let Some(image_index) = swapchain.acquire(&self.device, acquire)? else {
+            return Ok(None);
+        };
+        // From here on the acquire semaphore is signalled: every way out must consume it.
+        let prepared = match swapchain.view(image_index) {
+            Some(view) => self.prepare(view, slot, true).map(|p| (view, p)),
+            None => Err(GpuError::Surface(format!(
+                "acquired image {image_index} does not exist"
+            ))),
+        };
+        let (view, pipelines) = match prepared {
+            Ok(p) => p,
+            Err(e) => {
+                swapchain.stale = true;
+                self.frames.slots[slot].consume_acquire(&self.device);
+                return Err(e);
+            }
+        };
+        let target = FrameTarget::Swapchain {
+            swapchain,
+            image_index,
+        };
+        Ok(Some(Frame::new(
+            self.frame_context(pipelines),
+            target,
+            view,
+            slot,
+        )))
+    }
+
+    /// The fallible part of starting a frame: pipelines for the target, the slot's command
+    /// buffer begun, the attachments' barriers recorded.
+    fn prepare(
+        &mut self,
+        view: TargetView,
+        slot: usize,
+        swapchain: bool,
+    ) -> GpuResult<PipelineSet> {
+        let pipelines = *self
+            .pipelines
+            .get(&self.device, &self.shaders, pipeline_key(&view))?;
+        let frame_slot: &mut FrameSlot = &mut self.frames.slots[slot];
+        frame_slot.begin_commands(&self.device)?;
+        let barriers = barrier::begin_barriers(&view, swapchain);
+        // SAFETY: the slot's command buffer is recording (begun above, outside rendering);
+        // the images are live and owned by the target.
+        unsafe { barrier::record(&self.device.raw, frame_slot.cmd, &barriers) };
+        Ok(pipelines)
+    }
+
+    /// What a frame borrows from the renderer while it records.
+    fn frame_context(&mut self, pipelines: PipelineSet) -> FrameContext<'_> {
+        FrameContext {
+            device: &self.device,
+            ring: &mut self.frames,
+            grids: &mut self.grids,
+            uploader: &mut self.uploader,
+            layout: self.pipelines.layout,
+            pipelines,
+            font: self.font.as_ref().map_or(0, |f| f.address()),
+            always_flush: self.always_flush,
+        }
+    }
 }
 
 impl Drop for Renderer {
@@ -257,19 +422,12 @@ impl Drop for Renderer {
         }
         for orphan in std::mem::take(&mut self.orphans) {
             // SAFETY: the device is idle or lost, so no GPU work uses them.
-            unsafe {
-                match orphan {
-                    Orphan::Target(t) => t.destroy(&self.device),
-                    Orphan::Swapchain(s) => self.destroy_swapchain_now(s),
-                }
-            }
+            unsafe { self.destroy_orphan(orphan) };
         }
         let device = &*self.device;
         // SAFETY: the device is idle or lost, so no GPU work uses any of these objects.
         unsafe {
-            for f in std::mem::take(&mut self.frames) {
-                f.destroy(device);
-            }
+            self.frames.destroy(device);
             std::mem::take(&mut self.grids).destroy(device);
             std::mem::take(&mut self.uploader).destroy(device);
             if let Some(font) = self.font.take() {
@@ -287,5 +445,13 @@ impl Drop for Renderer {
             device.destroy();
             instance.destroy();
         }
+    }
+}
+
+/// Everything about a target that its pipelines bake in.
+fn pipeline_key(view: &TargetView) -> PipelineKey {
+    PipelineKey {
+        color_format: view.format,
+        samples: view.samples,
     }
 }

@@ -8,12 +8,12 @@ use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 
 use super::FRAMES_IN_FLIGHT;
 use super::device::Device;
-use super::error::{GpuError, GpuResult, VkResultExt};
-use super::frame::TargetView;
+use super::error::{GpuError, GpuResult, VkResultExt, vk_error};
 use super::image::{Attachments, create_view};
-use super::renderer::{Orphan, Renderer};
+use super::instance::Instance;
+use super::target::TargetView;
 
-/// Parameters for [`Renderer::create_swapchain`].
+/// Parameters for [`super::Renderer::create_swapchain`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SwapchainDesc {
     /// Window inner width in physical pixels (used when the surface does not dictate it).
@@ -22,11 +22,11 @@ pub struct SwapchainDesc {
     pub height: u32,
     /// `true`: FIFO (vsync). `false`: MAILBOX, else IMMEDIATE, else FIFO.
     pub vsync: bool,
-    /// MSAA sample count; 0 picks [`Renderer::default_samples`].
+    /// MSAA sample count; 0 picks [`super::Renderer::default_samples`].
     pub samples: u32,
 }
 
-/// A surface and its swapchain. Destroy with [`Renderer::destroy_swapchain`].
+/// A surface and its swapchain. Destroy with [`super::Renderer::destroy_swapchain`].
 ///
 /// It holds a reference to its window, so the window's handles stay valid for as long as the
 /// surface exists.
@@ -155,24 +155,24 @@ pub(crate) fn choose_present_mode(modes: &[vk::PresentModeKHR], vsync: bool) -> 
         .unwrap_or(vk::PresentModeKHR::FIFO)
 }
 
-impl Renderer {
-    /// Creates a surface for `window` and its swapchain. The renderer must have been created
-    /// with `RendererDesc::display` set to the window's display. The swapchain keeps `window`
-    /// alive (the surface must not outlive its window).
-    pub fn create_swapchain<W>(
-        &mut self,
+impl Swapchain {
+    /// Creates a surface for `window` and its swapchain (see
+    /// [`super::Renderer::create_swapchain`]).
+    pub(crate) fn new<W>(
+        instance: &Instance,
+        device: &Device,
         window: Arc<W>,
         desc: &SwapchainDesc,
-    ) -> GpuResult<Swapchain>
+    ) -> GpuResult<Self>
     where
         W: HasDisplayHandle + HasWindowHandle + Send + Sync + 'static,
     {
-        let surface_fn = self.instance.surface_fn.as_ref().ok_or_else(|| {
+        let surface_fn = instance.surface_fn.as_ref().ok_or_else(|| {
             GpuError::Surface(
                 "renderer was created without a display (RendererDesc::display)".into(),
             )
         })?;
-        if self.device.swapchain_fn.is_none() {
+        if device.swapchain_fn.is_none() {
             return Err(GpuError::Surface("device has no VK_KHR_swapchain".into()));
         }
         let display = window
@@ -186,20 +186,14 @@ impl Renderer {
         // SAFETY: the handles come from a live window, which the swapchain keeps alive (it
         // holds the Arc) until after the surface is destroyed.
         let surface = unsafe {
-            ash_window::create_surface(
-                &self.instance.entry,
-                &self.instance.raw,
-                display,
-                handle,
-                None,
-            )
+            ash_window::create_surface(&instance.entry, &instance.raw, display, handle, None)
         }
         .vk("vkCreate*SurfaceKHR")?;
         // SAFETY: valid physical device, queue family and surface.
         let supported = unsafe {
             surface_fn.get_physical_device_surface_support(
-                self.device.physical,
-                self.device.queue_family,
+                device.physical,
+                device.queue_family,
                 surface,
             )
         };
@@ -208,10 +202,10 @@ impl Renderer {
             unsafe { surface_fn.destroy_surface(surface, None) };
             return Err(GpuError::Surface(format!(
                 "{} cannot present to this window",
-                self.device.caps.name
+                device.caps.name
             )));
         }
-        let samples = match self.resolve_samples(desc.samples) {
+        let samples = match device.caps.resolve_samples(desc.samples) {
             Ok(s) => s,
             Err(e) => {
                 // SAFETY: the surface is unused.
@@ -239,116 +233,124 @@ impl Renderer {
             stale: true,
             retired: Vec::new(),
         };
-        if let Err(e) = self.rebuild_swapchain(&mut swapchain) {
+        if let Err(e) = swapchain.rebuild(instance, device, 0) {
             // SAFETY: the swapchain was just created: no frame ever rendered into its images.
-            unsafe { self.destroy_swapchain_now(swapchain) };
+            unsafe { swapchain.destroy(instance, device) };
             return Err(e);
         }
         Ok(swapchain)
     }
 
-    /// Rebuilds the swapchain for the current surface size. Returns `false` (and leaves no
-    /// images) when the surface has zero area, i.e. the window is minimised.
-    pub(crate) fn rebuild_swapchain(&mut self, sc: &mut Swapchain) -> GpuResult<bool> {
-        self.wait_idle()?;
-        let device = &*self.device;
-        let (Some(surface_fn), Some(swapchain_fn)) = (
-            self.instance.surface_fn.as_ref(),
-            device.swapchain_fn.as_ref(),
-        ) else {
+    /// Rebuilds the swapchain for the current surface size, after waiting for the device to
+    /// go idle; `frame_number` is the next frame's (it dates the retired predecessor).
+    /// Returns `false` (and leaves no images) when the surface has zero area, i.e. the window
+    /// is minimised.
+    pub(crate) fn rebuild(
+        &mut self,
+        instance: &Instance,
+        device: &Device,
+        frame_number: u64,
+    ) -> GpuResult<bool> {
+        device.wait_idle()?;
+        let (Some(surface_fn), Some(swapchain_fn)) =
+            (instance.surface_fn.as_ref(), device.swapchain_fn.as_ref())
+        else {
             return Err(GpuError::Surface("no surface support".into()));
         };
-        let old_images = sc.images.len();
+        let old_images = self.images.len();
         // SAFETY: the device is idle (waited above), so no frame renders into them.
-        unsafe { sc.destroy_images(device) };
-        // SAFETY: valid physical device and surface for all three queries.
-        let (caps, formats, modes) = unsafe {
-            (
-                surface_fn
-                    .get_physical_device_surface_capabilities(device.physical, sc.surface)
-                    .vk("vkGetPhysicalDeviceSurfaceCapabilitiesKHR")?,
-                surface_fn
-                    .get_physical_device_surface_formats(device.physical, sc.surface)
-                    .vk("vkGetPhysicalDeviceSurfaceFormatsKHR")?,
-                surface_fn
-                    .get_physical_device_surface_present_modes(device.physical, sc.surface)
-                    .vk("vkGetPhysicalDeviceSurfacePresentModesKHR")?,
-            )
-        };
-        // u32::MAX means "the swapchain decides"; otherwise the surface dictates the size.
-        let extent = if caps.current_extent.width != u32::MAX {
-            caps.current_extent
-        } else {
-            vk::Extent2D {
-                width: sc
-                    .wanted
-                    .width
-                    .clamp(caps.min_image_extent.width, caps.max_image_extent.width),
-                height: sc
-                    .wanted
-                    .height
-                    .clamp(caps.min_image_extent.height, caps.max_image_extent.height),
-            }
-        };
-        if extent.width == 0 || extent.height == 0 || sc.wanted.width == 0 || sc.wanted.height == 0
-        {
-            sc.extent = vk::Extent2D::default();
+        unsafe { self.destroy_images(device) };
+        let (caps, formats, modes) = self.surface_properties(surface_fn, device)?;
+        let Some(extent) = self.extent_for(&caps) else {
+            self.extent = vk::Extent2D::default();
             return Ok(false);
-        }
+        };
         let format = choose_format(&formats)
             .ok_or_else(|| GpuError::Surface("surface reports no formats".into()))?;
-        let present_mode = choose_present_mode(&modes, sc.vsync);
-        let mut image_count = caps.min_image_count + 1;
-        if caps.max_image_count > 0 {
-            image_count = image_count.min(caps.max_image_count);
-        }
-        let composite = [
-            vk::CompositeAlphaFlagsKHR::OPAQUE,
-            vk::CompositeAlphaFlagsKHR::INHERIT,
-            vk::CompositeAlphaFlagsKHR::PRE_MULTIPLIED,
-            vk::CompositeAlphaFlagsKHR::POST_MULTIPLIED,
-        ]
-        .into_iter()
-        .find(|c| caps.supported_composite_alpha.contains(*c))
-        .unwrap_or(vk::CompositeAlphaFlagsKHR::OPAQUE);
-        let old = sc.raw;
-        let info = vk::SwapchainCreateInfoKHR::default()
-            .surface(sc.surface)
-            .min_image_count(image_count)
-            .image_format(format.format)
-            .image_color_space(format.color_space)
-            .image_extent(extent)
-            .image_array_layers(1)
-            .image_usage(vk::ImageUsageFlags::COLOR_ATTACHMENT)
-            .image_sharing_mode(vk::SharingMode::EXCLUSIVE)
-            .pre_transform(caps.current_transform)
-            .composite_alpha(composite)
-            .present_mode(present_mode)
-            .clipped(true)
-            .old_swapchain(old);
+        let present_mode = choose_present_mode(&modes, self.vsync);
+        let old = self.raw;
+        let info = swapchain_info(self.surface, &caps, format, extent, present_mode, old);
         // SAFETY: parameters were validated against the surface capabilities above.
         let raw = unsafe { swapchain_fn.create_swapchain(&info, None) }.vk("vkCreateSwapchainKHR");
         if old != vk::SwapchainKHR::null() {
             // Passing it as old_swapchain retired it (even if creation failed); presentation
             // may still use it and its semaphores, so they are destroyed later.
-            sc.retired.push(Retired {
+            self.retired.push(Retired {
                 raw: old,
-                semaphores: std::mem::take(&mut sc.render_finished),
-                until: self.frame_number + (FRAMES_IN_FLIGHT + old_images.max(1)) as u64,
+                semaphores: std::mem::take(&mut self.render_finished),
+                until: frame_number + (FRAMES_IN_FLIGHT + old_images.max(1)) as u64,
             });
-            sc.raw = vk::SwapchainKHR::null();
+            self.raw = vk::SwapchainKHR::null();
         }
-        sc.raw = raw?;
-        sc.format = format;
-        sc.present_mode = present_mode;
-        sc.extent = extent;
+        self.raw = raw?;
+        self.format = format;
+        self.present_mode = present_mode;
+        self.extent = extent;
+        self.create_images(device, swapchain_fn)?;
+        self.stale = false;
+        Ok(true)
+    }
+
+    /// Capabilities, formats and present modes of the surface.
+    fn surface_properties(
+        &self,
+        surface_fn: &ash::khr::surface::Instance,
+        device: &Device,
+    ) -> GpuResult<SurfaceProperties> {
+        // SAFETY: valid physical device and surface for all three queries.
+        unsafe {
+            Ok((
+                surface_fn
+                    .get_physical_device_surface_capabilities(device.physical, self.surface)
+                    .vk("vkGetPhysicalDeviceSurfaceCapabilitiesKHR")?,
+                surface_fn
+                    .get_physical_device_surface_formats(device.physical, self.surface)
+                    .vk("vkGetPhysicalDeviceSurfaceFormatsKHR")?,
+                surface_fn
+                    .get_physical_device_surface_present_modes(device.physical, self.surface)
+                    .vk("vkGetPhysicalDeviceSurfacePresentModesKHR")?,
+            ))
+        }
+    }
+
+    /// The image size for the wanted window size, or `None` when either has zero area.
+    fn extent_for(&self, caps: &vk::SurfaceCapabilitiesKHR) -> Option<vk::Extent2D> {
+        // u32::MAX means "the swapchain decides"; otherwise the surface dictates the size.
+        let extent = if caps.current_extent.width != u32::MAX {
+            caps.current_extent
+        } else {
+            vk::Extent2D {
+                width: self
+                    .wanted
+                    .width
+                    .clamp(caps.min_image_extent.width, caps.max_image_extent.width),
+                height: self
+                    .wanted
+                    .height
+                    .clamp(caps.min_image_extent.height, caps.max_image_extent.height),
+            }
+        };
+        let empty = extent.width == 0
+            || extent.height == 0
+            || self.wanted.width == 0
+            || self.wanted.height == 0;
+        (!empty).then_some(extent)
+    }
+
+    /// Views, render-finished semaphores and attachments for the new swapchain's images.
+    fn create_images(
+        &mut self,
+        device: &Device,
+        swapchain_fn: &ash::khr::swapchain::Device,
+    ) -> GpuResult<()> {
         // SAFETY: valid swapchain.
-        sc.images =
-            unsafe { swapchain_fn.get_swapchain_images(sc.raw) }.vk("vkGetSwapchainImagesKHR")?;
-        for &image in &sc.images {
-            sc.views.push(create_view(device, image, format.format)?);
+        self.images =
+            unsafe { swapchain_fn.get_swapchain_images(self.raw) }.vk("vkGetSwapchainImagesKHR")?;
+        for &image in &self.images {
+            self.views
+                .push(create_view(device, image, self.format.format)?);
         }
-        while sc.render_finished.len() < sc.images.len() {
+        while self.render_finished.len() < self.images.len() {
             // SAFETY: valid device.
             let s = unsafe {
                 device
@@ -356,44 +358,85 @@ impl Renderer {
                     .create_semaphore(&vk::SemaphoreCreateInfo::default(), None)
             }
             .vk("vkCreateSemaphore")?;
-            sc.render_finished.push(s);
+            self.render_finished.push(s);
         }
-        sc.attachments = Some(Attachments::new(device, extent, format.format, sc.samples)?);
-        sc.stale = false;
-        Ok(true)
+        self.attachments = Some(Attachments::new(
+            device,
+            self.extent,
+            self.format.format,
+            self.samples,
+        )?);
+        Ok(())
     }
 
-    /// Destroys the swapchain and its surface (waits for the GPU first).
-    pub fn destroy_swapchain(&mut self, swapchain: Swapchain) -> GpuResult<()> {
-        match self.wait_idle() {
-            Ok(()) => {
-                // SAFETY: the device is idle.
-                unsafe { self.destroy_swapchain_now(swapchain) };
-                Ok(())
+    /// Acquires the next image, signalling `semaphore`. `None` when the swapchain is out of
+    /// date (it is marked stale; skip the frame).
+    pub(crate) fn acquire(
+        &mut self,
+        device: &Device,
+        semaphore: vk::Semaphore,
+    ) -> GpuResult<Option<u32>> {
+        let Some(swapchain_fn) = device.swapchain_fn.as_ref() else {
+            return Err(GpuError::Surface("device has no VK_KHR_swapchain".into()));
+        };
+        let limit = u64::try_from(super::WAIT_LIMIT.as_nanos()).unwrap_or(u64::MAX);
+        // SAFETY: valid swapchain; the caller's semaphore is unsignalled and not in use (its
+        // previous waiter, the slot's last submission, has completed).
+        let acquired = unsafe {
+            swapchain_fn.acquire_next_image(self.raw, limit, semaphore, vk::Fence::null())
+        };
+        match acquired {
+            Ok((index, suboptimal)) => {
+                // Still presentable; rebuild after this frame.
+                self.stale |= suboptimal;
+                Ok(Some(index))
             }
-            Err(e) if e.is_device_lost() => {
-                // SAFETY: nothing executes on a lost device.
-                unsafe { self.destroy_swapchain_now(swapchain) };
-                Err(e)
+            Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => {
+                self.stale = true;
+                Ok(None)
             }
-            Err(e) => {
-                // Work may still render into its images: keep it until the renderer goes.
-                self.orphans.push(Orphan::Swapchain(swapchain));
-                Err(e)
-            }
+            Err(result) => Err(vk_error("vkAcquireNextImageKHR", result)),
         }
     }
 
-    /// Destroys retired swapchains whose presents are surely done (`all`: every one, at
-    /// teardown after the device went idle).
-    pub(crate) fn collect_retired(&self, sc: &mut Swapchain, all: bool) {
-        let device = &*self.device;
+    /// Presents image `index` once `wait` is signalled; an out-of-date or suboptimal
+    /// swapchain is marked for rebuilding.
+    pub(crate) fn present(
+        &mut self,
+        device: &Device,
+        index: u32,
+        wait: vk::Semaphore,
+    ) -> GpuResult<()> {
+        let Some(swapchain_fn) = device.swapchain_fn.as_ref() else {
+            return Ok(());
+        };
+        let swapchains = [self.raw];
+        let indices = [index];
+        let waits = [wait];
+        let info = vk::PresentInfoKHR::default()
+            .wait_semaphores(&waits)
+            .swapchains(&swapchains)
+            .image_indices(&indices);
+        // SAFETY: the image was acquired this frame and its semaphore is signalled by the
+        // frame's submission.
+        let result = unsafe { swapchain_fn.queue_present(device.queue, &info) };
+        let stale = match result {
+            Ok(suboptimal) => suboptimal,
+            Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => true,
+            Err(result) => return Err(vk_error("vkQueuePresentKHR", result)),
+        };
+        self.stale |= stale;
+        Ok(())
+    }
+
+    /// Destroys retired swapchains whose presents are surely done, given the next frame's
+    /// number (`all`: every one, at teardown after the device went idle).
+    pub(crate) fn collect_retired(&mut self, device: &Device, frame_number: u64, all: bool) {
         let Some(swapchain_fn) = device.swapchain_fn.as_ref() else {
             return;
         };
-        let frame = self.frame_number;
-        sc.retired.retain(|r| {
-            if !all && frame < r.until {
+        self.retired.retain(|r| {
+            if !all && frame_number < r.until {
                 return true;
             }
             // SAFETY: `until` frames have been submitted since the swapchain was retired, so the
@@ -413,28 +456,72 @@ impl Renderer {
     ///
     /// # Safety
     /// The device must be idle or lost (no frame renders into its images).
-    pub(crate) unsafe fn destroy_swapchain_now(&mut self, mut sc: Swapchain) {
-        self.collect_retired(&mut sc, true);
-        let device = &*self.device;
+    pub(crate) unsafe fn destroy(mut self, instance: &Instance, device: &Device) {
+        self.collect_retired(device, 0, true);
         // SAFETY: the caller guarantees an idle (or lost) device.
-        unsafe { sc.destroy_images(device) };
+        unsafe { self.destroy_images(device) };
         if let Some(f) = device.swapchain_fn.as_ref()
-            && sc.raw != vk::SwapchainKHR::null()
+            && self.raw != vk::SwapchainKHR::null()
         {
             // SAFETY: idle device, swapchain destroyed once.
-            unsafe { f.destroy_swapchain(sc.raw, None) };
+            unsafe { f.destroy_swapchain(self.raw, None) };
         }
-        for s in sc.render_finished.drain(..) {
+        for s in self.render_finished.drain(..) {
             // SAFETY: the device is idle and the swapchain that presented with these
             // semaphores is gone. Present completion itself cannot be observed without
             // VK_EXT_swapchain_maintenance1; this is the teardown order the Vulkan samples use.
             unsafe { device.raw.destroy_semaphore(s, None) };
         }
-        if let Some(f) = self.instance.surface_fn.as_ref() {
+        if let Some(f) = instance.surface_fn.as_ref() {
             // SAFETY: the swapchain using the surface is gone.
-            unsafe { f.destroy_surface(sc.surface, None) };
+            unsafe { f.destroy_surface(self.surface, None) };
         }
     }
+}
+
+type SurfaceProperties = (
+    vk::SurfaceCapabilitiesKHR,
+    Vec<vk::SurfaceFormatKHR>,
+    Vec<vk::PresentModeKHR>,
+);
+
+/// The create info of a swapchain on `surface`: one image more than the minimum, opaque
+/// composition where supported.
+fn swapchain_info(
+    surface: vk::SurfaceKHR,
+    caps: &vk::SurfaceCapabilitiesKHR,
+    format: vk::SurfaceFormatKHR,
+    extent: vk::Extent2D,
+    present_mode: vk::PresentModeKHR,
+    old: vk::SwapchainKHR,
+) -> vk::SwapchainCreateInfoKHR<'static> {
+    let mut image_count = caps.min_image_count + 1;
+    if caps.max_image_count > 0 {
+        image_count = image_count.min(caps.max_image_count);
+    }
+    let composite = [
+        vk::CompositeAlphaFlagsKHR::OPAQUE,
+        vk::CompositeAlphaFlagsKHR::INHERIT,
+        vk::CompositeAlphaFlagsKHR::PRE_MULTIPLIED,
+        vk::CompositeAlphaFlagsKHR::POST_MULTIPLIED,
+    ]
+    .into_iter()
+    .find(|c| caps.supported_composite_alpha.contains(*c))
+    .unwrap_or(vk::CompositeAlphaFlagsKHR::OPAQUE);
+    vk::SwapchainCreateInfoKHR::default()
+        .surface(surface)
+        .min_image_count(image_count)
+        .image_format(format.format)
+        .image_color_space(format.color_space)
+        .image_extent(extent)
+        .image_array_layers(1)
+        .image_usage(vk::ImageUsageFlags::COLOR_ATTACHMENT)
+        .image_sharing_mode(vk::SharingMode::EXCLUSIVE)
+        .pre_transform(caps.current_transform)
+        .composite_alpha(composite)
+        .present_mode(present_mode)
+        .clipped(true)
+        .old_swapchain(old)
 }
 
 #[cfg(test)]

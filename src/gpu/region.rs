@@ -1,0 +1,154 @@
+//! Where a draw's data lies inside a mirror: a grid surface, a batch of surfaces of one
+//! shape, a run of points. Offsets and strides are in f32 elements.
+
+use super::error::{GpuError, GpuResult};
+use super::grid::{GridShape, GridStride};
+
+/// A surface's vertices inside a mirror: `shape.rows × shape.cols` vertices of 6 floats
+/// (position xyz, normal xyz), row-major, starting at float `offset`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SurfaceGrid {
+    /// Float offset of vertex (0, 0).
+    pub offset: usize,
+    /// Grid shape.
+    pub shape: GridShape,
+}
+
+impl SurfaceGrid {
+    /// Floats per surface vertex.
+    pub const FLOATS_PER_VERTEX: usize = 6;
+
+    /// Number of floats the grid occupies.
+    pub fn floats(&self) -> usize {
+        self.shape.vertices() as usize * Self::FLOATS_PER_VERTEX
+    }
+}
+
+/// Surfaces of one grid shape, each at its own float offset in one mirror, drawn with one
+/// stride in one call: many small patches (a teapot's 32, a scene's thousands) cost one
+/// multi-draw (`VK_EXT_multi_draw`) instead of a draw each, and surfaces stored back to back
+/// (each offset the previous one's end) are a single range of a repeated index buffer
+/// within it. Offsets must be congruent modulo [`SurfaceGrid::FLOATS_PER_VERTEX`] (vertices
+/// of one mirror bound once).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SurfaceBatch<'a> {
+    /// Shape shared by every surface.
+    pub shape: GridShape,
+    /// Rows and columns drawn (display level of detail).
+    pub stride: GridStride,
+    /// Float offset of each surface's vertex (0, 0).
+    pub offsets: &'a [usize],
+}
+
+impl SurfaceBatch<'_> {
+    /// Checks the batch against a mirror of `mirror_len` floats; returns the byte offset to
+    /// bind the vertices at and the batch's runs: (vertex offset from there, number of
+    /// surfaces stored back to back).
+    pub(crate) fn runs(&self, mirror_len: usize) -> GpuResult<(u64, Vec<(i32, u32)>)> {
+        let batch = self;
+        batch.shape.validate()?;
+        let per = SurfaceGrid::FLOATS_PER_VERTEX;
+        let floats = SurfaceGrid {
+            offset: 0,
+            shape: batch.shape,
+        }
+        .floats();
+        let residue = batch.offsets.first().map_or(0, |o| o % per);
+        let mut runs: Vec<(i32, u32)> = Vec::with_capacity(batch.offsets.len());
+        let mut next = None;
+        for &offset in batch.offsets {
+            let fits = offset
+                .checked_add(floats)
+                .is_some_and(|end| end <= mirror_len);
+            let vertex = i32::try_from((offset - offset % per) / per).ok();
+            match vertex {
+                Some(v) if fits && offset % per == residue => {
+                    match runs.last_mut() {
+                        // Right after the previous surface: the same run.
+                        Some(run) if next == Some(offset) => run.1 += 1,
+                        _ => runs.push((v, 1)),
+                    }
+                    next = Some(offset + floats);
+                }
+                _ => {
+                    return Err(GpuError::InvalidArgument(format!(
+                        "surface grid {}x{} at float {offset} does not fit a mirror of {} \
+                         floats (or its offset is not {residue} modulo {per})",
+                        batch.shape.rows, batch.shape.cols, mirror_len
+                    )));
+                }
+            }
+        }
+        Ok((residue as u64 * 4, runs))
+    }
+}
+
+/// A run of points inside a float buffer: point `i` is `xyz` at floats
+/// `offset + i*stride ..+3`. Covers tight runs (stride 3), the positions of surface vertices
+/// (stride 6) and columns of row-major grids (stride = row length × floats per vertex).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PointRun {
+    /// Float offset of point 0.
+    pub offset: usize,
+    /// Floats between consecutive points (≥ 3).
+    pub stride: usize,
+    /// Number of points.
+    pub count: usize,
+}
+
+impl PointRun {
+    /// `count` tightly packed xyz points starting at point index `first`.
+    pub fn packed(first: usize, count: usize) -> Self {
+        Self {
+            offset: first * 3,
+            stride: 3,
+            count,
+        }
+    }
+
+    /// Row `row` of a row-major grid of `cols` points with `floats_per_point` floats each,
+    /// starting at float `base`.
+    pub fn grid_row(base: usize, cols: usize, floats_per_point: usize, row: usize) -> Self {
+        Self {
+            offset: base + row * cols * floats_per_point,
+            stride: floats_per_point,
+            count: cols,
+        }
+    }
+
+    /// Column `col` of a row-major grid of `rows × cols` points (no copy: strided access).
+    pub fn grid_column(
+        base: usize,
+        rows: usize,
+        cols: usize,
+        floats_per_point: usize,
+        col: usize,
+    ) -> Self {
+        Self {
+            offset: base + col * floats_per_point,
+            stride: cols * floats_per_point,
+            count: rows,
+        }
+    }
+
+    pub(crate) fn check(&self, len: usize, min_count: usize) -> GpuResult<()> {
+        // One past the last float read; the shader's u32 index arithmetic stays below it.
+        let end = self
+            .count
+            .checked_sub(1)
+            .and_then(|n| n.checked_mul(self.stride))
+            .and_then(|n| n.checked_add(self.offset))
+            .and_then(|n| n.checked_add(3));
+        let ok = self.count >= min_count.max(1)
+            && self.stride >= 3
+            && end.is_some_and(|end| end <= len && u32::try_from(end).is_ok());
+        if ok {
+            Ok(())
+        } else {
+            Err(GpuError::InvalidArgument(format!(
+                "point run {self:?} does not fit a buffer of {len} floats \
+                 (or has fewer than {min_count} points / stride < 3)"
+            )))
+        }
+    }
+}
