@@ -1,34 +1,32 @@
 #version 460
-// HUD triangles: solid (negative font coordinates) or one quad per character whose fragments
-// look their font pixel up in the 5x7 glyph table (one uint of 5 bits per glyph row, bit 4 the
-// leftmost column); glyph g occupies font x in [8g, 8g + 5).
+// HUD triangles: solid (negative atlas coordinates) or glyph quads whose fragments take their
+// alpha from the glyph atlas: one coverage byte per texel, row-major, `atlas_width` bytes a
+// row, read as 32-bit words. Quads are texel-exact (one texel per pixel), so no filtering.
 #extension GL_EXT_buffer_reference : require
 
-layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer Font {
-    uint rows[];
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer Atlas {
+    uint words[];
 };
 
 layout(push_constant) uniform Push {
     vec2 viewport;
-    Font font;
+    Atlas atlas;
+    uint atlas_width;
 } pc;
 
 layout(location = 0) in vec4 v_color;
 layout(location = 1) in vec2 v_glyph;
 layout(location = 0) out vec4 out_color;
 
-const uint GLYPHS = 95u;
-
 void main() {
+    out_color = v_color;
     if (v_glyph.x >= 0.0) {
-        uint x = uint(v_glyph.x);
-        uint glyph = x / 8u;
-        uint col = x % 8u;
-        uint row = uint(max(v_glyph.y, 0.0));
-        if (glyph >= GLYPHS || col >= 5u || row >= 7u
-            || (pc.font.rows[glyph * 7u + row] & (0x10u >> col)) == 0u) {
+        uvec2 texel = uvec2(max(v_glyph, vec2(0.0)));
+        uint at = texel.y * pc.atlas_width + min(texel.x, pc.atlas_width - 1u);
+        uint coverage = (pc.atlas.words[at >> 2u] >> ((at & 3u) * 8u)) & 0xffu;
+        if (coverage == 0u) {
             discard;
         }
+        out_color.a *= float(coverage) / 255.0;
     }
-    out_color = v_color;
 }

@@ -1,10 +1,10 @@
 #version 460
 // Screen-space triangles in pixel coordinates (origin top-left, y down) for the HUD.
-// Vertex colours are sRGB-encoded RGBA8; glyph quads carry font coordinates (overlay.frag).
+// Vertex colours are sRGB-encoded RGBA8; glyph quads carry atlas coordinates (overlay.frag).
 #extension GL_EXT_buffer_reference : require
 
-layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer Font {
-    uint rows[];
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer Atlas {
+    uint words[];
 };
 
 layout(location = 0) in vec2 in_pos;
@@ -13,7 +13,8 @@ layout(location = 2) in vec2 in_glyph;
 
 layout(push_constant) uniform Push {
     vec2 viewport;
-    Font font;
+    Atlas atlas;
+    uint atlas_width;
 } pc;
 
 layout(location = 0) out vec4 v_color;

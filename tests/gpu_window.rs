@@ -12,7 +12,7 @@ mod common;
 use std::time::Duration;
 
 use glam::Vec3;
-use prespline::gpu::font::{push_rect, push_text};
+use prespline::gpu::font::{TextSize, push_rect};
 use prespline::gpu::{
     Fault, GpuError, GridShape, Mirror, PolylineStyle, Renderer, RendererDesc, SurfaceGrid,
     SurfaceStyle, Swapchain, SwapchainDesc, ValidationMode, ValidationSink, vk,
@@ -188,12 +188,12 @@ impl App {
             .map_err(|e| e.to_string())?;
         let mut hud = Vec::new();
         push_rect(&mut hud, 0.0, 0.0, w as f32, 20.0, [0, 0, 0, 128]);
-        push_text(
+        frame.font().push_text(
             &mut hud,
             &format!("frame {} {w}x{h}", frame.number()),
             4.0,
-            4.0,
-            1.0,
+            2.0,
+            TextSize::Small,
             [255, 255, 255, 255],
         );
         frame.draw_overlay(&hud).map_err(|e| e.to_string())?;

@@ -570,3 +570,84 @@ fn script_times_out_of_reach_are_one_line_errors() {
         );
     }
 }
+
+/// Screenshots with the HUD: the frame after a drag step (its slot still lacks that step's
+/// rows, while the screenshot's slot has them), and once idle.
+const DRAG_SCRIPT: &str = r#"[
+ {"frame": 3, "move_to": {"object": "bspline_surface", "point": [3, 4]}},
+ {"frame": 4, "press": "left"},
+ {"frame": 5, "move_by": [0, -20]},
+ {"frame": 6, "move_by": [0, -20]},
+ {"frame": 7, "screenshot": "SHOT7", "hud": true},
+ {"frame": 8, "release": "left"},
+ {"frame": 12, "screenshot": "SHOT12", "hud": true},
+ {"frame": 13, "quit": true}
+]"#;
+
+/// The "KB to GPU" figure of the HUD's second line, read back from a screenshot.
+fn kb_to_gpu(shot: &std::path::Path) -> (String, String) {
+    use prespline::gpu::font::{Font, TextSize};
+    use prespline::render::analysis::PANEL;
+    use prespline::view::hud::TEXT;
+    let px = Pixels::read_png(shot).unwrap();
+    let font = Font::new(1.0);
+    let line = font.metrics(TextSize::Normal).line_height + 2;
+    let read = |row: u32| {
+        let at = [16, 14 + row * line];
+        common::read_text(&px, &font, TextSize::Normal, at, 48, PANEL, TEXT)
+    };
+    // The reader reads what is there: the first line is the frame time.
+    assert!(read(0).starts_with("frame "), "{:?}", read(0));
+    let edit = read(1);
+    let kb = edit
+        .split(" KB to GPU")
+        .next()
+        .and_then(|s| s.rsplit(' ').next())
+        .filter(|n| n.parse::<f64>().is_ok())
+        .unwrap_or_else(|| panic!("no KB figure in {edit:?}"))
+        .to_string();
+    (edit, kb)
+}
+
+/// A viewer screenshot shows the figures of the window frame it reproduces: the bytes that
+/// frame copied to the GPU as the profile recorded them (the screenshot's own upload, of its
+/// own frame slot, used to replace them, often by 0).
+#[test]
+fn screenshots_show_the_bytes_their_frame_copied() {
+    if !common::display() {
+        return;
+    }
+    let dir = Scratch::new("view-kb");
+    let frames = [7, 12];
+    let mut script = DRAG_SCRIPT.to_string();
+    for f in frames {
+        let shot = dir.join(format!("shot{f}.png"));
+        script = script.replace(
+            &format!("\"SHOT{f}\""),
+            &format!("{:?}", shot.to_str().unwrap()),
+        );
+    }
+    let script = dir.file("script.json", &script);
+    let profile = dir.join("profile");
+    let out = run(prespline(&dir)
+        .args(["view", "--size", "800x600", "--script"])
+        .arg(&script)
+        .arg("--profile")
+        .arg(&profile));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "viewer failed: {err}");
+    let csv = std::fs::read_to_string(profile.join("frames.csv")).unwrap();
+    let bytes: Vec<u64> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(11).unwrap().parse().unwrap())
+        .collect();
+    let mut nonzero = 0;
+    for f in frames {
+        let (line, kb) = kb_to_gpu(&dir.join(format!("shot{f}.png")));
+        let recorded = format!("{:.1}", bytes[f] as f64 / 1024.0);
+        assert_eq!(kb, recorded, "frame {f}: {line:?}, profile {bytes:?}");
+        nonzero += usize::from(bytes[f] > 0);
+    }
+    assert_eq!(nonzero, 1, "frame 7 copies frame 6's rows: {bytes:?}");
+}

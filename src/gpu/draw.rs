@@ -474,8 +474,9 @@ impl Frame<'_> {
         Ok(())
     }
 
-    /// Draws alpha-blended triangles in pixel coordinates of the current viewport (no depth).
-    /// See [`super::font`] for text.
+    /// Draws alpha-blended triangles in pixel coordinates of the current viewport (no depth),
+    /// in order (later triangles over earlier ones). Text quads come from
+    /// [`Frame::font`]'s [`super::font::Font::push_text`].
     pub fn draw_overlay(&mut self, vertices: &[OverlayVertex]) -> GpuResult<()> {
         let count = vertices.len() / 3 * 3;
         if count == 0 {
@@ -485,6 +486,8 @@ impl Frame<'_> {
         let push = OverlayPush {
             viewport: self.viewport_size(),
             font: self.ctx.font,
+            atlas_width: self.ctx.text.atlas_size()[0],
+            _pad: 0,
         };
         self.bind_and_push(self.ctx.pipelines.overlay, &push);
         self.draw_transient(alloc, count as u32);

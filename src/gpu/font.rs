@@ -1,64 +1,279 @@
-//! A tiny built-in 5×7 bitmap font for HUD text, drawn as overlay quads.
+//! Overlay text: DejaVu Sans Mono (embedded, Bitstream Vera licence, see
+//! `assets/fonts/`) rasterised with `ab_glyph` into a glyph atlas of 8-bit coverage, built once
+//! per scale factor at the pixel sizes of [`TextSize`].
 //!
-//! Glyphs cover printable ASCII (32..=126); anything else renders as `?`. Each glyph is
-//! 7 rows of 5 bits, bit 4 being the leftmost column. Text is laid out on a 6×9 cell
-//! (one column and two rows of spacing) scaled by an integer-ish `scale` in pixels.
-//!
-//! Each character is one quad; the overlay fragment shader looks its font pixels up in the
-//! glyph table (uploaded once by the renderer), so a line of text costs two triangles per
-//! character rather than one quad per lit run of font pixels.
+//! The layout is monospace on whole pixels: every character advances a whole number of pixels
+//! and every glyph quad starts on a pixel corner, so each pixel of a quad reads exactly one
+//! atlas texel (no filtering, no blur). The overlay fragment shader reads the coverage from
+//! the atlas (a byte array in a storage buffer, through its device address) and uses it as
+//! alpha. Characters the atlas lacks are drawn as `?`.
+
+use ab_glyph::{Font as _, FontRef, PxScale, ScaleFont, point};
 
 use super::vertex::OverlayVertex;
 
-/// Glyph width in font pixels.
-pub const GLYPH_WIDTH: u32 = 5;
-/// Glyph height in font pixels.
-pub const GLYPH_HEIGHT: u32 = 7;
-/// Horizontal advance per character in font pixels.
-pub const ADVANCE: u32 = 6;
-/// Line height in font pixels.
-pub const LINE_HEIGHT: u32 = 9;
+/// DejaVu Sans Mono Book, as shipped by Debian's `fonts-dejavu-core`.
+pub const FONT_TTF: &[u8] = include_bytes!("../../assets/fonts/DejaVuSansMono.ttf");
 
-/// Rows of the glyph for `c` (printable ASCII, else `?`).
-pub fn glyph(c: char) -> &'static [u8; 7] {
-    &FONT[glyph_index(c) as usize]
+/// The text sizes the atlas holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum TextSize {
+    /// HUD, status line, legends, badges, the help on roomy windows.
+    Normal,
+    /// The help where the normal size does not fit.
+    Small,
 }
 
-/// The glyph table as the overlay shader reads it: row `r` of glyph `g` at `7 g + r`.
-pub(crate) fn glyph_rows() -> Vec<u32> {
-    FONT.iter().flatten().map(|&r| u32::from(r)).collect()
-}
+impl TextSize {
+    /// Every size, in atlas order.
+    pub const ALL: [TextSize; 2] = [TextSize::Normal, TextSize::Small];
 
-/// Index of `c` in the glyph table (printable ASCII, else `?`).
-fn glyph_index(c: char) -> u32 {
-    let code = c as u32;
-    if (32..=126).contains(&code) {
-        code - 32
-    } else {
-        u32::from(b'?') - 32
+    /// Line height (ascent − descent) in pixels at scale factor 1.
+    fn height(self) -> f32 {
+        match self {
+            TextSize::Normal => 18.0,
+            TextSize::Small => 12.0,
+        }
+    }
+
+    fn index(self) -> usize {
+        self as usize
     }
 }
 
-/// Size in pixels of `text` (which may contain `\n`) at `scale` pixels per font pixel.
-pub fn text_size(text: &str, scale: f32) -> [f32; 2] {
-    let lines = text.split('\n');
-    let mut widest = 0usize;
-    let mut count = 0usize;
-    for line in lines {
-        widest = widest.max(line.chars().count());
-        count += 1;
+/// The characters of the atlas besides printable ASCII: Latin-1 letters and signs, and the
+/// Greek letters and symbols that messages about curves use.
+const EXTRA: &str = "¡¢£§©«°±²³µ·¹º»¼½¾¿ÀÁÂÃÄÅÆÇÈÉÊËÌÍÎÏÐÑÒÓÔÕÖ×ØÙÚÛÜÝÞßàáâãäåæçèéêëìíîïðñòóôõö÷øùúûüýþÿ\
+                     ΑΒΓΔΕΖΗΘΙΚΛΜΝΞΟΠΡΣΤΥΦΧΨΩαβγδεζηθικλμνξοπρστυφχψωϕ\
+                     ‐–—‘’“”•…′″→←↑↓−√∞≈≠≤≥∂∫·⁻⁰⁴⁵⁶⁷⁸⁹";
+
+/// Columns of cells per atlas row.
+const ATLAS_COLUMNS: u32 = 32;
+
+/// Where one size's cells lie in the atlas, and its metrics in whole pixels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SizeMetrics {
+    /// Horizontal advance per character.
+    pub advance: u32,
+    /// Distance between baselines of consecutive lines.
+    pub line_height: u32,
+    /// Cell (quad) size: one pixel wider than the advance, so glyphs that touch the advance
+    /// are not clipped; neighbouring quads overlap by that pixel.
+    pub cell: [u32; 2],
+    /// Atlas row of this size's first cell row.
+    top: u32,
+}
+
+/// The overlay font at one scale factor: metrics per [`TextSize`] and the atlas.
+pub struct Font {
+    scale_factor: f32,
+    sizes: [SizeMetrics; 2],
+    /// Characters in atlas order (cell `i` of each size is `chars[i]`).
+    chars: Vec<char>,
+    /// Cell of `?`, drawn for characters the atlas lacks.
+    fallback: usize,
+    atlas: Vec<u8>,
+    width: u32,
+    height: u32,
+}
+
+impl std::fmt::Debug for Font {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Font")
+            .field("scale_factor", &self.scale_factor)
+            .field("sizes", &self.sizes)
+            .field("atlas", &[self.width, self.height])
+            .finish()
     }
-    let w = if widest == 0 {
-        0
-    } else {
-        widest as u32 * ADVANCE - 1
-    };
-    let h = count as u32 * LINE_HEIGHT - (LINE_HEIGHT - GLYPH_HEIGHT);
-    [w as f32 * scale, h as f32 * scale]
+}
+
+impl Font {
+    /// Rasterises the atlas for a window whose scale factor (physical pixels per logical
+    /// pixel) is `scale_factor`; non-finite or non-positive values mean 1.
+    #[must_use]
+    pub fn new(scale_factor: f32) -> Self {
+        let scale_factor = if scale_factor.is_finite() && scale_factor > 0.0 {
+            scale_factor.clamp(0.5, 8.0)
+        } else {
+            1.0
+        };
+        let face = FontRef::try_from_slice(FONT_TTF).expect("the embedded font parses");
+        let mut chars: Vec<char> = (' '..='~').chain(EXTRA.chars()).collect();
+        chars.retain(|&c| c == ' ' || face.glyph_id(c).0 != 0);
+        chars.dedup();
+        let rows = (chars.len() as u32).div_ceil(ATLAS_COLUMNS);
+        let mut sizes = [SizeMetrics {
+            advance: 0,
+            line_height: 0,
+            cell: [0, 0],
+            top: 0,
+        }; 2];
+        let mut top = 0;
+        for size in TextSize::ALL {
+            let scaled = face.as_scaled(PxScale::from(size.height() * scale_factor));
+            let advance = scaled.h_advance(face.glyph_id('M')).round().max(1.0) as u32;
+            let line_height = scaled.height().ceil().max(1.0) as u32;
+            sizes[size.index()] = SizeMetrics {
+                advance,
+                line_height,
+                cell: [advance + 1, line_height],
+                top,
+            };
+            top += rows * line_height;
+        }
+        let width = ATLAS_COLUMNS * sizes.iter().map(|s| s.cell[0]).max().unwrap_or(1);
+        let mut font = Self {
+            scale_factor,
+            sizes,
+            fallback: chars.iter().position(|&c| c == '?').unwrap_or(0),
+            chars,
+            atlas: vec![0; (width * top) as usize],
+            width,
+            height: top,
+        };
+        for size in TextSize::ALL {
+            font.rasterise(&face, size);
+        }
+        font
+    }
+
+    /// Draws every glyph of `size` into its cell, baseline at the rounded ascent.
+    fn rasterise(&mut self, face: &FontRef<'_>, size: TextSize) {
+        let m = self.sizes[size.index()];
+        let px = PxScale::from(size.height() * self.scale_factor);
+        let ascent = face.as_scaled(px).ascent().round();
+        for (i, &c) in self.chars.iter().enumerate() {
+            let [cx, cy] = self.cell_origin(m, i);
+            let glyph = face
+                .glyph_id(c)
+                .with_scale_and_position(px, point(0.0, ascent));
+            let Some(outline) = face.outline_glyph(glyph) else {
+                continue;
+            };
+            let bounds = outline.px_bounds();
+            let (w, atlas) = (self.width, &mut self.atlas);
+            outline.draw(|x, y, coverage| {
+                let gx = bounds.min.x as i64 + i64::from(x);
+                let gy = bounds.min.y as i64 + i64::from(y);
+                let inside = (0..i64::from(m.cell[0])).contains(&gx)
+                    && (0..i64::from(m.cell[1])).contains(&gy);
+                if inside {
+                    let at = (cy + gy as u32) * w + cx + gx as u32;
+                    let v = (coverage.clamp(0.0, 1.0) * 255.0).round() as u8;
+                    let texel = &mut atlas[at as usize];
+                    *texel = (*texel).max(v);
+                }
+            });
+        }
+    }
+
+    fn cell_origin(&self, m: SizeMetrics, index: usize) -> [u32; 2] {
+        let (col, row) = (index as u32 % ATLAS_COLUMNS, index as u32 / ATLAS_COLUMNS);
+        [col * m.cell[0], m.top + row * m.cell[1]]
+    }
+
+    /// The scale factor the atlas was built for.
+    pub fn scale_factor(&self) -> f32 {
+        self.scale_factor
+    }
+
+    /// Metrics of `size`, in physical pixels.
+    pub fn metrics(&self, size: TextSize) -> SizeMetrics {
+        self.sizes[size.index()]
+    }
+
+    /// The atlas: one coverage byte per texel, rows of [`Font::atlas_size`]`[0]` bytes.
+    pub fn atlas(&self) -> &[u8] {
+        &self.atlas
+    }
+
+    /// Atlas width and height in texels.
+    pub fn atlas_size(&self) -> [u32; 2] {
+        [self.width, self.height]
+    }
+
+    /// The atlas cell of `c` (the fallback `?` when the atlas lacks it).
+    fn cell_index(&self, c: char) -> usize {
+        self.chars
+            .iter()
+            .position(|&x| x == c)
+            .unwrap_or(self.fallback)
+    }
+
+    /// The coverage of `c` at `size`, a `cell[0] × cell[1]` bitmap, row-major: what a quad
+    /// of [`Font::push_text`] shows for it.
+    pub fn glyph_cell(&self, c: char, size: TextSize) -> Vec<u8> {
+        let m = self.metrics(size);
+        let [cx, cy] = self.cell_origin(m, self.cell_index(c));
+        let mut out = Vec::with_capacity((m.cell[0] * m.cell[1]) as usize);
+        for y in 0..m.cell[1] {
+            let start = ((cy + y) * self.width + cx) as usize;
+            out.extend_from_slice(&self.atlas[start..start + m.cell[0] as usize]);
+        }
+        out
+    }
+
+    /// Size in pixels of `text` (which may contain `\n`) at `size`.
+    pub fn text_size(&self, text: &str, size: TextSize) -> [f32; 2] {
+        let m = self.metrics(size);
+        let mut widest = 0usize;
+        let mut lines = 0u32;
+        for line in text.split('\n') {
+            widest = widest.max(line.chars().count());
+            lines += 1;
+        }
+        [
+            (widest as u32 * m.advance) as f32,
+            (lines * m.line_height) as f32,
+        ]
+    }
+
+    /// How many characters of `size` fit on a line `width` pixels wide.
+    pub fn chars_fitting(&self, width: f32, size: TextSize) -> usize {
+        (width.max(0.0) / self.metrics(size).advance as f32).floor() as usize
+    }
+
+    /// Appends one quad per visible character drawing `text` with its top-left corner at
+    /// `(x, y)` (pixels, y down; rounded to whole pixels) in sRGB colour `color`. Returns the
+    /// advance width in pixels of the longest line.
+    pub fn push_text(
+        &self,
+        out: &mut Vec<OverlayVertex>,
+        text: &str,
+        x: f32,
+        y: f32,
+        size: TextSize,
+        color: [u8; 4],
+    ) -> f32 {
+        let m = self.metrics(size);
+        let (x, y) = (x.round(), y.round());
+        let [cw, ch] = [m.cell[0] as f32, m.cell[1] as f32];
+        let mut widest = 0.0f32;
+        for (line_no, line) in text.split('\n').enumerate() {
+            let top = y + (line_no as u32 * m.line_height) as f32;
+            let mut left = x;
+            for c in line.chars() {
+                if !c.is_whitespace() {
+                    let [gx, gy] = self.cell_origin(m, self.cell_index(c));
+                    let g0 = [gx as f32, gy as f32];
+                    push_quad(
+                        out,
+                        [left, top, cw, ch],
+                        color,
+                        g0,
+                        [g0[0] + cw, g0[1] + ch],
+                    );
+                }
+                left += m.advance as f32;
+            }
+            widest = widest.max(left - x);
+        }
+        widest
+    }
 }
 
 /// Appends a quad (two triangles) from `(x, y)` to `(x + w, y + h)` in pixels whose corners
-/// carry font coordinates `g0` and `g1` (see [`OverlayVertex::glyph`]).
+/// carry atlas coordinates `g0` and `g1` (see [`OverlayVertex::glyph`]).
 fn push_quad(
     out: &mut Vec<OverlayVertex>,
     [x, y, w, h]: [f32; 4],
@@ -87,179 +302,65 @@ pub fn push_rect(out: &mut Vec<OverlayVertex>, x: f32, y: f32, w: f32, h: f32, c
     push_quad(out, [x, y, w, h], color, solid, solid);
 }
 
-/// Appends one quad per visible character drawing `text` with its top-left corner at
-/// `(x, y)` (pixels, y down), `scale` pixels per font pixel, in sRGB colour `color`. Returns
-/// the advance width in pixels of the longest line.
-pub fn push_text(
-    out: &mut Vec<OverlayVertex>,
-    text: &str,
-    x: f32,
-    y: f32,
-    scale: f32,
-    color: [u8; 4],
-) -> f32 {
-    let mut widest = 0.0f32;
-    for (line_no, line) in text.split('\n').enumerate() {
-        let top = y + (line_no as u32 * LINE_HEIGHT) as f32 * scale;
-        let mut left = x;
-        for c in line.chars() {
-            if glyph(c).iter().any(|&row| row != 0) {
-                let g = (glyph_index(c) * 8) as f32;
-                let (w, h) = (GLYPH_WIDTH as f32, GLYPH_HEIGHT as f32);
-                push_quad(
-                    out,
-                    [left, top, w * scale, h * scale],
-                    color,
-                    [g, 0.0],
-                    [g + w, h],
-                );
-            }
-            left += ADVANCE as f32 * scale;
-        }
-        widest = widest.max(left - x);
-    }
-    widest
-}
-
-#[rustfmt::skip]
-const FONT: [[u8; 7]; 95] = [
-    [0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00], // space
-    [0x04, 0x04, 0x04, 0x04, 0x04, 0x00, 0x04], // !
-    [0x0A, 0x0A, 0x0A, 0x00, 0x00, 0x00, 0x00], // "
-    [0x0A, 0x0A, 0x1F, 0x0A, 0x1F, 0x0A, 0x0A], // #
-    [0x04, 0x0F, 0x14, 0x0E, 0x05, 0x1E, 0x04], // $
-    [0x18, 0x19, 0x02, 0x04, 0x08, 0x13, 0x03], // %
-    [0x0C, 0x12, 0x14, 0x08, 0x15, 0x12, 0x0D], // &
-    [0x04, 0x04, 0x08, 0x00, 0x00, 0x00, 0x00], // '
-    [0x02, 0x04, 0x08, 0x08, 0x08, 0x04, 0x02], // (
-    [0x08, 0x04, 0x02, 0x02, 0x02, 0x04, 0x08], // )
-    [0x00, 0x04, 0x15, 0x0E, 0x15, 0x04, 0x00], // *
-    [0x00, 0x04, 0x04, 0x1F, 0x04, 0x04, 0x00], // +
-    [0x00, 0x00, 0x00, 0x00, 0x0C, 0x04, 0x08], // ,
-    [0x00, 0x00, 0x00, 0x1F, 0x00, 0x00, 0x00], // -
-    [0x00, 0x00, 0x00, 0x00, 0x00, 0x0C, 0x0C], // .
-    [0x00, 0x01, 0x02, 0x04, 0x08, 0x10, 0x00], // /
-    [0x0E, 0x11, 0x13, 0x15, 0x19, 0x11, 0x0E], // 0
-    [0x04, 0x0C, 0x04, 0x04, 0x04, 0x04, 0x0E], // 1
-    [0x0E, 0x11, 0x01, 0x02, 0x04, 0x08, 0x1F], // 2
-    [0x1F, 0x02, 0x04, 0x02, 0x01, 0x11, 0x0E], // 3
-    [0x02, 0x06, 0x0A, 0x12, 0x1F, 0x02, 0x02], // 4
-    [0x1F, 0x10, 0x1E, 0x01, 0x01, 0x11, 0x0E], // 5
-    [0x06, 0x08, 0x10, 0x1E, 0x11, 0x11, 0x0E], // 6
-    [0x1F, 0x01, 0x02, 0x04, 0x08, 0x08, 0x08], // 7
-    [0x0E, 0x11, 0x11, 0x0E, 0x11, 0x11, 0x0E], // 8
-    [0x0E, 0x11, 0x11, 0x0F, 0x01, 0x02, 0x0C], // 9
-    [0x00, 0x0C, 0x0C, 0x00, 0x0C, 0x0C, 0x00], // :
-    [0x00, 0x0C, 0x0C, 0x00, 0x0C, 0x04, 0x08], // ;
-    [0x02, 0x04, 0x08, 0x10, 0x08, 0x04, 0x02], // <
-    [0x00, 0x00, 0x1F, 0x00, 0x1F, 0x00, 0x00], // =
-    [0x08, 0x04, 0x02, 0x01, 0x02, 0x04, 0x08], // >
-    [0x0E, 0x11, 0x01, 0x02, 0x04, 0x00, 0x04], // ?
-    [0x0E, 0x11, 0x01, 0x0D, 0x15, 0x15, 0x0E], // @
-    [0x0E, 0x11, 0x11, 0x1F, 0x11, 0x11, 0x11], // A
-    [0x1E, 0x11, 0x11, 0x1E, 0x11, 0x11, 0x1E], // B
-    [0x0E, 0x11, 0x10, 0x10, 0x10, 0x11, 0x0E], // C
-    [0x1C, 0x12, 0x11, 0x11, 0x11, 0x12, 0x1C], // D
-    [0x1F, 0x10, 0x10, 0x1E, 0x10, 0x10, 0x1F], // E
-    [0x1F, 0x10, 0x10, 0x1E, 0x10, 0x10, 0x10], // F
-    [0x0E, 0x11, 0x10, 0x17, 0x11, 0x11, 0x0F], // G
-    [0x11, 0x11, 0x11, 0x1F, 0x11, 0x11, 0x11], // H
-    [0x0E, 0x04, 0x04, 0x04, 0x04, 0x04, 0x0E], // I
-    [0x07, 0x02, 0x02, 0x02, 0x02, 0x12, 0x0C], // J
-    [0x11, 0x12, 0x14, 0x18, 0x14, 0x12, 0x11], // K
-    [0x10, 0x10, 0x10, 0x10, 0x10, 0x10, 0x1F], // L
-    [0x11, 0x1B, 0x15, 0x15, 0x11, 0x11, 0x11], // M
-    [0x11, 0x11, 0x19, 0x15, 0x13, 0x11, 0x11], // N
-    [0x0E, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0E], // O
-    [0x1E, 0x11, 0x11, 0x1E, 0x10, 0x10, 0x10], // P
-    [0x0E, 0x11, 0x11, 0x11, 0x15, 0x12, 0x0D], // Q
-    [0x1E, 0x11, 0x11, 0x1E, 0x14, 0x12, 0x11], // R
-    [0x0F, 0x10, 0x10, 0x0E, 0x01, 0x01, 0x1E], // S
-    [0x1F, 0x04, 0x04, 0x04, 0x04, 0x04, 0x04], // T
-    [0x11, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0E], // U
-    [0x11, 0x11, 0x11, 0x11, 0x11, 0x0A, 0x04], // V
-    [0x11, 0x11, 0x11, 0x15, 0x15, 0x15, 0x0A], // W
-    [0x11, 0x11, 0x0A, 0x04, 0x0A, 0x11, 0x11], // X
-    [0x11, 0x11, 0x11, 0x0A, 0x04, 0x04, 0x04], // Y
-    [0x1F, 0x01, 0x02, 0x04, 0x08, 0x10, 0x1F], // Z
-    [0x0E, 0x08, 0x08, 0x08, 0x08, 0x08, 0x0E], // [
-    [0x00, 0x10, 0x08, 0x04, 0x02, 0x01, 0x00], // backslash
-    [0x0E, 0x02, 0x02, 0x02, 0x02, 0x02, 0x0E], // ]
-    [0x04, 0x0A, 0x11, 0x00, 0x00, 0x00, 0x00], // ^
-    [0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x1F], // _
-    [0x08, 0x04, 0x02, 0x00, 0x00, 0x00, 0x00], // `
-    [0x00, 0x00, 0x0E, 0x01, 0x0F, 0x11, 0x0F], // a
-    [0x10, 0x10, 0x16, 0x19, 0x11, 0x11, 0x1E], // b
-    [0x00, 0x00, 0x0E, 0x10, 0x10, 0x11, 0x0E], // c
-    [0x01, 0x01, 0x0D, 0x13, 0x11, 0x11, 0x0F], // d
-    [0x00, 0x00, 0x0E, 0x11, 0x1F, 0x10, 0x0E], // e
-    [0x06, 0x09, 0x08, 0x1C, 0x08, 0x08, 0x08], // f
-    [0x00, 0x0F, 0x11, 0x11, 0x0F, 0x01, 0x0E], // g
-    [0x10, 0x10, 0x16, 0x19, 0x11, 0x11, 0x11], // h
-    [0x04, 0x00, 0x0C, 0x04, 0x04, 0x04, 0x0E], // i
-    [0x02, 0x00, 0x06, 0x02, 0x02, 0x12, 0x0C], // j
-    [0x10, 0x10, 0x12, 0x14, 0x18, 0x14, 0x12], // k
-    [0x0C, 0x04, 0x04, 0x04, 0x04, 0x04, 0x0E], // l
-    [0x00, 0x00, 0x1A, 0x15, 0x15, 0x11, 0x11], // m
-    [0x00, 0x00, 0x16, 0x19, 0x11, 0x11, 0x11], // n
-    [0x00, 0x00, 0x0E, 0x11, 0x11, 0x11, 0x0E], // o
-    [0x00, 0x00, 0x1E, 0x11, 0x1E, 0x10, 0x10], // p
-    [0x00, 0x00, 0x0D, 0x13, 0x0F, 0x01, 0x01], // q
-    [0x00, 0x00, 0x16, 0x19, 0x10, 0x10, 0x10], // r
-    [0x00, 0x00, 0x0E, 0x10, 0x0E, 0x01, 0x1E], // s
-    [0x08, 0x08, 0x1C, 0x08, 0x08, 0x09, 0x06], // t
-    [0x00, 0x00, 0x11, 0x11, 0x11, 0x13, 0x0D], // u
-    [0x00, 0x00, 0x11, 0x11, 0x11, 0x0A, 0x04], // v
-    [0x00, 0x00, 0x11, 0x11, 0x15, 0x15, 0x0A], // w
-    [0x00, 0x00, 0x11, 0x0A, 0x04, 0x0A, 0x11], // x
-    [0x00, 0x00, 0x11, 0x11, 0x0F, 0x01, 0x0E], // y
-    [0x00, 0x00, 0x1F, 0x02, 0x04, 0x08, 0x1F], // z
-    [0x02, 0x04, 0x04, 0x08, 0x04, 0x04, 0x02], // {
-    [0x04, 0x04, 0x04, 0x04, 0x04, 0x04, 0x04], // |
-    [0x08, 0x04, 0x04, 0x02, 0x04, 0x04, 0x08], // }
-    [0x00, 0x00, 0x08, 0x15, 0x02, 0x00, 0x00], // ~
-];
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
-    fn glyph_lookup_and_fallback() {
-        assert_eq!(glyph('A'), &FONT[(b'A' - 32) as usize]);
-        assert_eq!(glyph('é'), glyph('?'));
-        assert!(glyph(' ').iter().all(|&r| r == 0));
-        assert!(FONT.iter().flatten().all(|&r| r < 32));
+    fn metrics_are_whole_pixels_and_scale_with_the_factor() {
+        let one = Font::new(1.0);
+        let two = Font::new(2.0);
+        for size in TextSize::ALL {
+            let (a, b) = (one.metrics(size), two.metrics(size));
+            assert!(a.advance >= 6 && a.line_height > a.advance, "{a:?}");
+            assert!(b.advance.abs_diff(2 * a.advance) <= 1, "{a:?} {b:?}");
+            assert!(b.line_height.abs_diff(2 * a.line_height) <= 1);
+        }
+        assert!(one.metrics(TextSize::Small).advance < one.metrics(TextSize::Normal).advance);
+        assert_eq!(Font::new(f32::NAN).scale_factor(), 1.0);
     }
 
     #[test]
-    fn one_quad_per_visible_character() {
+    fn glyphs_have_ink_and_unknown_characters_fall_back() {
+        let f = Font::new(1.0);
+        let ink = |c| {
+            f.glyph_cell(c, TextSize::Normal)
+                .iter()
+                .filter(|&&v| v > 128)
+                .count()
+        };
+        assert!(ink('M') > 20 && ink('κ') > 10 && ink('…') > 2);
+        assert_eq!(ink(' '), 0);
+        assert_eq!(
+            f.glyph_cell('\u{4e2d}', TextSize::Normal),
+            f.glyph_cell('?', TextSize::Normal)
+        );
+        assert_ne!(
+            f.glyph_cell('l', TextSize::Normal),
+            f.glyph_cell('1', TextSize::Normal)
+        );
+    }
+
+    #[test]
+    fn one_quad_per_visible_character_on_whole_pixels() {
+        let f = Font::new(1.0);
+        let m = f.metrics(TextSize::Normal);
         let mut v = Vec::new();
-        let w = push_text(&mut v, "I I", 10.0, 20.0, 2.0, [255; 4]);
+        let w = f.push_text(&mut v, "I I", 10.4, 20.0, TextSize::Normal, [255; 4]);
         // Two glyph quads; the space advances without a quad.
         assert_eq!(v.len(), 2 * 6);
-        assert_eq!(w, 36.0);
+        assert_eq!(w, 3.0 * m.advance as f32);
         assert_eq!(v[0].pos, [10.0, 20.0]);
-        assert_eq!(v[2].pos, [20.0, 34.0]);
-        let g = (u32::from(b'I') - 32) as f32 * 8.0;
-        assert_eq!(v[0].glyph, [g, 0.0]);
-        assert_eq!(v[2].glyph, [g + 5.0, 7.0]);
-        assert_eq!(v[6].pos, [34.0, 20.0]);
-        assert_eq!(text_size("ab\ncde", 1.0), [17.0, 16.0]);
+        assert_eq!(v[2].pos, [10.0 + m.cell[0] as f32, 20.0 + m.cell[1] as f32]);
+        assert_eq!(v[6].pos, [10.0 + 2.0 * m.advance as f32, 20.0]);
+        // Texel-exact: the quad spans as many texels as pixels.
+        assert_eq!(v[2].glyph[0] - v[0].glyph[0], m.cell[0] as f32);
+        assert_eq!(
+            f.text_size("ab\ncde", TextSize::Normal),
+            [3.0 * m.advance as f32, 2.0 * m.line_height as f32]
+        );
         let mut r = Vec::new();
         push_rect(&mut r, 0.0, 0.0, 1.0, 1.0, [0; 4]);
         assert!(r.iter().all(|v| v.glyph == OverlayVertex::SOLID));
-    }
-
-    #[test]
-    fn glyph_table_matches_the_font() {
-        let rows = glyph_rows();
-        assert_eq!(rows.len(), 95 * 7);
-        let a = glyph_index('A') as usize;
-        assert_eq!(
-            &rows[a * 7..a * 7 + 7],
-            glyph('A').map(u32::from).as_slice()
-        );
-        assert_eq!(glyph_index('\u{e9}'), glyph_index('?'));
     }
 }

@@ -7,6 +7,7 @@ use ash::vk;
 use super::barrier;
 use super::device::Device;
 use super::error::{GpuError, GpuResult};
+use super::font::Font;
 use super::grid::GridCache;
 use super::mirror::{Mirror, MirrorWriter};
 use super::offscreen::OffscreenTarget;
@@ -60,8 +61,10 @@ pub(crate) struct FrameContext<'a> {
     pub uploader: &'a mut Uploader,
     pub layout: vk::PipelineLayout,
     pub pipelines: PipelineSet,
-    /// Device address of the overlay font's glyph table (0: none).
+    /// Device address of the overlay font's glyph atlas (0: none).
     pub font: vk::DeviceAddress,
+    /// The overlay font the atlas was built from (metrics and layout).
+    pub text: &'a Font,
     /// Flush host writes even to coherent memory (see `RendererDesc::always_flush`).
     pub always_flush: bool,
 }
@@ -128,6 +131,11 @@ impl<'a> Frame<'a> {
     /// this slot of each mirror up to date.
     pub fn slot(&self) -> usize {
         self.slot
+    }
+
+    /// The overlay font whose atlas [`Frame::draw_overlay`] samples: lay text out with it.
+    pub fn font(&self) -> &'a Font {
+        self.ctx.text
     }
 
     /// Sequential frame number (0 for the renderer's first frame).

@@ -101,8 +101,11 @@ pub(crate) struct Lines3dPush {
 #[derive(Clone, Copy)]
 pub(crate) struct OverlayPush {
     pub viewport: [f32; 2],
-    /// Device address of the font table (one u32 of 5 bits per glyph row).
+    /// Device address of the glyph atlas (one coverage byte per texel, row-major).
     pub font: u64,
+    /// Atlas width in texels (bytes per row).
+    pub atlas_width: u32,
+    pub _pad: u32,
 }
 
 // SAFETY: all push structs are repr(C) with fields laid out without padding (the size and
@@ -131,8 +134,9 @@ const _: () = {
     assert!(offset_of!(PointsPush, quads) == 112);
     assert!(offset_of!(PolylinePush, thin) == 116);
     assert!(size_of::<Lines3dPush>() == 64);
-    assert!(size_of::<OverlayPush>() == 16);
+    assert!(size_of::<OverlayPush>() == 24);
     assert!(offset_of!(OverlayPush, font) == 8);
+    assert!(offset_of!(OverlayPush, atlas_width) == 16);
     assert!(offset_of!(PolylinePush, grid_cols) == 112);
     // std430 offsets of the blocks in surface.*, polyline.vert and points.vert.
     assert!(offset_of!(SurfacePush, eye) == 64);

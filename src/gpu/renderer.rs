@@ -12,6 +12,7 @@ use super::FRAMES_IN_FLIGHT;
 use super::barrier;
 use super::device::{Device, DeviceCaps};
 use super::error::{GpuError, GpuResult};
+use super::font::Font;
 use super::frame::{Frame, FrameContext, FrameTarget};
 use super::grid::GridCache;
 use super::instance::{Instance, InstanceDesc, ValidationMode};
@@ -19,7 +20,6 @@ use super::memory::Buffer;
 use super::mirror::Mirror;
 use super::offscreen::{OffscreenDesc, OffscreenTarget, Pixels};
 use super::pipeline::{PipelineKey, PipelineSet, Pipelines};
-use super::pod::slice_bytes;
 use super::shader::Shaders;
 use super::slot::{FrameRing, FrameSlot};
 use super::swapchain::{Swapchain, SwapchainDesc};
@@ -76,7 +76,9 @@ pub struct Renderer {
     shaders: Shaders,
     grids: GridCache,
     uploader: Uploader,
-    /// The HUD font's glyph rows in device memory (read by `overlay.frag` through its address).
+    /// The overlay font (metrics, layout) and its glyph atlas in device memory (read by
+    /// `overlay.frag` through its address).
+    text: Font,
     font: Option<Buffer>,
     always_flush: bool,
     /// Objects whose GPU use could not be shown to have ended when they were given back;
@@ -115,6 +117,7 @@ impl Renderer {
             shaders: Shaders::default(),
             grids: GridCache::default(),
             uploader: Uploader::default(),
+            text: Font::new(1.0),
             font: None,
             always_flush: desc.always_flush,
             orphans: Vec::new(),
@@ -124,13 +127,10 @@ impl Renderer {
         renderer.shaders = Shaders::new(&renderer.device)?;
         renderer.pipelines = Pipelines::new(&renderer.device)?;
         renderer.uploader = Uploader::new(&renderer.device)?;
-        renderer.font = Some(renderer.uploader.upload(
+        renderer.font = Some(upload_atlas(
             &renderer.device,
-            "font",
-            slice_bytes(&super::font::glyph_rows()),
-            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS,
-            vk::PipelineStageFlags2::FRAGMENT_SHADER,
-            vk::AccessFlags2::SHADER_STORAGE_READ,
+            &mut renderer.uploader,
+            &renderer.text,
         )?);
         for _ in 0..FRAMES_IN_FLIGHT {
             let slot = FrameSlot::new(&renderer.device, desc.always_flush)?;
@@ -179,6 +179,28 @@ impl Renderer {
     /// Blocks until the GPU has finished all submitted work.
     pub fn wait_idle(&self) -> GpuResult<()> {
         self.device.wait_idle()
+    }
+
+    /// The overlay font: lay text out with it (see [`Frame::font`]).
+    pub fn font(&self) -> &Font {
+        &self.text
+    }
+
+    /// Rebuilds the overlay font for a window scale factor (physical pixels per logical
+    /// pixel; 1 headless). Waits for the frames in flight when the atlas changes.
+    pub fn set_text_scale(&mut self, scale_factor: f32) -> GpuResult<()> {
+        let text = Font::new(scale_factor);
+        if text.scale_factor() == self.text.scale_factor() {
+            return Ok(());
+        }
+        let atlas = upload_atlas(&self.device, &mut self.uploader, &text)?;
+        self.frames.wait_all(&self.device)?;
+        if let Some(old) = self.font.replace(atlas) {
+            // SAFETY: every frame slot was waited for: no submission reads the old atlas.
+            unsafe { self.device.destroy_buffer(old) };
+        }
+        self.text = text;
+        Ok(())
     }
 
     /// Creates a mirrored array of `len` f32s (one buffer per frame in flight). Its contents
@@ -405,6 +427,7 @@ impl Renderer {
             layout: self.pipelines.layout,
             pipelines,
             font: self.font.as_ref().map_or(0, |f| f.address()),
+            text: &self.text,
             always_flush: self.always_flush,
         }
     }
@@ -454,4 +477,19 @@ fn pipeline_key(view: &TargetView) -> PipelineKey {
         color_format: view.format,
         samples: view.samples,
     }
+}
+
+/// The glyph atlas of `text` in device memory, padded to whole 32-bit words (the shader reads
+/// words).
+fn upload_atlas(device: &Device, uploader: &mut Uploader, text: &Font) -> GpuResult<Buffer> {
+    let mut bytes = text.atlas().to_vec();
+    bytes.resize(bytes.len().next_multiple_of(4).max(4), 0);
+    uploader.upload(
+        device,
+        "glyph atlas",
+        &bytes,
+        vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS,
+        vk::PipelineStageFlags2::FRAGMENT_SHADER,
+        vk::AccessFlags2::SHADER_STORAGE_READ,
+    )
 }

@@ -14,7 +14,7 @@ pub struct LineVertex {
 }
 
 /// Vertex of [`super::Frame::draw_overlay`]: pixel position (origin top-left, y down),
-/// sRGB-encoded RGBA8 colour (alpha-blended) and where in the built-in font the quad samples.
+/// sRGB-encoded RGBA8 colour (alpha-blended) and where in the glyph atlas the quad samples.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OverlayVertex {
@@ -22,10 +22,9 @@ pub struct OverlayVertex {
     pub pos: [f32; 2],
     /// sRGB-encoded colour, straight alpha.
     pub color: [u8; 4],
-    /// Font coordinates: `x = 8 · glyph + column`, `y = row`, in font pixels of the glyph
-    /// table of [`super::font`] (glyph = character code − 32). The fragment shader keeps the
-    /// fragment where that font pixel is lit. [`OverlayVertex::SOLID`] (negative) fills the
-    /// whole triangle.
+    /// Atlas coordinates in texels of [`super::font::Font`]'s glyph atlas (a quad's corners
+    /// carry its cell's corners); the fragment shader takes the texel's coverage as alpha.
+    /// [`OverlayVertex::SOLID`] (negative) fills the whole triangle.
     pub glyph: [f32; 2],
 }
 

@@ -7,7 +7,7 @@ use crate::editor::Document;
 use crate::geom::continuity::{JoinClass, classify};
 use crate::geom::differential::frenet_frame;
 use crate::geom::{BSplineCurve, ErbsCurve};
-use crate::gpu::font::{push_rect, push_text, text_size};
+use crate::gpu::font::{Font, TextSize, push_rect};
 use crate::gpu::{LineVertex, OverlayVertex};
 use crate::model::{Model, ModelRef};
 use glam::DVec3;
@@ -232,13 +232,14 @@ pub fn badge_color(class: JoinClass) -> [u8; 4] {
 }
 
 /// Every continuity badge of the document as overlay quads: a dot on the join and its label
-/// beside it, placed by `project` (world → pixel, `None` behind the camera).
+/// beside it on an opaque tag, placed by `project` (world → pixel, `None` behind the camera).
 pub fn badge_overlay(
     doc: &Document,
+    font: &Font,
     project: impl Fn(DVec3) -> Option<(f64, f64)>,
 ) -> Vec<OverlayVertex> {
     let mut v = Vec::new();
-    let scale = 2.0;
+    let size = TextSize::Normal;
     for o in &doc.objects {
         for j in curve_joins(o.sampled.model()) {
             let Some((x, y)) = project(j.position) else {
@@ -246,14 +247,14 @@ pub fn badge_overlay(
             };
             let (x, y) = (x as f32, y as f32);
             let color = badge_color(j.class);
-            push_rect(&mut v, x - 4.0, y - 4.0, 8.0, 8.0, [10, 12, 16, 255]);
+            push_rect(&mut v, x - 4.0, y - 4.0, 8.0, 8.0, PANEL);
             push_rect(&mut v, x - 3.0, y - 3.0, 6.0, 6.0, color);
             let label = j.class.label();
-            let [w, h] = text_size(label, scale);
+            let [w, h] = font.text_size(label, size);
             let (bx, by) = (x + 8.0, y - h - 10.0);
-            push_rect(&mut v, bx, by, w + 8.0, h + 6.0, [10, 12, 16, 215]);
-            push_rect(&mut v, bx, by + h + 4.0, w + 8.0, 2.0, color);
-            push_text(&mut v, label, bx + 4.0, by + 3.0, scale, color);
+            push_rect(&mut v, bx, by, w + 8.0, h + 4.0, PANEL);
+            push_rect(&mut v, bx, by + h + 2.0, w + 8.0, 2.0, color);
+            font.push_text(&mut v, label, bx + 4.0, by + 1.0, size, color);
         }
     }
     v
@@ -292,23 +293,41 @@ pub fn osculating_lines(o: &Osculating) -> Vec<LineVertex> {
 }
 
 /// The osculating readout (curvature, radius, torsion) as a label next to the curve point,
-/// kept inside a `size` image.
+/// kept inside a `size` image, on an opaque panel: draw it after the badges, so none covers
+/// it.
 pub fn osculating_overlay(
     name: &str,
     o: &Osculating,
+    font: &Font,
     at: (f64, f64),
     size: [f32; 2],
 ) -> Vec<OverlayVertex> {
     let mut v = Vec::new();
-    let scale = 2.0;
-    let text = format!(
+    let text = osculating_text(name, o);
+    let [w, h] = font.text_size(&text, TextSize::Normal);
+    let [x, y] = osculating_panel_origin([w, h], at, size);
+    push_rect(&mut v, x, y, w + 10.0, h + 8.0, PANEL);
+    let magenta = [240, 150, 240, 255];
+    font.push_text(&mut v, &text, x + 5.0, y + 4.0, TextSize::Normal, magenta);
+    v
+}
+
+/// The readout's lines: curve name and parameter, curvature and radius, torsion.
+#[must_use]
+pub fn osculating_text(name: &str, o: &Osculating) -> String {
+    format!(
         "{name}  t = {}\ncurvature {}  radius {}\ntorsion {}",
         short(o.t),
         short(o.curvature),
         short(o.radius()),
         short(o.torsion)
-    );
-    let [w, h] = text_size(&text, scale);
+    )
+}
+
+/// Top-left corner of the readout panel for text of `[w, h]` pixels next to the curve point
+/// `at`: right of it, or left where the image ends, inside the image.
+#[must_use]
+pub fn osculating_panel_origin([w, h]: [f32; 2], at: (f64, f64), size: [f32; 2]) -> [f32; 2] {
     let (px, py) = (at.0 as f32, at.1 as f32);
     let x = if px + 14.0 + w + 10.0 <= size[0] {
         px + 14.0
@@ -316,10 +335,11 @@ pub fn osculating_overlay(
         (px - 14.0 - w - 10.0).max(0.0)
     };
     let y = (py + 10.0).min(size[1] - h - 8.0).max(0.0);
-    push_rect(&mut v, x, y, w + 10.0, h + 8.0, [10, 12, 16, 215]);
-    push_text(&mut v, &text, x + 5.0, y + 4.0, scale, [240, 150, 240, 255]);
-    v
+    [x.round(), y.round()]
 }
+
+/// Colour of the opaque panels under overlay text (sRGB).
+pub const PANEL: [u8; 4] = [10, 12, 16, 255];
 
 #[cfg(test)]
 mod tests {

@@ -8,7 +8,7 @@
 
 use crate::editor::Document;
 use crate::gpu::OverlayVertex;
-use crate::gpu::font::{push_rect, push_text, text_size};
+use crate::gpu::font::{Font, TextSize, push_rect};
 use crate::sampling::curvature::principal;
 
 /// What an analysis view shows on surfaces.
@@ -168,30 +168,30 @@ fn srgb(c: [f32; 3]) -> [u8; 4] {
     [enc(c[0]), enc(c[1]), enc(c[2]), 255]
 }
 
-const PANEL: [u8; 4] = [10, 12, 16, 200];
+const PANEL: [u8; 4] = super::analysis::PANEL;
 const TEXT: [u8; 4] = [230, 232, 238, 255];
 
 /// The legend of `map` with half range `r`, bottom right of a `width × height` image: the title,
 /// a colour bar from −R to +R with its end and middle values (zebra: a note instead).
-pub fn legend(map: SurfaceMap, r: f64, width: f32, height: f32) -> Vec<OverlayVertex> {
+pub fn legend(map: SurfaceMap, r: f64, font: &Font, width: f32, height: f32) -> Vec<OverlayVertex> {
     let mut v = Vec::new();
-    let scale = 2.0;
+    let size = TextSize::Normal;
     let title = map.title();
-    let [tw, th] = text_size(title, scale);
+    let [tw, th] = font.text_size(title, size);
     let (bar_w, bar_h) = (280.0f32, 16.0f32);
     let panel_w = tw.max(bar_w) + 24.0;
     let panel_h = if map == SurfaceMap::Zebra {
-        th + 20.0
+        th + 16.0
     } else {
-        th + bar_h + th + 36.0
+        th + bar_h + th + 28.0
     };
     let (x, y) = (width - panel_w - 12.0, height - panel_h - 64.0);
     push_rect(&mut v, x, y, panel_w, panel_h, PANEL);
-    push_text(&mut v, title, x + 12.0, y + 10.0, scale, TEXT);
+    font.push_text(&mut v, title, x + 12.0, y + 8.0, size, TEXT);
     if map == SurfaceMap::Zebra {
         return v;
     }
-    let (bx, by) = (x + 12.0, y + th + 18.0);
+    let (bx, by) = (x + 12.0, y + th + 12.0);
     let steps = 56;
     let w = bar_w / steps as f32;
     for k in 0..steps {
@@ -205,14 +205,14 @@ pub fn legend(map: SurfaceMap, r: f64, width: f32, height: f32) -> Vec<OverlayVe
             srgb(scale_color(s)),
         );
     }
-    let ly = by + bar_h + 6.0;
+    let ly = by + bar_h + 4.0;
     let lo = format!("-{}", super::style::short(r));
     let hi = super::style::short(r);
-    push_text(&mut v, &lo, bx, ly, scale, TEXT);
-    let [zw, _] = text_size("0", scale);
-    push_text(&mut v, "0", bx + 0.5 * (bar_w - zw), ly, scale, TEXT);
-    let [hw, _] = text_size(&hi, scale);
-    push_text(&mut v, &hi, bx + bar_w - hw, ly, scale, TEXT);
+    font.push_text(&mut v, &lo, bx, ly, size, TEXT);
+    let [zw, _] = font.text_size("0", size);
+    font.push_text(&mut v, "0", bx + 0.5 * (bar_w - zw), ly, size, TEXT);
+    let [hw, _] = font.text_size(&hi, size);
+    font.push_text(&mut v, &hi, bx + bar_w - hw, ly, size, TEXT);
     v
 }
 

@@ -79,7 +79,11 @@ fn record(
     let mut lines = overlay_lines(doc, &shot.options, bounds.radius());
     let (w, h) = (shot.width as f64, shot.height as f64);
     let project = |p| camera.project(p, w, h, &bounds).map(|(x, y, _)| (x, y));
+    let font = frame.font();
+    let size = [w as f32, h as f32];
+    // Back to front: badges, legend, then the osculating readout, which no badge covers.
     let mut overlay = Vec::new();
+    let mut readout = Vec::new();
     if let Some((i, t)) = shot.options.osculating_at
         && let Some(o) = doc.objects.get(i).and_then(|o| {
             let curve = CurveEval::of(o.sampled.model())?;
@@ -88,23 +92,19 @@ fn record(
     {
         lines.extend(osculating_lines(&o));
         if let Some(at) = project(o.point) {
-            overlay.extend(osculating_overlay(
-                &doc.objects[i].name,
-                &o,
-                at,
-                [w as f32, h as f32],
-            ));
+            readout = osculating_overlay(&doc.objects[i].name, &o, font, at, size);
         }
     }
     if !lines.is_empty() {
         frame.draw_lines3d(&lines)?;
     }
     if shot.options.badges {
-        overlay.extend(badge_overlay(doc, project));
+        overlay.extend(badge_overlay(doc, font, project));
     }
     if let Some(m) = map {
-        overlay.extend(legend(m.map, m.range, w as f32, h as f32));
+        overlay.extend(legend(m.map, m.range, font, size[0], size[1]));
     }
+    overlay.extend(readout);
     if !overlay.is_empty() {
         frame.draw_overlay(&overlay)?;
     }

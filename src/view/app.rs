@@ -212,6 +212,10 @@ impl App {
         .map_err(|e| e.to_string())?;
         self.sink = renderer.validation_sink();
         self.device = renderer.caps().name.clone();
+        // Text is laid out in physical pixels at the window's scale factor.
+        renderer
+            .set_text_scale(window.scale_factor() as f32)
+            .map_err(|e| e.to_string())?;
         let size = window.inner_size();
         let swapchain = renderer
             .create_swapchain(
@@ -475,7 +479,12 @@ fn screenshot(r: &mut Running, path: &Path, hud: bool) -> Result<(), String> {
         .map_err(|e| e.to_string())?;
     let result = (|| {
         let mut frame = r.renderer.begin_offscreen(&mut target)?;
+        // The picture shows the figures of the window's last frame: this frame's upload only
+        // brings its own slot up to date and is no edit of the user's (it used to reset the
+        // HUD's "KB to GPU" to 0 before drawing).
+        let shown = r.session.hud.bytes;
         r.session.upload(&mut frame)?;
+        r.session.hud.bytes = shown;
         r.session.record(&mut frame, hud)?;
         frame.capture();
         frame.finish()?;
@@ -507,8 +516,15 @@ impl ApplicationHandler for App {
                 }
                 self.dirty = true;
             }
-            WindowEvent::ScaleFactorChanged { .. }
-            | WindowEvent::Focused(_)
+            WindowEvent::ScaleFactorChanged { scale_factor, .. } => {
+                if let Some(r) = self.running.as_mut()
+                    && let Err(e) = r.renderer.set_text_scale(scale_factor as f32)
+                {
+                    return self.fail(event_loop, e.to_string());
+                }
+                self.dirty = true;
+            }
+            WindowEvent::Focused(_)
             | WindowEvent::Occluded(false)
             | WindowEvent::ThemeChanged(_) => self.dirty = true,
             WindowEvent::ModifiersChanged(m) => {

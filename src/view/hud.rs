@@ -2,14 +2,18 @@
 //! GPU time; the status line; and the key help.
 
 use crate::gpu::OverlayVertex;
-use crate::gpu::font::{ADVANCE, LINE_HEIGHT, push_rect, push_text};
+use crate::gpu::font::{Font, TextSize, push_rect};
 use std::collections::VecDeque;
 
 /// Frames kept in the graph.
 const HISTORY: usize = 240;
-const TEXT: [u8; 4] = [230, 232, 238, 255];
+/// Colour of overlay text.
+pub const TEXT: [u8; 4] = [230, 232, 238, 255];
 const DIM: [u8; 4] = [150, 155, 165, 255];
-const PANEL: [u8; 4] = [10, 12, 16, 190];
+/// Opaque, so neither the scene nor other overlays show through the text.
+const PANEL: [u8; 4] = crate::render::analysis::PANEL;
+/// The help's panel (opaque too).
+pub const HELP_PANEL: [u8; 4] = [8, 10, 14, 255];
 
 /// Every key binding, as shown by the help overlay (H or F1); docs/viewer.md and the README's key
 /// table describe the same keys.
@@ -129,91 +133,188 @@ impl Hud {
             / n as f64
     }
 
-    /// Overlay vertices for a `width × height` image.
-    pub fn build(&self, width: f32, height: f32, status: &str, help: bool) -> Vec<OverlayVertex> {
+    /// The HUD lines: frame time, edit cost and bytes copied, level of detail.
+    #[must_use]
+    pub fn lines(&self) -> [String; 3] {
+        let mean = self.mean();
+        let fps = if mean > 0.0 { 1000.0 / mean } else { 0.0 };
+        let gpu = self
+            .gpu_ms
+            .map_or("n/a".to_string(), |g| format!("{g:.2} ms"));
+        [
+            format!("frame {mean:.2} ms ({fps:.0} fps)   GPU {gpu}"),
+            format!(
+                "edit {:.1} us   {} samples   {:.1} KB to GPU",
+                self.edit_us,
+                self.samples_touched,
+                self.bytes as f64 / 1024.0
+            ),
+            lod_line(self.triangles),
+        ]
+    }
+
+    /// Overlay vertices of the performance panel (when visible and the help is not shown)
+    /// and the status line, for a `width × height` image. The help comes separately
+    /// ([`help_overlay`]), to be drawn last.
+    pub fn build(
+        &self,
+        font: &Font,
+        width: f32,
+        height: f32,
+        status: &str,
+        help: bool,
+    ) -> Vec<OverlayVertex> {
         let mut v = Vec::new();
-        let scale = 2.0;
-        let line = LINE_HEIGHT as f32 * scale + 2.0;
         // The help panel covers the overlay's corner; it shows alone.
         if self.visible && !help {
-            let mean = self.mean();
-            let fps = if mean > 0.0 { 1000.0 / mean } else { 0.0 };
-            let gpu = self
-                .gpu_ms
-                .map_or("n/a".to_string(), |g| format!("{g:.2} ms"));
-            let lines = [
-                format!("frame {mean:.2} ms ({fps:.0} fps)   GPU {gpu}"),
-                format!(
-                    "edit {:.1} us   {} samples   {:.1} KB to GPU",
-                    self.edit_us,
-                    self.samples_touched,
-                    self.bytes as f64 / 1024.0
-                ),
-                lod_line(self.triangles),
-            ];
-            let (gw, gh) = (HISTORY as f32 * 2.0, 60.0);
-            push_rect(
-                &mut v,
-                8.0,
-                8.0,
-                gw.max(560.0) + 16.0,
-                lines.len() as f32 * line + gh + 24.0,
-                PANEL,
-            );
-            for (k, l) in lines.iter().enumerate() {
-                push_text(&mut v, l, 16.0, 14.0 + k as f32 * line, scale, TEXT);
-            }
-            // Frame-time graph: one bar per frame. Full scale is 33 ms, or the next of 50, 100,
-            // 200, 500, 1000 ms above the slowest recent frame (software rendering is slow), so
-            // bars are never pegged; reference lines at 16.7 and 33.3 ms and at full scale.
-            let (gx, gy) = (16.0, 16.0 + lines.len() as f32 * line);
-            let slowest = self.frames.iter().copied().fold(0.0f32, f32::max);
-            let full = [33.3f32, 50.0, 100.0, 200.0, 500.0, 1000.0]
-                .into_iter()
-                .find(|&f| slowest <= f)
-                .unwrap_or(slowest);
-            for ms in [16.7f32, 33.3, full] {
-                if ms <= full {
-                    push_rect(
-                        &mut v,
-                        gx,
-                        gy + gh - gh * ms / full,
-                        gw,
-                        1.0,
-                        [90, 90, 100, 255],
-                    );
-                }
-            }
-            push_text(
-                &mut v,
-                &format!("{full:.0} ms"),
-                gx + gw + 6.0,
-                gy,
-                2.0,
-                DIM,
-            );
-            for (k, &ms) in self.frames.iter().enumerate() {
-                let h = (gh * ms / full).min(gh);
-                let c = if ms > 33.3 {
-                    [235, 80, 70, 255]
-                } else if ms > 16.7 {
-                    [235, 190, 60, 255]
-                } else {
-                    [90, 200, 120, 255]
-                };
-                push_rect(&mut v, gx + k as f32 * 2.0, gy + gh - h, 2.0, h, c);
-            }
+            self.push_panel(&mut v, font);
         }
-        if !status.is_empty() {
-            let y = height - line - 10.0;
-            push_rect(&mut v, 0.0, y - 6.0, width, line + 12.0, PANEL);
-            push_text(&mut v, status, 12.0, y, scale, TEXT);
-        }
-        if help {
-            push_help(&mut v, width, height);
-        }
+        push_status(&mut v, font, width, height, status);
         v
     }
+
+    fn push_panel(&self, v: &mut Vec<OverlayVertex>, font: &Font) {
+        let size = TextSize::Normal;
+        let line = font.metrics(size).line_height as f32 + 2.0;
+        let lines = self.lines();
+        let (gw, gh) = (HISTORY as f32 * 2.0, 60.0);
+        let text_w = lines
+            .iter()
+            .map(|l| font.text_size(l, size)[0])
+            .fold(0.0f32, f32::max);
+        let [label_w, _] = font.text_size("1000 ms", size);
+        push_rect(
+            v,
+            8.0,
+            8.0,
+            text_w.max(gw + 6.0 + label_w) + 16.0,
+            lines.len() as f32 * line + gh + 24.0,
+            PANEL,
+        );
+        for (k, l) in lines.iter().enumerate() {
+            font.push_text(v, l, 16.0, 14.0 + k as f32 * line, size, TEXT);
+        }
+        // Frame-time graph: one bar per frame. Full scale is 33 ms, or the next of 50, 100,
+        // 200, 500, 1000 ms above the slowest recent frame (software rendering is slow), so
+        // bars are never pegged; reference lines at 16.7 and 33.3 ms and at full scale.
+        let (gx, gy) = (16.0, 16.0 + lines.len() as f32 * line);
+        let slowest = self.frames.iter().copied().fold(0.0f32, f32::max);
+        let full = [33.3f32, 50.0, 100.0, 200.0, 500.0, 1000.0]
+            .into_iter()
+            .find(|&f| slowest <= f)
+            .unwrap_or(slowest);
+        for ms in [16.7f32, 33.3, full] {
+            if ms <= full {
+                push_rect(v, gx, gy + gh - gh * ms / full, gw, 1.0, [90, 90, 100, 255]);
+            }
+        }
+        font.push_text(v, &format!("{full:.0} ms"), gx + gw + 6.0, gy, size, DIM);
+        for (k, &ms) in self.frames.iter().enumerate() {
+            let h = (gh * ms / full).min(gh);
+            let c = if ms > 33.3 {
+                [235, 80, 70, 255]
+            } else if ms > 16.7 {
+                [235, 190, 60, 255]
+            } else {
+                [90, 200, 120, 255]
+            };
+            push_rect(v, gx + k as f32 * 2.0, gy + gh - h, 2.0, h, c);
+        }
+    }
+}
+
+/// Left margin of the status text, in pixels.
+pub const STATUS_MARGIN: f32 = 12.0;
+
+/// The status line at the bottom of a `width × height` image on an opaque band: one line, or
+/// two when it is longer ([`status_lines`]).
+fn push_status(v: &mut Vec<OverlayVertex>, font: &Font, width: f32, height: f32, status: &str) {
+    if status.is_empty() {
+        return;
+    }
+    let size = TextSize::Normal;
+    let lines = status_lines(font, width, status);
+    let line = font.metrics(size).line_height as f32;
+    let y = status_top(font, height, lines.len());
+    push_rect(
+        v,
+        0.0,
+        y - 6.0,
+        width,
+        lines.len() as f32 * line + 12.0,
+        PANEL,
+    );
+    for (k, l) in lines.iter().enumerate() {
+        font.push_text(v, l, STATUS_MARGIN, y + k as f32 * line, size, TEXT);
+    }
+}
+
+/// Top of the status text of `lines` lines in an image `height` pixels high.
+#[must_use]
+pub fn status_top(font: &Font, height: f32, lines: usize) -> f32 {
+    let line = font.metrics(TextSize::Normal).line_height as f32;
+    (height - lines as f32 * line - 10.0).round()
+}
+
+/// The status message as shown in a `width`-pixel window: one line when it fits, else
+/// word-wrapped onto two, else its middle elided (`…`) so that the start and the end (where
+/// the advice is) both show. The full text goes to stderr when the status is set.
+#[must_use]
+pub fn status_lines(font: &Font, width: f32, status: &str) -> Vec<String> {
+    let fit = font
+        .chars_fitting(width - 2.0 * STATUS_MARGIN, TextSize::Normal)
+        .max(8);
+    let status = status.replace('\n', " ");
+    if status.chars().count() <= fit {
+        return vec![status];
+    }
+    let wrapped = wrap_chars(&status, fit);
+    if wrapped.len() <= 2 {
+        return wrapped;
+    }
+    // Elide the middle: the first line as wrapped, the second "… " and the message's end.
+    let first = wrapped[0].clone();
+    let chars: Vec<char> = status.chars().collect();
+    let keep = fit - 2;
+    let start = chars.len() - keep;
+    let mut tail: String = chars[start..].iter().collect();
+    // Start the tail at a word where the cut falls inside one (and the tail has a space).
+    if chars[start - 1] != ' '
+        && let Some(space) = tail.find(' ')
+    {
+        tail = tail[space..].to_string();
+    }
+    vec![first, format!("… {}", tail.trim_start())]
+}
+
+/// Greedy word wrap to lines of at most `width` characters; a word longer than a line is cut.
+fn wrap_chars(text: &str, width: usize) -> Vec<String> {
+    let mut lines: Vec<String> = vec![String::new()];
+    for word in text.split(' ') {
+        let mut word: Vec<char> = word.chars().collect();
+        loop {
+            let last = lines.last_mut().expect("never empty");
+            let used = last.chars().count();
+            let gap = usize::from(used > 0);
+            if used + gap + word.len() <= width {
+                if gap == 1 {
+                    last.push(' ');
+                }
+                last.extend(word.iter());
+                break;
+            }
+            if used > 0 {
+                lines.push(String::new());
+                continue;
+            }
+            // A word longer than a whole line: cut it.
+            let rest = word.split_off(width);
+            last.extend(word.iter());
+            word = rest;
+            lines.push(String::new());
+        }
+    }
+    lines
 }
 
 /// The level-of-detail line: surface triangles drawn and what the full grids would take.
@@ -234,51 +335,76 @@ fn lod_line((drawn, full): (u64, u64)) -> String {
     }
 }
 
-/// The key help, laid out to fit a `width × height` window: two columns at 2× scale with the
-/// descriptions word-wrapped to the space left, or at 1× when even that does not fit.
-fn push_help(v: &mut Vec<OverlayVertex>, width: f32, height: f32) {
+/// The key help, laid out to fit a `width × height` image on an opaque panel: two columns
+/// at the normal text size with the descriptions word-wrapped to the space left, or at the
+/// small size when even that does not fit. Draw it last, above every other overlay.
+#[must_use]
+pub fn help_overlay(font: &Font, width: f32, height: f32) -> Vec<OverlayVertex> {
+    let mut v = Vec::new();
     let title = "prespline keys (H or F1 closes)";
-    let key_chars = KEY_HELP.iter().map(|(k, _)| k.len()).max().unwrap_or(0) + 3;
+    let key_chars = KEY_HELP
+        .iter()
+        .map(|(k, _)| k.chars().count())
+        .max()
+        .unwrap_or(0)
+        + 3;
+    let layout = help_layout(font, width, height, key_chars);
+    let HelpLayout {
+        size,
+        rows,
+        panel: [x, y, panel_w, panel_h],
+    } = layout;
+    let m = font.metrics(size);
+    let (advance, line) = (m.advance as f32, m.line_height as f32 + 2.0);
+    push_rect(&mut v, x, y, panel_w, panel_h, HELP_PANEL);
+    font.push_text(&mut v, title, x + 12.0, y + 10.0, size, TEXT);
+    let mut row = 1.5f32;
+    for (key, desc) in rows {
+        let ty = y + 10.0 + row * line;
+        font.push_text(&mut v, key, x + 12.0, ty, size, DIM);
+        for (k, part) in desc.iter().enumerate() {
+            let dx = x + 12.0 + key_chars as f32 * advance;
+            font.push_text(&mut v, part, dx, ty + k as f32 * line, size, TEXT);
+        }
+        row += desc.len() as f32;
+    }
+    v
+}
+
+/// Where the help goes and at which size.
+struct HelpLayout {
+    size: TextSize,
+    rows: Vec<(&'static str, Vec<String>)>,
+    /// x, y, width, height in pixels.
+    panel: [f32; 4],
+}
+
+/// The normal size when its wrapped rows fit the window, else the small one.
+fn help_layout(font: &Font, width: f32, height: f32, key_chars: usize) -> HelpLayout {
     let margin = 20.0;
-    let layout = |scale: f32| {
-        let advance = ADVANCE as f32 * scale;
-        let line = LINE_HEIGHT as f32 * scale + 2.0;
+    let at = |size: TextSize| {
+        let m = font.metrics(size);
+        let (advance, line) = (m.advance as f32, m.line_height as f32 + 2.0);
         let panel_w = (width - 2.0 * margin).max(0.0);
-        let desc_chars = ((panel_w - 24.0) / advance).floor() as usize;
-        let desc_chars = desc_chars.saturating_sub(key_chars);
+        let desc_chars =
+            (((panel_w - 24.0) / advance).floor().max(0.0) as usize).saturating_sub(key_chars);
         let rows: Vec<(&str, Vec<String>)> = KEY_HELP
             .iter()
             .map(|&(k, d)| (k, wrap(d, desc_chars.max(12))))
             .collect();
         let lines = rows.iter().map(|(_, d)| d.len()).sum::<usize>() as f32 + 1.5;
-        (
-            scale,
-            advance,
-            line,
-            panel_w,
-            desc_chars,
+        let panel_h = lines * line + 20.0;
+        let fits = desc_chars >= 24 && panel_h <= height - 2.0 * margin;
+        let y = ((height - panel_h) * 0.5).max(0.0).round();
+        let layout = HelpLayout {
+            size,
             rows,
-            lines * line + 20.0,
-        )
+            panel: [margin, y, panel_w, panel_h],
+        };
+        (layout, fits)
     };
-    let mut l = layout(2.0);
-    if l.4 < 24 || l.6 > height - 2.0 * margin {
-        l = layout(1.0);
-    }
-    let (scale, advance, line, panel_w, _, rows, panel_h) = l;
-    let (x, y) = (margin, ((height - panel_h) * 0.5).max(0.0));
-    push_rect(v, x, y, panel_w, panel_h, [8, 10, 14, 225]);
-    push_text(v, title, x + 12.0, y + 10.0, scale, TEXT);
-    let mut row = 1.5f32;
-    for (key, desc) in rows {
-        let ty = y + 10.0 + row * line;
-        push_text(v, key, x + 12.0, ty, scale, DIM);
-        for (k, part) in desc.iter().enumerate() {
-            let dx = x + 12.0 + key_chars as f32 * advance;
-            push_text(v, part, dx, ty + k as f32 * line, scale, TEXT);
-        }
-        row += desc.len() as f32;
-    }
+    let (normal, fits) = at(TextSize::Normal);
+    if fits { normal } else { at(TextSize::Small).0 }
 }
 
 /// Greedy word wrap to lines of at most `width` characters (longer words stay whole).
@@ -304,8 +430,7 @@ mod tests {
 
     /// Every vertex of the help overlay inside the window.
     fn fits(width: f32, height: f32) -> bool {
-        let mut v = Vec::new();
-        push_help(&mut v, width, height);
+        let v = help_overlay(&Font::new(1.0), width, height);
         !v.is_empty()
             && v.iter()
                 .all(|p| (0.0..=width).contains(&p.pos[0]) && (0.0..=height).contains(&p.pos[1]))
@@ -323,6 +448,36 @@ mod tests {
         }
         // Negative control: a window narrower than the key column cannot hold it.
         assert!(!fits(200.0, 150.0));
+    }
+
+    #[test]
+    fn status_fits_wraps_or_elides_the_middle_keeping_the_end() {
+        let font = Font::new(1.0);
+        let width = 800.0;
+        let fit = font.chars_fitting(width - 2.0 * STATUS_MARGIN, TextSize::Normal);
+        assert_eq!(status_lines(&font, width, "saved"), vec!["saved"]);
+        let two = "word ".repeat(fit / 5 + 3);
+        let lines = status_lines(&font, width, two.trim());
+        assert_eq!(lines.len(), 2);
+        assert_eq!(lines.join(" "), two.trim());
+        let long = format!(
+            "s: cannot save: {} is not a rational function, so save it as a .json scene instead",
+            "the ERBS surface ".repeat(12)
+        );
+        let lines = status_lines(&font, width, &long);
+        assert_eq!(lines.len(), 2);
+        assert!(lines[0].starts_with("s: cannot save:"), "{lines:?}");
+        assert!(lines[1].starts_with("… "), "{lines:?}");
+        assert!(
+            lines[1].ends_with("save it as a .json scene instead"),
+            "{lines:?}"
+        );
+        assert!(lines.iter().all(|l| l.chars().count() <= fit), "{lines:?}");
+        // A single word longer than the line is cut, not lost at the edge.
+        let word = "x".repeat(fit + 5);
+        let lines = status_lines(&font, width, &word);
+        assert!(lines.iter().all(|l| l.chars().count() <= fit));
+        assert_eq!(lines.concat(), word);
     }
 
     #[test]

@@ -4,7 +4,7 @@
 //! replays and `prespline bench` all drive this same type.
 
 use super::autosave::{Autosave, Kept, Lost};
-use super::hud::Hud;
+use super::hud::{Hud, help_overlay};
 use super::input::{InputEvent, Key, Modifiers, MouseButton};
 use super::picking::{PICK_RADIUS, Projected, pick, project_all};
 use super::refine::{Refine, index_text, path_text};
@@ -323,6 +323,8 @@ impl Session {
         let s: String = s.into();
         self.status = crate::scene::escape_controls(&s).into_owned();
         self.status_since = Some(Instant::now());
+        // The window may show it wrapped or with its middle elided; the whole text stays here.
+        eprintln!("prespline: {}", self.status);
     }
 
     fn view(&self) -> View<'_> {
@@ -465,7 +467,12 @@ impl Session {
             .draw(frame, self.editor.doc(), &self.options, &hl, &lod)?;
         self.hud.triangles = (report.triangles, report.full_triangles);
         let mut lines = overlay_lines(self.editor.doc(), &self.options, self.bounds.radius());
-        let mut analysis = Vec::new();
+        let font = frame.font();
+        let (width, height) = (self.size[0] as f32, self.size[1] as f32);
+        // Back to front: badges, legend, the osculating readout (never under a badge), the
+        // HUD and status line, and the help above everything.
+        let mut overlay = Vec::new();
+        let mut readout = Vec::new();
         if self.osculating
             && matches!(
                 self.mode,
@@ -476,8 +483,7 @@ impl Session {
             lines.extend(osculating_lines(&o));
             if let Some(at) = self.view().project(o.point) {
                 let name = &self.editor.doc().objects[object].name;
-                let size = [self.size[0] as f32, self.size[1] as f32];
-                analysis.extend(osculating_overlay(name, &o, at, size));
+                readout = osculating_overlay(name, &o, font, at, [width, height]);
             }
         }
         if !lines.is_empty() {
@@ -485,16 +491,12 @@ impl Session {
         }
         if self.options.badges {
             let view = self.view();
-            analysis.extend(badge_overlay(self.editor.doc(), |p| view.project(p)));
+            overlay.extend(badge_overlay(self.editor.doc(), font, |p| view.project(p)));
         }
         if let Some(map) = self.options.analysis {
-            analysis.extend(legend(
-                map,
-                self.map_range,
-                self.size[0] as f32,
-                self.size[1] as f32,
-            ));
+            overlay.extend(legend(map, self.map_range, font, width, height));
         }
+        overlay.extend(readout);
         if let Some(t) = self.status_since
             && t.elapsed().as_secs_f64() > 6.0
             && !matches!(self.mode, Mode::Transform { .. })
@@ -522,19 +524,14 @@ impl Session {
             ),
             _ => self.status.clone(),
         };
-        if !analysis.is_empty() {
-            frame.draw_overlay(&analysis)?;
-        }
         if hud {
-            let hud = self.hud.build(
-                self.size[0] as f32,
-                self.size[1] as f32,
-                &status,
-                self.show_help,
-            );
-            if !hud.is_empty() {
-                frame.draw_overlay(&hud)?;
+            overlay.extend(self.hud.build(font, width, height, &status, self.show_help));
+            if self.show_help {
+                overlay.extend(help_overlay(font, width, height));
             }
+        }
+        if !overlay.is_empty() {
+            frame.draw_overlay(&overlay)?;
         }
         Ok(())
     }

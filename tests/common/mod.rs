@@ -452,3 +452,81 @@ pub fn edit(
     gs.consume(&applied);
     applied
 }
+
+/// sRGB byte → linear.
+pub fn srgb_to_linear(c: u8) -> f32 {
+    let c = f32::from(c) / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Linear → sRGB byte.
+pub fn linear_to_srgb(c: f32) -> u8 {
+    let c = c.clamp(0.0, 1.0);
+    let s = if c <= 0.003_130_8 {
+        c * 12.92
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    };
+    (s * 255.0).round() as u8
+}
+
+/// What a pixel of overlay text with coverage `a` (0..=255) in colour `color` over the opaque
+/// `panel` looks like: the GPU blends in linear space into an sRGB target.
+pub fn text_over(panel: [u8; 4], color: [u8; 4], a: u8) -> [u8; 3] {
+    let a = f32::from(a) / 255.0;
+    std::array::from_fn(|i| {
+        let (p, c) = (srgb_to_linear(panel[i]), srgb_to_linear(color[i]));
+        linear_to_srgb(p + (c - p) * a)
+    })
+}
+
+/// Reads `count` characters of overlay text whose first cell's top-left corner is `at`,
+/// drawn with `font` at `size` in `color` over the opaque `panel`: each cell is compared with
+/// every printable ASCII glyph (and `…`) as the GPU would blend it, and the closest wins. The
+/// overlay font is monospace on whole pixels, so this reads what a user sees on the panel.
+pub fn read_text(
+    px: &Pixels,
+    font: &prespline::gpu::font::Font,
+    size: prespline::gpu::font::TextSize,
+    at: [u32; 2],
+    count: usize,
+    panel: [u8; 4],
+    color: [u8; 4],
+) -> String {
+    let m = font.metrics(size);
+    let candidates: Vec<(char, Vec<u8>)> = (' '..='~')
+        .chain(['…'])
+        .map(|c| (c, font.glyph_cell(c, size)))
+        .collect();
+    let mut text = String::new();
+    for i in 0..count as u32 {
+        let x0 = at[0] + i * m.advance;
+        let error = |cell: &[u8]| -> u64 {
+            let mut e = 0u64;
+            for y in 0..m.cell[1] {
+                for x in 0..m.advance {
+                    let (gx, gy) = (x0 + x, at[1] + y);
+                    if gx >= px.width || gy >= px.height {
+                        return u64::MAX;
+                    }
+                    let want = text_over(panel, color, cell[(y * m.cell[0] + x) as usize]);
+                    let got = px.get(gx, gy);
+                    e += (0..3)
+                        .map(|k| u64::from(want[k].abs_diff(got[k])))
+                        .sum::<u64>();
+                }
+            }
+            e
+        };
+        let best = candidates
+            .iter()
+            .min_by_key(|(_, cell)| error(cell))
+            .map_or('?', |(c, _)| *c);
+        text.push(best);
+    }
+    text
+}

@@ -4,7 +4,7 @@
 use crate::common;
 
 use glam::Vec3;
-use prespline::gpu::font::{push_rect, push_text, text_size};
+use prespline::gpu::font::{TextSize, push_rect};
 use prespline::gpu::{
     GridShape, LineVertex, OffscreenDesc, PointRun, PointStyle, PolylineStyle, SurfaceGrid,
     SurfaceStyle,
@@ -61,14 +61,15 @@ fn synthetic_scene_matches_golden() {
         });
     }
     let mut hud = Vec::new();
-    let [tw, th] = text_size("prespline 0.1", 2.0);
+    let font = r.font();
+    let [tw, th] = font.text_size("prespline 0.1", TextSize::Normal);
     push_rect(&mut hud, 4.0, 4.0, tw + 8.0, th + 8.0, [0, 0, 0, 160]);
-    push_text(
+    font.push_text(
         &mut hud,
         "prespline 0.1",
         8.0,
         8.0,
-        2.0,
+        TextSize::Normal,
         [255, 230, 120, 255],
     );
 

@@ -10,8 +10,12 @@ use crate::common;
 
 use glam::DVec3;
 use prespline::editor::Document;
+use prespline::gpu::font::TextSize;
 use prespline::gpu::{OffscreenDesc, OffscreenTarget, Pixels, Renderer};
 use prespline::model::{Edit, KindEdit, PointEdit, SurfaceEdit};
+use prespline::render::analysis::{
+    CurveEval, Osculating, PANEL, badge_overlay, osculating_panel_origin, osculating_text,
+};
 use prespline::render::maps::SurfaceMap;
 use prespline::render::offscreen::{Shot, render_document, shot_camera};
 use prespline::render::{GpuScene, Highlight, Lod, MapView, ViewOptions};
@@ -338,4 +342,110 @@ fn a_drag_copies_only_its_rows_of_the_map() {
     }
     common::teardown(renderer, sink);
     assert!(bytes[1] > bytes[0]);
+}
+
+/// Whether every pixel of `rect` is the readout's panel, its magenta text or a blend of the
+/// two (within 2 per channel): no badge or other overlay shows on the readout.
+fn only_readout(px: &Pixels, rect: [u32; 4]) -> Result<(), String> {
+    let blends: Vec<[u8; 3]> = (0..=255u8)
+        .map(|a| common::text_over(PANEL, READOUT, a))
+        .collect();
+    for y in rect[1]..rect[3] {
+        for x in rect[0]..rect[2] {
+            let p = px.get(x, y);
+            let near = blends
+                .iter()
+                .any(|b| (0..3).all(|k| b[k].abs_diff(p[k]) <= 2));
+            if !near {
+                return Err(format!("pixel ({x}, {y}) is {p:?}: not the readout"));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The readout's text colour (sRGB).
+const READOUT: [u8; 4] = [240, 150, 240, 255];
+
+/// `prespline render examples/catmull_rom.json --badges --osculating centripetal@3.3`: the
+/// readout lies over a G1 badge there, and is drawn above it on its opaque panel (it used to
+/// read "cur C2 ture").
+#[test]
+fn the_osculating_readout_is_not_overlapped_by_badges() {
+    let scene = load("examples/catmull_rom.json");
+    let i = scene
+        .objects
+        .iter()
+        .position(|o| o.name == "centripetal")
+        .unwrap();
+    let options = ViewOptions {
+        badges: true,
+        osculating_at: Some((i, 3.3)),
+        ..ViewOptions::default()
+    };
+    let (mut renderer, sink) = common::renderer();
+    let doc = Document::new(&scene);
+    let shot = Shot {
+        width: 1280,
+        height: 720,
+        camera: None,
+        options,
+        msaa: 0,
+    };
+    let px = render_document(&mut renderer, &doc, &shot).unwrap();
+    // Where the readout goes, as the renderer places it.
+    let font = renderer.font();
+    let o = Osculating::at(&CurveEval::of(doc.objects[i].sampled.model()).unwrap(), 3.3).unwrap();
+    let (w, h) = (shot.width as f64, shot.height as f64);
+    let (x, y, _) = shot_camera(&doc, &shot)
+        .project(o.point, w, h, &doc.bounds())
+        .unwrap();
+    let [tw, th] = font.text_size(&osculating_text("centripetal", &o), TextSize::Normal);
+    let [px0, py0] = osculating_panel_origin([tw, th], (x, y), [w as f32, h as f32]);
+    let rect = [
+        px0 as u32,
+        py0 as u32,
+        (px0 + tw + 10.0) as u32,
+        (py0 + th + 8.0) as u32,
+    ];
+    // A badge lies under the readout here (a join of a curve inside its panel).
+    let badges = badge_overlay(&doc, font, |p| {
+        shot_camera(&doc, &shot)
+            .project(p, w, h, &doc.bounds())
+            .map(|(x, y, _)| (x, y))
+    });
+    let covered = badges.chunks_exact(6).any(|q| {
+        let (a, b) = (q[0].pos, q[2].pos);
+        a[0] < rect[2] as f32
+            && b[0] > rect[0] as f32
+            && a[1] < rect[3] as f32
+            && b[1] > rect[1] as f32
+    });
+    assert!(
+        covered,
+        "no badge under the readout: the test shows nothing"
+    );
+    let magenta = (rect[1]..rect[3])
+        .flat_map(|y| (rect[0]..rect[2]).map(move |x| (x, y)))
+        .filter(|&(x, y)| px.get(x, y)[..3] == READOUT[..3])
+        .count();
+    assert!(
+        magenta > 200,
+        "the readout is not there ({magenta} text pixels)"
+    );
+    only_readout(&px, rect).unwrap_or_else(|e| {
+        px.write_png(&std::env::temp_dir().join("readout-actual.png"))
+            .unwrap();
+        panic!("{e}")
+    });
+    // Negative control: a badge-coloured square on the panel is found.
+    let mut bad = px.clone();
+    for y in rect[1] + 2..rect[1] + 6 {
+        for x in rect[0] + 2..rect[0] + 6 {
+            let at = ((y * bad.width + x) * 4) as usize;
+            bad.rgba[at..at + 3].copy_from_slice(&[235, 190, 60]);
+        }
+    }
+    assert!(only_readout(&bad, rect).is_err());
+    common::teardown(renderer, sink);
 }
