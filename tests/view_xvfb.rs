@@ -651,3 +651,39 @@ fn screenshots_show_the_bytes_their_frame_copied() {
     }
     assert_eq!(nonzero, 1, "frame 7 copies frame 6's rows: {bytes:?}");
 }
+
+/// A status message the window can only show with its middle elided (saving an expo ERBS
+/// surface as OBJ, with its advice at the end) goes to stderr whole, once; a short one does not.
+#[test]
+fn an_elided_status_goes_to_stderr_whole() {
+    if !common::display() {
+        return;
+    }
+    let dir = Scratch::new("view-xvfb");
+    let example =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/erbs_surface.json");
+    let out = run(prespline(&dir)
+        .arg("view")
+        .arg(&example)
+        .args(["--size", "320x240", "--save-as", "x.obj", "--script"])
+        .arg(dir.file(
+            "save.json",
+            r#"[{"frame": 2, "key": "s", "ctrl": true}, {"frame": 4, "key": "j"}, {"frame": 6, "quit": true}]"#,
+        )));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let echoed: Vec<&str> = err
+        .lines()
+        .filter(|l| l.starts_with("prespline: "))
+        .collect();
+    assert_eq!(
+        echoed.len(),
+        1,
+        "the long message once, the short one never: {err}"
+    );
+    assert!(
+        echoed[0].starts_with("prespline: save failed: ") && echoed[0].ends_with(')'),
+        "the whole message, advice included: {err}"
+    );
+    assert!(!dir.join("x.obj").exists());
+}

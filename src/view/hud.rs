@@ -258,7 +258,7 @@ pub fn status_top(font: &Font, height: f32, lines: usize) -> f32 {
 
 /// The status message as shown in a `width`-pixel window: one line when it fits, else
 /// word-wrapped onto two, else its middle elided (`…`) so that the start and the end (where
-/// the advice is) both show. The full text goes to stderr when the status is set.
+/// the advice is) both show. The viewer writes an elided message to stderr whole.
 #[must_use]
 pub fn status_lines(font: &Font, width: f32, status: &str) -> Vec<String> {
     let fit = font
@@ -285,6 +285,14 @@ pub fn status_lines(font: &Font, width: f32, status: &str) -> Vec<String> {
         tail = tail[space..].to_string();
     }
     vec![first, format!("… {}", tail.trim_start())]
+}
+
+/// Whether the window shows `status` with its middle elided ([`status_lines`]).
+#[must_use]
+pub fn status_elided(font: &Font, width: f32, status: &str) -> bool {
+    status_lines(font, width, status)
+        .last()
+        .is_some_and(|l| l.starts_with("… "))
 }
 
 /// Greedy word wrap to lines of at most `width` characters; a word longer than a line is cut.

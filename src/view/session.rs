@@ -4,7 +4,7 @@
 //! replays and `prespline bench` all drive this same type.
 
 use super::autosave::{Autosave, Kept, Lost};
-use super::hud::{Hud, help_overlay};
+use super::hud::{Hud, help_overlay, status_elided};
 use super::input::{InputEvent, Key, Modifiers, MouseButton};
 use super::picking::{PICK_RADIUS, Projected, pick, project_all};
 use super::refine::{Refine, index_text, path_text};
@@ -95,6 +95,8 @@ pub struct Session {
     save_path: PathBuf,
     status: String,
     status_since: Option<Instant>,
+    /// The last status message written to stderr because the window cut it.
+    status_echoed: String,
     pub hud: Hud,
     pub show_help: bool,
     pub quit: bool,
@@ -168,6 +170,7 @@ impl Session {
             save_path,
             status: "H or F1: keys".into(),
             status_since: Some(Instant::now()),
+            status_echoed: String::new(),
             hud: Hud::new(),
             show_help: false,
             quit: false,
@@ -246,8 +249,10 @@ impl Session {
             .map(Autosave::take_notes)
             .unwrap_or_default();
         for note in notes {
-            eprintln!("{note}");
+            eprintln!("{}", crate::scene::escape_controls(&note));
             self.set_status(note);
+            // Already on stderr whole: not again when the window elides it.
+            self.status_echoed.clone_from(&self.status);
         }
     }
 
@@ -323,8 +328,6 @@ impl Session {
         let s: String = s.into();
         self.status = crate::scene::escape_controls(&s).into_owned();
         self.status_since = Some(Instant::now());
-        // The window may show it wrapped or with its middle elided; the whole text stays here.
-        eprintln!("prespline: {}", self.status);
     }
 
     fn view(&self) -> View<'_> {
@@ -525,6 +528,12 @@ impl Session {
             _ => self.status.clone(),
         };
         if hud {
+            // A message the window can only show with its middle elided goes to stderr whole,
+            // once, so its advice is never lost.
+            if status_elided(font, width, &status) && self.status_echoed != status {
+                eprintln!("prespline: {status}");
+                self.status_echoed.clone_from(&status);
+            }
             overlay.extend(self.hud.build(font, width, height, &status, self.show_help));
             if self.show_help {
                 overlay.extend(help_overlay(font, width, height));
