@@ -177,6 +177,12 @@ impl Editor {
         std::mem::take(&mut self.applied)
     }
 
+    /// Applies the queued edits now (so the document shows them), keeping the report for the
+    /// next [`Editor::apply_pending`].
+    pub fn apply_queued(&mut self) {
+        self.flush();
+    }
+
     /// Applies the queued edits into the held report.
     fn flush(&mut self) {
         if self.pending.is_empty() {

@@ -64,6 +64,19 @@ pub struct LocalPath<I> {
     steps: [I; MAX_NESTING],
 }
 
+/// "2 → [1, 0]": the steps from the object's own locals down.
+impl<I: Copy + std::fmt::Display> std::fmt::Display for LocalPath<I> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        for (k, step) in self.steps[..usize::from(self.len)].iter().enumerate() {
+            if k > 0 {
+                f.write_str(" → ")?;
+            }
+            write!(f, "{step}")?;
+        }
+        Ok(())
+    }
+}
+
 impl<I: Copy + Default> LocalPath<I> {
     /// `None` for an empty or too long path.
     pub fn new(steps: &[I]) -> Option<Self> {

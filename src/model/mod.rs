@@ -42,6 +42,16 @@ pub enum Index2 {
     Two(usize, usize),
 }
 
+/// "3" or "[1, 2]", as messages and the file format write an index.
+impl std::fmt::Display for Index2 {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            Index2::One(k) => write!(f, "{k}"),
+            Index2::Two(a, b) => write!(f, "[{a}, {b}]"),
+        }
+    }
+}
+
 /// How a polynomial-basis object is written: as a Bézier object (one span on [0, 1]) or as a
 /// B-spline. Both are evaluated as B-splines; knot insertion turns a Bézier object into a
 /// B-spline object.

@@ -1,6 +1,7 @@
 //! The on-screen overlay: frame-time graph, edit cost, samples touched, bytes copied to the GPU,
 //! GPU time; the status line; and the key help.
 
+use super::keymap::KEY_HELP;
 use crate::gpu::OverlayVertex;
 use crate::gpu::font::{Font, TextSize, push_rect};
 use std::collections::VecDeque;
@@ -14,82 +15,6 @@ const DIM: [u8; 4] = [150, 155, 165, 255];
 const PANEL: [u8; 4] = crate::render::analysis::PANEL;
 /// The help's panel (opaque too).
 pub const HELP_PANEL: [u8; 4] = [8, 10, 14, 255];
-
-/// Every key binding, as shown by the help overlay (H or F1); docs/viewer.md and the README's key
-/// table describe the same keys.
-pub const KEY_HELP: &[(&str, &str)] = &[
-    (
-        "left drag on a point",
-        "move it in the view plane (X/Y/Z while dragging: along an axis)",
-    ),
-    ("left drag elsewhere", "orbit"),
-    (
-        "middle drag / right drag / shift+left drag",
-        "orbit / pan / pan",
-    ),
-    ("wheel", "zoom to the cursor"),
-    (
-        "click a point",
-        "select it (ERBS: selects its local curve/patch too)",
-    ),
-    (
-        "G / R / S",
-        "grab / rotate / scale the selected local curve or patch (G also a point)",
-    ),
-    (
-        "  X / Y / Z, digits, Enter",
-        "axis constraint, typed value (distance, degrees, factor), confirm",
-    ),
-    ("  Esc / right click", "cancel the transform"),
-    (
-        "I",
-        "insert a knot at the cursor on the selected curve or surface (U/V direction)",
-    ),
-    (
-        "  on ERBS",
-        "refine at the cursor: a new local (row/column of patches) in the selected local's level",
-    ),
-    (
-        "X",
-        "turn the selected ERBS local into an ERBS of its own (3 locals per direction, same shape)",
-    ),
-    (
-        "E / Shift+E",
-        "elevate the degree of the selected curve or surface (in u / in v)",
-    ),
-    (
-        "Alt+drag on a point / Shift+W",
-        "change its weight (up: heavier) / type its weight; a polynomial object becomes rational",
-    ),
-    (
-        "B",
-        "convert the selected Catmull-Rom or Bezier spline to a bspline_curve",
-    ),
-    (
-        "J / O",
-        "continuity badges at joins / osculating circle, curvature, torsion at the cursor",
-    ),
-    (
-        "M",
-        "surface map: Gaussian, mean, max and min principal curvature, zebra, off",
-    ),
-    ("Ctrl+Z / Ctrl+Shift+Z (Ctrl+Y)", "undo / redo"),
-    ("Ctrl+S", "save the scene file"),
-    ("F / A / Home", "frame selection / frame all / reset camera"),
-    (
-        "C / L / W",
-        "control nets / local curves / wireframe (off, isolines, full)",
-    ),
-    ("N / T / K", "normals / Frenet frames / curvature combs"),
-    (
-        "D",
-        "level of detail on/off (dense surfaces drawn from a strided subset)",
-    ),
-    ("P", "performance overlay"),
-    ("H or F1", "this help"),
-    ("Esc", "deselect"),
-    ("Ctrl+Q or close the window", "quit"),
-];
 
 /// Numbers shown in the overlay.
 #[derive(Debug, Clone, Default)]

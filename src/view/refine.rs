@@ -100,6 +100,19 @@ impl Refine {
         });
     }
 
+    /// Whether the object takes knots at all (Catmull–Rom and Bézier splines keep their
+    /// segments); the reason, with the way out, when not.
+    pub fn supported(&self, doc: &Document) -> Result<(), String> {
+        let model = doc.objects[self.object].sampled.model();
+        match model {
+            ModelRef::CatmullRom(_) | ModelRef::BezierSpline(_) => Err(format!(
+                "a {} keeps its segments: B converts it to a bspline_curve first",
+                model.type_name()
+            )),
+            _ => Ok(()),
+        }
+    }
+
     /// The insertion as an edit, validated against the object (an error is one line).
     pub fn edit(&self, doc: &Document) -> Result<Edit, String> {
         let t = self
@@ -115,10 +128,7 @@ impl Refine {
             }
             .into_object(),
             ModelRef::CatmullRom(_) | ModelRef::BezierSpline(_) => {
-                return Err(format!(
-                    "a {} keeps its segments: B converts it to a bspline_curve first",
-                    model.type_name()
-                ));
+                return Err(self.supported(doc).err().unwrap_or_default());
             }
             ModelRef::ErbsCurve(_) => ErbsCurveEdit::InsertKnot {
                 local: self.level.and_then(|p| p.to_curve()),
@@ -206,7 +216,7 @@ impl Refine {
             .ok_or_else(|| {
                 format!(
                     "{axis} = {t:.4} is outside local {} ({axis} in [{a:.4}, {b:.4}]): aim inside it",
-                    path_text(path),
+                    path,
                     axis = self.axis_name(doc),
                 )
             })
@@ -235,7 +245,7 @@ impl Refine {
         };
         Some(match self.level {
             None => what,
-            Some(p) => format!("{what} in local {}", path_text(p)),
+            Some(p) => format!("{what} in local {}", p),
         })
     }
 
@@ -269,7 +279,7 @@ impl Refine {
         }
         let level = self
             .level
-            .map_or(String::new(), |p| format!(" local {}", path_text(p)));
+            .map_or(String::new(), |p| format!(" local {}", p));
         let at = self
             .at
             .map_or("aim at the object".into(), |t| format!("{dir}{t:.4}"));
@@ -344,19 +354,6 @@ fn isoline(dir: usize, t: f64, (a, b): (f64, f64), eval: impl Fn(f64, f64) -> DV
             if dir == 0 { eval(t, x) } else { eval(x, t) }
         })
         .collect()
-}
-
-/// "2 → [1, 0]" for messages.
-pub fn path_text(path: LocalPath<Index2>) -> String {
-    let steps: Vec<String> = path.steps().iter().map(|&i| index_text(i)).collect();
-    steps.join(" → ")
-}
-
-pub fn index_text(i: Index2) -> String {
-    match i {
-        Index2::One(k) => k.to_string(),
-        Index2::Two(a, b) => format!("[{a}, {b}]"),
-    }
 }
 
 /// The sample projecting nearest the cursor (within `radius` pixels): a coarse search over

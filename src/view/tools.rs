@@ -56,9 +56,13 @@ impl View<'_> {
     }
 
     pub fn project(&self, p: DVec3) -> Option<(f64, f64)> {
+        self.project_depth(p).map(|(x, y, _)| (x, y))
+    }
+
+    /// Pixel position and depth in [0, 1] of a world point; `None` behind the eye.
+    pub fn project_depth(&self, p: DVec3) -> Option<(f64, f64, f64)> {
         self.camera
             .project(p, self.size[0], self.size[1], self.bounds)
-            .map(|(x, y, _)| (x, y))
     }
 }
 
