@@ -3,10 +3,11 @@
 //! into the object or into an ERBS local, a polynomial local turned into an ERBS local of its own.
 //! One generic edit type serves both kinds through [`ErbsNet`].
 
-use super::edit::{EditError, KindEdit, ObjectEdit, Target};
+use super::edit::{EditError, KindEdit, ObjectEdit, Target, check_shape_kept};
 use super::points::check_vector;
 use super::{Index2, MAX_CURVE_SAMPLES, MAX_DEGREE, check_samples, check_surface_samples};
 use crate::geom::erbs::{ErbsCurve, ErbsSurface, LocalCurve, LocalPatch, MAX_NESTING};
+use crate::geom::shape::{ShapeChange, erbs_knot_probes, erbs_probes, shape_change};
 use crate::geom::{BFunctionKind, GeomError};
 use glam::{DMat4, DVec3, DVec4};
 use std::fmt::Debug;
@@ -190,6 +191,16 @@ pub trait ErbsNet: Clone + PartialEq + Debug + Sized {
     ) -> Result<Self, GeomError>;
     fn bfunction(&self) -> BFunctionKind;
     fn check_degree(d: Self::Degree) -> Result<(), EditError>;
+
+    /// What the kind is called in messages ("curve", "surface"), and one of its locals.
+    const NOUN: &'static str;
+    const LOCAL_NOUN: &'static str;
+    /// How far `refined` (this net refined at `at`) moved the shape where local refinement
+    /// keeps it: at the knots, at `at`, and on the intervals beside the refined one.
+    fn refinement_change(&self, refined: &Self, at: Self::Knot) -> ShapeChange;
+    /// How far `built` (an ERBS local built from `local`) lies from `local` at its knots, where
+    /// it interpolates it.
+    fn build_change(local: &Self::Local, built: &Self) -> ShapeChange;
 
     fn into_object(e: ErbsEdit<Self>) -> ObjectEdit;
     fn from_object(e: &ObjectEdit) -> Option<&ErbsEdit<Self>>;
@@ -375,7 +386,12 @@ impl<N: ErbsNet> ErbsEdit<N> {
                         )
                     })?,
                 };
-                target.refine(*at, *degree).map(|_| ()).map_err(geom)
+                let refined = target.refine(*at, *degree).map_err(geom)?;
+                check_shape_kept(
+                    "insert_knot",
+                    N::NOUN,
+                    target.refinement_change(&refined, *at),
+                )
             }
             ErbsEdit::ToErbs {
                 local,
@@ -392,9 +408,8 @@ impl<N: ErbsNet> ErbsEdit<N> {
                         format!("ERBS locals nest at most {MAX_NESTING} levels deep"),
                     ));
                 }
-                N::build(l, *count, *degree, net.bfunction())
-                    .map(|_| ())
-                    .map_err(geom)
+                let built = N::build(l, *count, *degree, net.bfunction()).map_err(geom)?;
+                check_shape_kept("to_erbs", N::LOCAL_NOUN, N::build_change(l, &built))
             }
             ErbsEdit::SetLocal { local, .. } => local_of(net, local).map(|_| ()),
             ErbsEdit::Restore(_) => Ok(()),
@@ -657,6 +672,21 @@ impl ErbsNet for ErbsCurve {
         check_max_degree("degree", d)
     }
 
+    const NOUN: &'static str = "curve";
+    const LOCAL_NOUN: &'static str = "local curve";
+
+    fn refinement_change(&self, refined: &Self, t: f64) -> ShapeChange {
+        let degree = self.local_curves().iter().map(LocalCurve::degree).max();
+        let mut at = erbs_probes(self.knots(), degree.unwrap_or(0), Some(self.knots().locate(t)));
+        at.push(t);
+        shape_change(self, refined, &at)
+    }
+
+    fn build_change(local: &LocalCurve, built: &Self) -> ShapeChange {
+        let at = erbs_knot_probes(built.knots());
+        shape_change(local, &Self::wrap(built.clone()), &at)
+    }
+
     fn into_object(e: ErbsEdit<Self>) -> ObjectEdit {
         ObjectEdit::ErbsCurve(e)
     }
@@ -773,6 +803,31 @@ impl ErbsNet for ErbsSurface {
 
     fn check_degree([du, dv]: [usize; 2]) -> Result<(), EditError> {
         check_max_degree("degree", du.max(dv))
+    }
+
+    const NOUN: &'static str = "surface";
+    const LOCAL_NOUN: &'static str = "local patch";
+
+    /// On a grid: the probes beside the refined interval in its direction against every knot
+    /// and interval of the other, and the line u = t (or v = t) at the other's knots only
+    /// (the new patches interpolate there, at their knot crossings).
+    fn refinement_change(&self, refined: &Self, (dir, t): (usize, f64)) -> ShapeChange {
+        let knots = self.knots();
+        let degree = self
+            .local_patches()
+            .iter()
+            .map(LocalPatch::degree)
+            .fold([0, 0], |a, d| [a[0].max(d[0]), a[1].max(d[1])]);
+        let mut beside = [0, 1].map(|d| erbs_probes(&knots[d], degree[d], None));
+        beside[dir] = erbs_probes(&knots[dir], degree[dir], Some(knots[dir].locate(t)));
+        let mut line = [0, 1].map(|d| erbs_knot_probes(&knots[d]));
+        line[dir] = vec![t];
+        shape_change(self, refined, &beside).worse(shape_change(self, refined, &line))
+    }
+
+    fn build_change(local: &LocalPatch, built: &Self) -> ShapeChange {
+        let at = built.knots().each_ref().map(erbs_knot_probes);
+        shape_change(local, &Self::wrap(built.clone()), &at)
     }
 
     fn into_object(e: ErbsEdit<Self>) -> ObjectEdit {

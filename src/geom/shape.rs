@@ -1,0 +1,379 @@
+//! How far a structural edit moves a shape. Knot insertion and degree elevation promise the
+//! same shape; ERBS refinement promises it outside the refined interval and at the knots. Before
+//! such an edit is applied, its result is compared with the shape it replaces ([`shape_change`])
+//! at parameters where the promise must hold ([`span_probes`]: d+1 per span), and src/model
+//! refuses an edit that would move the shape by more than [`SHAPE_TOLERANCE`] of its size.
+//!
+//! Positions only: a refined net carries the shape's derivatives as accurately as its spans
+//! allow (docs/scene-format.md), and that is a property of the representation, not a move.
+
+use super::basis::basis_funs;
+use super::bspline::BSplineCurve;
+use super::erbs::{ErbsCurve, ErbsKnots, ErbsSurface, LocalCurve, LocalPatch};
+use super::point::nan_max;
+use super::surface::TensorSurface;
+use glam::{DVec3, DVec4};
+
+/// How far a structural edit may move a shape, as a fraction of its size: far above the rounding
+/// of a stable refinement (about 1e-15 of the size), far below anything visible.
+pub const SHAPE_TOLERANCE: f64 = 1e-9;
+
+/// Rounding of the coordinates themselves, relative to their magnitude: a net far from the
+/// origin compared with its size is refined to the last bits of its coordinates, not of its
+/// size, so that much movement is always allowed.
+const COORDINATE_ROUNDING: f64 = 1e3 * f64::EPSILON;
+
+/// The largest distance between an old and a new shape at the compared parameters, the old
+/// control net's size (bounding-box diagonal) and its largest coordinate.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShapeChange {
+    pub moved: f64,
+    pub size: f64,
+    pub magnitude: f64,
+}
+
+impl ShapeChange {
+    /// The largest movement allowed: [`SHAPE_TOLERANCE`] of the size, or the rounding of the
+    /// coordinates where that is larger.
+    pub fn tolerance(&self) -> f64 {
+        (SHAPE_TOLERANCE * self.size).max(COORDINATE_ROUNDING * self.magnitude)
+    }
+
+    /// The larger movement of two comparisons of the same shape.
+    #[must_use]
+    pub fn worse(self, other: ShapeChange) -> ShapeChange {
+        ShapeChange {
+            moved: nan_max(self.moved, other.moved),
+            ..self
+        }
+    }
+
+    /// Moved by at most [`ShapeChange::tolerance`]; a NaN anywhere counts as moved.
+    pub fn is_kept(&self) -> bool {
+        self.moved <= self.tolerance()
+    }
+}
+
+/// A shape that structural edits compare: its positions at given parameters, and its control
+/// points (for its size).
+pub trait Shape {
+    /// Where positions are compared: parameters (curves) or a grid of them (surfaces).
+    type Probes: ?Sized;
+
+    /// The positions at `at`, in a fixed order.
+    fn positions(&self, at: &Self::Probes) -> Vec<DVec3>;
+
+    /// Calls `f` on every control point, at any depth.
+    fn each_control_point(&self, f: &mut dyn FnMut(DVec3));
+}
+
+/// How far `new` lies from `old` at `at`, against the size of `old`'s control net: the one
+/// comparison every structural edit runs before it is applied.
+#[must_use]
+pub fn shape_change<S: Shape + ?Sized>(old: &S, new: &S, at: &S::Probes) -> ShapeChange {
+    let moved = old
+        .positions(at)
+        .iter()
+        .zip(new.positions(at))
+        .fold(0.0, |m, (a, b)| nan_max(m, a.distance(b)));
+    let (mut lo, mut hi, mut magnitude) = (DVec3::INFINITY, DVec3::NEG_INFINITY, 0.0);
+    old.each_control_point(&mut |p| {
+        lo = lo.min(p);
+        hi = hi.max(p);
+        magnitude = nan_max(magnitude, p.abs().max_element());
+    });
+    let size = if lo.cmple(hi).all() {
+        (hi - lo).length()
+    } else {
+        0.0
+    };
+    ShapeChange {
+        moved,
+        size,
+        magnitude,
+    }
+}
+
+/// d+1 parameters inside each non-empty span of `knots` within [a, b] (the midpoints of d+1
+/// equal parts): two polynomials of degree ≤ d that agree there are equal on the span.
+#[must_use]
+pub fn span_probes(knots: &[f64], degree: usize, (a, b): (f64, f64)) -> Vec<f64> {
+    let per = degree + 1;
+    let mut out = Vec::new();
+    for w in knots.windows(2) {
+        let (lo, hi) = (w[0].max(a), w[1].min(b));
+        if lo < hi {
+            out.extend((0..per).map(|i| lo + (hi - lo) * (i as f64 + 0.5) / per as f64));
+        }
+    }
+    out
+}
+
+/// The Greville abscissae (u_{i+1} + … + u_{i+d}) / d of n points, held inside [a, b]: at them
+/// the d-th degree B-splines of a clamped vector without jumps are independent (Schoenberg and
+/// Whitney), so a surface compared there along an unrefined direction is compared on every
+/// line of its net. Degree 0 takes the midpoint of each span.
+#[must_use]
+pub fn greville(knots: &[f64], degree: usize, n: usize, (a, b): (f64, f64)) -> Vec<f64> {
+    if degree == 0 {
+        return span_probes(knots, 0, (a, b));
+    }
+    (0..n)
+        .map(|i| {
+            let mean = knots[i + 1..=i + degree].iter().sum::<f64>() / degree as f64;
+            mean.clamp(a, b)
+        })
+        .collect()
+}
+
+/// Where an ERBS direction refined inside interval `changed` keeps its shape: the knots around
+/// it and d+1 parameters inside each neighbouring interval, where the two restricted locals
+/// blend with unchanged ones; with `None`, every knot and every interval (a direction that was
+/// not refined). Held to the domain window. An ERBS blend is no polynomial, so these are
+/// samples, not a proof: they are where a wrong restriction or placement of a local shows.
+#[must_use]
+pub fn erbs_probes(knots: &ErbsKnots, degree: usize, changed: Option<usize>) -> Vec<f64> {
+    let count = knots.intervals();
+    let intervals: Vec<usize> = match changed {
+        None => (0..count).collect(),
+        Some(i) if knots.is_closed() => vec![(i + count - 1) % count, (i + 1) % count],
+        Some(i) => [i.checked_sub(1), Some(i + 1).filter(|&j| j < count)]
+            .into_iter()
+            .flatten()
+            .collect(),
+    };
+    let (a, b) = knots.domain();
+    let mut out = Vec::new();
+    for i in intervals {
+        let (lo, hi) = knots.interval(i);
+        out.extend([lo, hi].into_iter().filter(|t| (a..=b).contains(t)));
+        out.extend(span_probes(&[lo, hi], degree, (a, b)));
+    }
+    out
+}
+
+/// The knots (centres) of an ERBS direction inside its domain window: where an ERBS built from
+/// a local interpolates it.
+#[must_use]
+pub fn erbs_knot_probes(knots: &ErbsKnots) -> Vec<f64> {
+    let (a, b) = knots.domain();
+    (0..=knots.intervals())
+        .map(|i| knots.centre(i))
+        .filter(|t| (a..=b).contains(t))
+        .collect()
+}
+
+impl Shape for BSplineCurve {
+    type Probes = [f64];
+
+    fn positions(&self, at: &[f64]) -> Vec<DVec3> {
+        at.iter().map(|&t| self.eval(t)).collect()
+    }
+
+    fn each_control_point(&self, f: &mut dyn FnMut(DVec3)) {
+        self.points().iter().for_each(|&p| f(p));
+    }
+}
+
+/// One direction's basis at each probe: the span and the d+1 non-vanishing functions.
+fn probe_bases(s: &TensorSurface, dir: usize, at: &[f64]) -> Vec<(usize, Vec<f64>)> {
+    let (d, n, knots) = (s.degree()[dir], s.count()[dir], &s.knots()[dir]);
+    let (a, b) = s.domain()[dir];
+    at.iter()
+        .map(|&t| {
+            let t = t.clamp(a, b);
+            let span = knots.find_span(d, n, t);
+            (span, basis_funs(knots, d, span, t))
+        })
+        .collect()
+}
+
+impl Shape for TensorSurface {
+    /// The grid `us × vs`.
+    type Probes = [Vec<f64>; 2];
+
+    /// S(u, v) over the grid by the tensor structure: each row of the net is combined for every
+    /// v first, then the rows for every u (BasisFuns once per parameter, in homogeneous form).
+    fn positions(&self, [us, vs]: &[Vec<f64>; 2]) -> Vec<DVec3> {
+        let [du, dv] = self.degree();
+        let [nu, nv] = self.count();
+        let h = self.homogeneous_points();
+        let (bu, bv) = (probe_bases(self, 0, us), probe_bases(self, 1, vs));
+        let mut rows = vec![DVec4::ZERO; nu * vs.len()];
+        for i in 0..nu {
+            for (j, (span, n)) in bv.iter().enumerate() {
+                let line = &h[i * nv + span - dv..=i * nv + span];
+                rows[i * vs.len() + j] = line.iter().zip(n).map(|(p, &w)| *p * w).sum();
+            }
+        }
+        let mut out = Vec::with_capacity(us.len() * vs.len());
+        for (span, n) in &bu {
+            for j in 0..vs.len() {
+                let p: DVec4 = (0..=du)
+                    .map(|k| rows[(span - du + k) * vs.len() + j] * n[k])
+                    .sum();
+                out.push(p.truncate() / p.w);
+            }
+        }
+        out
+    }
+
+    fn each_control_point(&self, f: &mut dyn FnMut(DVec3)) {
+        self.points().iter().for_each(|&p| f(p));
+    }
+}
+
+impl Shape for LocalCurve {
+    type Probes = [f64];
+
+    fn positions(&self, at: &[f64]) -> Vec<DVec3> {
+        at.iter().map(|&t| self.eval(t)).collect()
+    }
+
+    fn each_control_point(&self, f: &mut dyn FnMut(DVec3)) {
+        match self {
+            LocalCurve::Spline { curve, .. } => curve.each_control_point(f),
+            LocalCurve::Erbs(e) => e.each_control_point(f),
+        }
+    }
+}
+
+impl Shape for ErbsCurve {
+    type Probes = [f64];
+
+    fn positions(&self, at: &[f64]) -> Vec<DVec3> {
+        at.iter().map(|&t| self.eval(t)).collect()
+    }
+
+    fn each_control_point(&self, f: &mut dyn FnMut(DVec3)) {
+        for l in self.local_curves() {
+            l.each_control_point(f);
+        }
+    }
+}
+
+/// Every pair of a grid `us × vs`, row by row.
+fn grid_pairs<'a>(us: &'a [f64], vs: &'a [f64]) -> impl Iterator<Item = (f64, f64)> + 'a {
+    us.iter().flat_map(move |&u| vs.iter().map(move |&v| (u, v)))
+}
+
+impl Shape for LocalPatch {
+    type Probes = [Vec<f64>; 2];
+
+    fn positions(&self, [us, vs]: &[Vec<f64>; 2]) -> Vec<DVec3> {
+        grid_pairs(us, vs).map(|(u, v)| self.eval(u, v)).collect()
+    }
+
+    fn each_control_point(&self, f: &mut dyn FnMut(DVec3)) {
+        match self {
+            LocalPatch::Spline { surface, .. } => surface.each_control_point(f),
+            LocalPatch::Erbs(e) => e.each_control_point(f),
+        }
+    }
+}
+
+impl Shape for ErbsSurface {
+    type Probes = [Vec<f64>; 2];
+
+    fn positions(&self, [us, vs]: &[Vec<f64>; 2]) -> Vec<DVec3> {
+        grid_pairs(us, vs).map(|(u, v)| self.eval(u, v)).collect()
+    }
+
+    fn each_control_point(&self, f: &mut dyn FnMut(DVec3)) {
+        for l in self.local_patches() {
+            l.each_control_point(f);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::KnotVector;
+
+    fn curve(weights: bool) -> BSplineCurve {
+        let pts: Vec<DVec3> = (0..7)
+            .map(|i| DVec3::new(i as f64, (i as f64).sin() * 2.0, 0.5 * (i % 2) as f64))
+            .collect();
+        let w = weights.then(|| vec![1.0, 2.0, 0.5, 1.0, 1.5, 1.0, 0.7]);
+        BSplineCurve::new(3, vec![0., 0., 0., 0., 1., 1.5, 3., 4., 4., 4., 4.], pts, w).unwrap()
+    }
+
+    fn probes(c: &BSplineCurve) -> Vec<f64> {
+        span_probes(c.knots(), c.degree(), c.domain())
+    }
+
+    #[test]
+    fn span_probes_are_degree_plus_one_per_span_inside_the_domain() {
+        let at = span_probes(&[0., 0., 1., 1., 3., 5.], 2, (0.5, 4.0));
+        // Spans [0.5, 1] (clipped), [1, 3], [3, 4] (clipped): three points each, inside.
+        assert_eq!(at.len(), 9);
+        for (a, b) in at.iter().zip([0.5 + 0.5 / 6.0, 0.75, 1.0 - 0.5 / 6.0]) {
+            assert!((a - b).abs() < 1e-15, "{a} {b}");
+        }
+        assert!(at.iter().all(|&t| t > 0.5 && t < 4.0));
+    }
+
+    /// Negative controls: a control point moved by 1e-7 of the size, or made NaN, is caught;
+    /// rounding-sized noise is not.
+    #[test]
+    fn a_moved_or_nan_curve_is_caught_and_rounding_is_not() {
+        for weights in [false, true] {
+            let c = curve(weights);
+            let same = shape_change(&c, &c.clone(), &probes(&c));
+            assert_eq!(same.moved, 0.0);
+            assert!(same.is_kept());
+            assert!((same.size - (DVec3::new(6.0, 4.0, 0.5)).length()).abs() < 2.0);
+            for (delta, kept) in [(1e-15, true), (1e-7, false)] {
+                let mut d = c.clone();
+                d.translate_point(3, DVec3::Y * delta * same.size);
+                let change = shape_change(&c, &d, &probes(&c));
+                assert_eq!(change.is_kept(), kept, "{delta}: {change:?}");
+            }
+            let mut d = c.clone();
+            d.translate_point(6, DVec3::new(f64::NAN, 0.0, 0.0));
+            assert!(!shape_change(&c, &d, &probes(&c)).is_kept());
+            assert!(!shape_change(&d, &c, &probes(&c)).is_kept());
+        }
+    }
+
+    /// A net far from the origin is allowed the rounding of its coordinates.
+    #[test]
+    fn coordinate_rounding_is_allowed_far_from_the_origin() {
+        let far = ShapeChange {
+            moved: 1e-9,
+            size: 1e-3,
+            magnitude: 1e7,
+        };
+        assert!(far.is_kept());
+        assert!(!ShapeChange { magnitude: 1.0, ..far }.is_kept());
+        assert!(!ShapeChange { moved: f64::NAN, ..far }.is_kept());
+    }
+
+    /// Compared along an unrefined direction at its Greville abscissae, every line of the net
+    /// counts: one moved point anywhere in the net is caught.
+    #[test]
+    fn a_surface_compared_on_the_grid_sees_every_line() {
+        let (nu, nv) = (5, 6);
+        let pts: Vec<DVec3> = (0..nu * nv)
+            .map(|k| DVec3::new((k / nv) as f64, (k % nv) as f64, ((k * 7) % 5) as f64 * 0.3))
+            .collect();
+        let ku = KnotVector::clamped_uniform(2, nu, 0.0, 1.0).into_vec();
+        let kv = KnotVector::clamped_uniform(3, nv, 0.0, 2.0).into_vec();
+        let s = TensorSurface::bspline([2, 3], [ku, kv], [nu, nv], pts, None).unwrap();
+        let refined = s.elevate_degree(0, 1);
+        let at = [
+            span_probes(&refined.knots()[0], 3, refined.domain()[0]),
+            greville(&s.knots()[1], 3, nv, s.domain()[1]),
+        ];
+        assert!(shape_change(&s, &refined, &at).moved < 1e-14);
+        for i in 0..nu {
+            for j in 0..nv {
+                let mut moved = s.clone();
+                moved.translate_point(i, j, DVec3::Z * 1e-6);
+                let change = shape_change(&s, &moved, &at);
+                assert!(!change.is_kept(), "point [{i}, {j}]: {change:?}");
+            }
+        }
+    }
+}
