@@ -627,7 +627,11 @@ mod tests {
         let points = (0..n)
             .map(|i| {
                 let x = i as f64;
-                let w = if rational { 1.25 + 0.75 * (1.7 * x).sin() } else { 1.0 };
+                let w = if rational {
+                    1.25 + 0.75 * (1.7 * x).sin()
+                } else {
+                    1.0
+                };
                 (DVec3::new((0.9 * x).sin(), (1.3 * x).cos(), (0.4 * x).sin() * 2.0) * w).extend(w)
             })
             .collect();
@@ -684,7 +688,10 @@ mod tests {
         assert_eq!(raised.len(), c.knots.len() + 5);
         for r in 0..=3 {
             let t = Thinning::new(&raised, 3, r);
-            assert_eq!(missing(&c.knots, &t.knots).len() + c.knots.len(), t.knots.len());
+            assert_eq!(
+                missing(&c.knots, &t.knots).len() + c.knots.len(),
+                t.knots.len()
+            );
             assert_eq!(&t.knots[..4], &[0.0; 4]);
             assert_eq!(&t.knots[t.knots.len() - 4..], &[1.0; 4]);
             let n = t.knots.len() - 4;
@@ -730,7 +737,10 @@ mod tests {
                         );
                     }
                     let m = moved(&c, &e);
-                    assert!(m < 1e-13, "degree {p} + {by} (rational {rational}): moved {m:e}");
+                    assert!(
+                        m < 1e-13,
+                        "degree {p} + {by} (rational {rational}): moved {m:e}"
+                    );
                 }
             }
         }

@@ -254,7 +254,8 @@ impl Shape for ErbsCurve {
 
 /// Every pair of a grid `us × vs`, row by row.
 fn grid_pairs<'a>(us: &'a [f64], vs: &'a [f64]) -> impl Iterator<Item = (f64, f64)> + 'a {
-    us.iter().flat_map(move |&u| vs.iter().map(move |&v| (u, v)))
+    us.iter()
+        .flat_map(move |&u| vs.iter().map(move |&v| (u, v)))
 }
 
 impl Shape for LocalPatch {
@@ -346,8 +347,20 @@ mod tests {
             magnitude: 1e7,
         };
         assert!(far.is_kept());
-        assert!(!ShapeChange { magnitude: 1.0, ..far }.is_kept());
-        assert!(!ShapeChange { moved: f64::NAN, ..far }.is_kept());
+        assert!(
+            !ShapeChange {
+                magnitude: 1.0,
+                ..far
+            }
+            .is_kept()
+        );
+        assert!(
+            !ShapeChange {
+                moved: f64::NAN,
+                ..far
+            }
+            .is_kept()
+        );
     }
 
     /// Compared along an unrefined direction at its Greville abscissae, every line of the net

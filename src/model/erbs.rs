@@ -677,7 +677,11 @@ impl ErbsNet for ErbsCurve {
 
     fn refinement_change(&self, refined: &Self, t: f64) -> ShapeChange {
         let degree = self.local_curves().iter().map(LocalCurve::degree).max();
-        let mut at = erbs_probes(self.knots(), degree.unwrap_or(0), Some(self.knots().locate(t)));
+        let mut at = erbs_probes(
+            self.knots(),
+            degree.unwrap_or(0),
+            Some(self.knots().locate(t)),
+        );
         at.push(t);
         shape_change(self, refined, &at)
     }

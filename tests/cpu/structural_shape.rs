@@ -87,7 +87,11 @@ fn knot_vector(r: &mut Draw, d: usize, a: f64, len: f64, distinct: usize) -> (Ve
     let mut knots = Vec::new();
     let clamped = r.below(3) > 0;
     for i in (0..=d).rev() {
-        knots.push(if clamped { a } else { a - len * i as f64 * r.range(0.1, 0.5) });
+        knots.push(if clamped {
+            a
+        } else {
+            a - len * i as f64 * r.range(0.1, 0.5)
+        });
     }
     knots.sort_by(f64::total_cmp);
     for x in inner {
@@ -170,7 +174,11 @@ fn insertion(r: &mut Draw, knots: &[f64], d: usize, (a, b): (f64, f64)) -> Optio
         let room = d.saturating_sub(knots.iter().filter(|&&x| x == t).count());
         if t > a && t < b && room > 0 {
             // Up to full multiplicity, often all of it.
-            let times = if r.below(2) == 0 { room } else { 1 + r.below(room) };
+            let times = if r.below(2) == 0 {
+                room
+            } else {
+                1 + r.below(room)
+            };
             return Some((t, times));
         }
     }
@@ -228,13 +236,17 @@ fn size(points: &[DVec3]) -> f64 {
 /// Largest distance between two position lists over `size`; NaN anywhere gives +∞.
 fn relative_distance(a: &[DVec3], b: &[DVec3], size: f64) -> f64 {
     assert_eq!(a.len(), b.len());
-    let worst = a.iter().zip(b).map(|(x, y)| x.distance(*y)).fold(0.0f64, |m, d| {
-        if d.is_nan() || m.is_nan() {
-            f64::NAN
-        } else {
-            f64::max(m, d)
-        }
-    });
+    let worst = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| x.distance(*y))
+        .fold(0.0f64, |m, d| {
+            if d.is_nan() || m.is_nan() {
+                f64::NAN
+            } else {
+                f64::max(m, d)
+            }
+        });
     if worst.is_nan() {
         f64::INFINITY
     } else {
@@ -399,7 +411,13 @@ fn issue_reproduction_through_the_binary_agrees_with_the_original() {
         .as_array()
         .unwrap()
         .iter()
-        .map(|p| DVec3::new(p[0].as_f64().unwrap(), p[1].as_f64().unwrap(), p[2].as_f64().unwrap()))
+        .map(|p| {
+            DVec3::new(
+                p[0].as_f64().unwrap(),
+                p[1].as_f64().unwrap(),
+                p[2].as_f64().unwrap(),
+            )
+        })
         .collect();
     for full in [false, true] {
         let (ok, stdout, stderr) = sample(&dir, Some(REPRO_EDITS), full);
@@ -446,11 +464,26 @@ fn elevating_a_degree_10_curve_beside_a_short_span_keeps_it() {
             // What the screen shows (the delta path's samples) is the saved curve, too.
             let fresh = SampledObject::new(&saved, SampleMode::Render);
             let e = relative_distance(
-                &shown.grid().data.iter().step_by(2).copied().collect::<Vec<_>>(),
-                &fresh.grid().data.iter().step_by(2).copied().collect::<Vec<_>>(),
+                &shown
+                    .grid()
+                    .data
+                    .iter()
+                    .step_by(2)
+                    .copied()
+                    .collect::<Vec<_>>(),
+                &fresh
+                    .grid()
+                    .data
+                    .iter()
+                    .step_by(2)
+                    .copied()
+                    .collect::<Vec<_>>(),
                 size(&pts),
             );
-            assert!(e <= SHAPE_TOL, "step {step}: screen and model differ by {e:e}");
+            assert!(
+                e <= SHAPE_TOL,
+                "step {step}: screen and model differ by {e:e}"
+            );
         }
     }
 }
