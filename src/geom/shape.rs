@@ -10,6 +10,7 @@
 use super::basis::basis_funs;
 use super::bspline::BSplineCurve;
 use super::erbs::{ErbsCurve, ErbsKnots, ErbsSurface, LocalCurve, LocalPatch};
+use super::knots::KnotVector;
 use super::point::nan_max;
 use super::surface::TensorSurface;
 use glam::{DVec3, DVec4};
@@ -109,6 +110,21 @@ pub fn span_probes(knots: &[f64], degree: usize, (a, b): (f64, f64)) -> Vec<f64>
     out
 }
 
+/// Where a knot insertion at `t` can change the shape, within the domain `(a, b)`: the support
+/// [u_{k−d}, u_{k+d+1}] of the basis functions of the span k holding t, the only ones
+/// CurveKnotIns recombines; elsewhere the refined net copies the old points.
+#[must_use]
+pub fn insertion_window(
+    knots: &KnotVector,
+    degree: usize,
+    t: f64,
+    (a, b): (f64, f64),
+) -> (f64, f64) {
+    let n = knots.len() - degree - 1;
+    let k = knots.find_span(degree, n, t);
+    (knots[k - degree].max(a), knots[k + degree + 1].min(b))
+}
+
 /// The Greville abscissae (u_{i+1} + … + u_{i+d}) / d of n points, held inside [a, b]: at them
 /// the d-th degree B-splines of a clamped vector without jumps are independent (Schoenberg and
 /// Whitney), so a surface compared there along an unrefined direction is compared on every
@@ -192,28 +208,37 @@ impl Shape for TensorSurface {
     /// The grid `us × vs`.
     type Probes = [Vec<f64>; 2];
 
-    /// S(u, v) over the grid by the tensor structure: each row of the net is combined for every
-    /// v first, then the rows for every u (BasisFuns once per parameter, in homogeneous form).
+    /// S(u, v) over the grid by the tensor structure: every row of the net that some u probe
+    /// uses is combined for each v first, then those rows for each u (BasisFuns once per
+    /// parameter, in homogeneous form), so the cost is that of the probes' own rows.
     fn positions(&self, [us, vs]: &[Vec<f64>; 2]) -> Vec<DVec3> {
         let [du, dv] = self.degree();
-        let [nu, nv] = self.count();
+        let nv = self.count()[1];
         let h = self.homogeneous_points();
         let (bu, bv) = (probe_bases(self, 0, us), probe_bases(self, 1, vs));
-        let mut rows = vec![DVec4::ZERO; nu * vs.len()];
-        for i in 0..nu {
-            for (j, (span, n)) in bv.iter().enumerate() {
+        let Some(first) = bu.iter().map(|(span, _)| span - du).min() else {
+            return Vec::new();
+        };
+        let last = bu.iter().map(|(span, _)| *span).max().unwrap_or(first);
+        let m = vs.len();
+        let mut rows = vec![DVec4::ZERO; (last + 1 - first) * m];
+        for (i, row) in (first..=last).zip(rows.chunks_exact_mut(m)) {
+            for (r, (span, n)) in row.iter_mut().zip(&bv) {
                 let line = &h[i * nv + span - dv..=i * nv + span];
-                rows[i * vs.len() + j] = line.iter().zip(n).map(|(p, &w)| *p * w).sum();
+                *r = line.iter().zip(n).map(|(p, &w)| *p * w).sum();
             }
         }
-        let mut out = Vec::with_capacity(us.len() * vs.len());
+        let mut out = Vec::with_capacity(us.len() * m);
+        let mut acc = vec![DVec4::ZERO; m];
         for (span, n) in &bu {
-            for j in 0..vs.len() {
-                let p: DVec4 = (0..=du)
-                    .map(|k| rows[(span - du + k) * vs.len() + j] * n[k])
-                    .sum();
-                out.push(p.truncate() / p.w);
+            acc.fill(DVec4::ZERO);
+            for (k, &w) in n.iter().enumerate() {
+                let row = &rows[(span - du + k - first) * m..][..m];
+                for (a, r) in acc.iter_mut().zip(row) {
+                    *a += *r * w;
+                }
             }
+            out.extend(acc.iter().map(|p| p.truncate() / p.w));
         }
         out
     }
@@ -290,7 +315,6 @@ impl Shape for ErbsSurface {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geom::KnotVector;
 
     fn curve(weights: bool) -> BSplineCurve {
         let pts: Vec<DVec3> = (0..7)

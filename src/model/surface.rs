@@ -4,7 +4,7 @@ use super::curve::{check_elevation, check_insertion, check_restore, replace};
 use super::edit::{EditError, KindEdit, ObjectEdit, Target, check_shape_kept};
 use super::points::PointEdit;
 use super::{SplineForm, check_surface_samples};
-use crate::geom::shape::{greville, shape_change, span_probes};
+use crate::geom::shape::{greville, insertion_window, shape_change, span_probes};
 use crate::geom::{KnotVector, TensorSurface};
 use glam::DVec3;
 
@@ -103,9 +103,14 @@ impl KindEdit for SurfaceEdit {
                 let refined = s
                     .insert_knot(dir, t, times)
                     .map_err(|e| EditError::new("insert_knot", e.message))?;
-                let mut directions = [false; 2];
-                directions[dir] = true;
-                check_surface_kept("insert_knot", s, &refined, directions)
+                let mut windows = [None; 2];
+                windows[dir] = Some(insertion_window(
+                    &s.knots()[dir],
+                    s.degree()[dir],
+                    t,
+                    s.domain()[dir],
+                ));
+                check_surface_kept("insert_knot", s, &refined, windows)
             }
             SurfaceEdit::ElevateDegree { by } => {
                 if by == [0, 0] {
@@ -120,7 +125,8 @@ impl KindEdit for SurfaceEdit {
                             .map_err(|e| in_direction(e, dir))?;
                     }
                 }
-                check_surface_kept("elevate_degree", s, &elevated(s, by), by.map(|b| b > 0))
+                let windows = [0, 1].map(|dir| (by[dir] > 0).then(|| s.domain()[dir]));
+                check_surface_kept("elevate_degree", s, &elevated(s, by), windows)
             }
             SurfaceEdit::Restore { ref model, .. } => check_restore(model.samples == m.samples),
         }
@@ -191,22 +197,21 @@ fn elevated(s: &TensorSurface, by: [usize; 2]) -> TensorSurface {
     out
 }
 
-/// A refinement of `old` in the `refined` directions (an edit's `field`) that keeps its shape:
-/// the surfaces agree on a grid of d+1 parameters per span of each refined direction and the
-/// Greville abscissae of an unrefined one (where its B-splines are independent, so every line
-/// of the net is compared).
+/// A refinement of `old` (an edit's `field`) that keeps its shape: the surfaces agree on a
+/// grid of d+1 parameters per span of each refined direction inside its window (where the
+/// refinement can change it) and the Greville abscissae of an unrefined one (where its
+/// B-splines are independent, so every line of the net is compared).
 fn check_surface_kept(
     field: &'static str,
     old: &TensorSurface,
     new: &TensorSurface,
-    refined: [bool; 2],
+    windows: [Option<(f64, f64)>; 2],
 ) -> Result<(), EditError> {
     let at = [0, 1].map(|dir| {
-        let (d, knots, domain) = (new.degree()[dir], &new.knots()[dir], new.domain()[dir]);
-        if refined[dir] {
-            span_probes(knots, d, domain)
-        } else {
-            greville(knots, d, new.count()[dir], domain)
+        let (d, knots) = (new.degree()[dir], &new.knots()[dir]);
+        match windows[dir] {
+            Some(window) => span_probes(knots, d, window),
+            None => greville(knots, d, new.count()[dir], new.domain()[dir]),
         }
     });
     check_shape_kept(field, "surface", shape_change(old, new, &at))
