@@ -210,6 +210,103 @@ pub fn degree_elevate<P: Point>(c: &Spline<P>, t: usize) -> Spline<P> {
     join_at_jumps(pieces.iter().map(|piece| elevate_piece(piece, t)))
 }
 
+/// DegreeElevateCurve for many curves on one knot vector (the lines of a net, A5.10): the
+/// elevation is linear, Q_j = Σ_l E_{j,l} P_l on the clamped points, and E depends on the knots
+/// alone, so it is computed once and every line costs d+2 products per new point.
+///
+/// E comes from [`degree_elevate`] itself, run on unit points: E_{j,l} ≠ 0 only where the new
+/// B-spline N'_j has its support inside the old N_l's (on a span outside it N_l vanishes and the
+/// N'_j there are independent), which leaves at most d+1 consecutive l for each j. So unit
+/// points d+2 apart share a lane without meeting in any new point, and one run of 16 lanes
+/// gives E for up to degree 14. Its entries are convex weights (rows sum to 1), like those of
+/// the elevation they record: E·P is as stable.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Elevation {
+    /// The elevated degree and knots.
+    degree: usize,
+    knots: Vec<f64>,
+    /// Per new point j: the first clamped point it weighs and the weights.
+    rows: Vec<(usize, Vec<f64>)>,
+}
+
+impl Elevation {
+    /// The elevation by `t` of degree-`degree` curves on `knots` (any count of points).
+    #[must_use]
+    pub fn new(degree: usize, knots: &[f64], t: usize) -> Self {
+        let count = knots.len() - degree - 1;
+        let lanes = 4 * LINES;
+        let clamped = clamp(&Spline {
+            degree,
+            knots: knots.to_vec(),
+            points: vec![0.0; count],
+        })
+        .knots;
+        let n = clamped.len() - degree - 1;
+        // Unit points l ≡ c (mod apart) share lane c.
+        let apart = degree + 2;
+        let runs: Vec<Spline<Pack>> = (0..apart)
+            .step_by(lanes)
+            .map(|base| {
+                let points = (0..n)
+                    .map(|l| {
+                        let mut p = Pack::default();
+                        if let Some(lane) = (l % apart).checked_sub(base).filter(|&c| c < lanes) {
+                            p.0[lane] = 1.0;
+                        }
+                        p
+                    })
+                    .collect();
+                let unit = Spline {
+                    degree,
+                    knots: clamped.clone(),
+                    points,
+                };
+                degree_elevate(&unit, t)
+            })
+            .collect();
+        let (q, raised) = (runs[0].degree, &runs[0].knots);
+        let rows = (0..runs[0].points.len())
+            .map(|j| {
+                // The first l with N'_j's support inside N_l's: u_{l+d+1} ≥ û_{j+q+1}.
+                let first = clamped.partition_point(|&x| x < raised[j + q + 1]);
+                let lo = first.saturating_sub(degree + 1);
+                let weights = (lo..(lo + apart).min(n))
+                    .map(|l| {
+                        let c = l % apart;
+                        runs[c / lanes].points[j].0[c % lanes]
+                    })
+                    .collect();
+                (lo, weights)
+            })
+            .collect();
+        Self {
+            degree: q,
+            knots: runs[0].knots.clone(),
+            rows,
+        }
+    }
+
+    /// The elevated curve of `c`, whose degree and knots are the ones this was made for.
+    #[must_use]
+    pub fn apply<P: Point>(&self, c: &Spline<P>) -> Spline<P> {
+        let c = clamp(c);
+        let points = self
+            .rows
+            .iter()
+            .map(|(lo, w)| {
+                w.iter()
+                    .zip(&c.points[*lo..])
+                    .fold(P::default(), |acc, (&w, &p)| acc + p * w)
+            })
+            .collect();
+        Spline {
+            degree: self.degree,
+            knots: self.knots.clone(),
+            points,
+        }
+    }
+}
+
 /// One clamped piece without jumps elevated by t: a Bézier span in one step, a B-spline by t
 /// steps of one.
 fn elevate_piece<P: Point>(piece: &Spline<P>, t: usize) -> Spline<P> {
@@ -741,6 +838,43 @@ mod tests {
                         m < 1e-13,
                         "degree {p} + {by} (rational {rational}): moved {m:e}"
                     );
+                }
+            }
+        }
+    }
+
+    /// The net form (E computed once) equals elevating each curve, on clamped and unclamped
+    /// knots, with jumps, at degrees that need one and several runs of lanes.
+    #[test]
+    fn the_elevation_matrix_equals_elevating_each_curve() {
+        let mut cases = vec![
+            curve(3, &[0.25, 0.5, 0.5, 0.5001], true),
+            curve(2, &[0.3, 0.3, 0.3, 0.6], false),
+            curve(20, &[1e-6, 0.5, 0.7], true),
+            curve(40, &[0.5], false),
+        ];
+        let mut unclamped = curve(4, &[0.2, 0.4, 0.6], true);
+        unclamped.knots = (0..unclamped.knots.len()).map(|i| i as f64 * 0.1).collect();
+        cases.push(unclamped);
+        for c in cases {
+            for by in [1, 3] {
+                if c.degree + by > 64 {
+                    continue;
+                }
+                let (direct, plan) = (
+                    degree_elevate(&c, by),
+                    Elevation::new(c.degree, &c.knots, by),
+                );
+                let net = plan.apply(&c);
+                assert_eq!((net.degree, &net.knots), (direct.degree, &direct.knots));
+                let (_, _, size) = bounds(&c);
+                for (a, b) in net.points.iter().zip(&direct.points) {
+                    let d = (a.truncate() / a.w - b.truncate() / b.w).length();
+                    assert!(d < 1e-13 * size, "degree {} + {by}: {a} {b}", c.degree);
+                }
+                for (_, w) in &plan.rows {
+                    let sum: f64 = w.iter().sum();
+                    assert!((sum - 1.0).abs() < 1e-13 && w.iter().all(|&x| x >= 0.0));
                 }
             }
         }

@@ -61,28 +61,49 @@ pub trait Shape {
     /// Where positions are compared: parameters (curves) or a grid of them (surfaces).
     type Probes: ?Sized;
 
-    /// The positions at `at`, in a fixed order.
-    fn positions(&self, at: &Self::Probes) -> Vec<DVec3>;
+    /// The positions at `at` in a fixed order, a row at a time (a surface: one u at a time),
+    /// so a large surface's grid is never held in memory (fresh pages cost more than the
+    /// arithmetic).
+    fn positions<'a>(&'a self, at: &'a Self::Probes) -> Box<dyn Iterator<Item = Vec<DVec3>> + 'a>;
 
-    /// Calls `f` on every control point, at any depth.
-    fn each_control_point(&self, f: &mut dyn FnMut(DVec3));
+    /// Calls `f` on every control net (at any depth, for ERBS locals).
+    fn each_control_net(&self, f: &mut dyn FnMut(&[DVec3]));
 }
 
 /// How far `new` lies from `old` at `at`, against the size of `old`'s control net: the one
 /// comparison every structural edit runs before it is applied.
 #[must_use]
 pub fn shape_change<S: Shape + ?Sized>(old: &S, new: &S, at: &S::Probes) -> ShapeChange {
-    let moved = old
+    let moved_squared = old
         .positions(at)
-        .iter()
         .zip(new.positions(at))
-        .fold(0.0, |m, (a, b)| nan_max(m, a.distance(b)));
-    let (mut lo, mut hi, mut magnitude) = (DVec3::INFINITY, DVec3::NEG_INFINITY, 0.0);
-    old.each_control_point(&mut |p| {
-        lo = lo.min(p);
-        hi = hi.max(p);
-        magnitude = nan_max(magnitude, p.abs().max_element());
+        .fold(0.0, |m, (a, b)| {
+            let row = a
+                .iter()
+                .zip(&b)
+                .fold(0.0f64, |m, (p, q)| m.max(p.distance_squared(*q)));
+            // f64::max drops a NaN: look for one per row.
+            let nan = a.iter().chain(&b).any(|p| p.is_nan());
+            nan_max(m, if nan { f64::NAN } else { row })
+        });
+    let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+    let mut magnitude = 0.0;
+    old.each_control_net(&mut |net| {
+        for &p in net {
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+        let nan = net.iter().any(|p| p.is_nan());
+        magnitude = nan_max(
+            magnitude,
+            if nan {
+                f64::NAN
+            } else {
+                lo.abs().max(hi.abs()).max_element()
+            },
+        );
     });
+    let moved = moved_squared.sqrt();
     let size = if lo.cmple(hi).all() {
         (hi - lo).length()
     } else {
@@ -182,83 +203,140 @@ pub fn erbs_knot_probes(knots: &ErbsKnots) -> Vec<f64> {
 impl Shape for BSplineCurve {
     type Probes = [f64];
 
-    fn positions(&self, at: &[f64]) -> Vec<DVec3> {
-        at.iter().map(|&t| self.eval(t)).collect()
+    fn positions<'a>(&'a self, at: &'a [f64]) -> Box<dyn Iterator<Item = Vec<DVec3>> + 'a> {
+        Box::new(std::iter::once(at.iter().map(|&t| self.eval(t)).collect()))
     }
 
-    fn each_control_point(&self, f: &mut dyn FnMut(DVec3)) {
-        self.points().iter().for_each(|&p| f(p));
+    fn each_control_net(&self, f: &mut dyn FnMut(&[DVec3])) {
+        f(self.points());
     }
 }
 
-/// One direction's basis at each probe: the span and the d+1 non-vanishing functions.
-fn probe_bases(s: &TensorSurface, dir: usize, at: &[f64]) -> Vec<(usize, Vec<f64>)> {
+/// One direction's basis at a parameter: the span and the d+1 non-vanishing functions.
+fn probe_basis(s: &TensorSurface, dir: usize, t: f64) -> (usize, Vec<f64>) {
     let (d, n, knots) = (s.degree()[dir], s.count()[dir], &s.knots()[dir]);
     let (a, b) = s.domain()[dir];
-    at.iter()
-        .map(|&t| {
-            let t = t.clamp(a, b);
-            let span = knots.find_span(d, n, t);
-            (span, basis_funs(knots, d, span, t))
-        })
-        .collect()
+    let t = t.clamp(a, b);
+    let span = knots.find_span(d, n, t);
+    (span, basis_funs(knots, d, span, t))
+}
+
+/// S(u, v) over a grid `us × vs`, row by row of u, by the tensor structure: each row of the
+/// net is combined for every v once (kept in a ring of d_u + 1 rows, which is all one u
+/// needs), then d_u + 1 such rows for each u (BasisFuns once per parameter, homogeneous form).
+struct GridPositions<'a> {
+    surface: &'a TensorSurface,
+    us: &'a [f64],
+    bv: Vec<(usize, Vec<f64>)>,
+    /// Row i of the net combined for every v, in slot i mod (d_u + 1).
+    ring: Vec<DVec4>,
+    ring_rows: Vec<Option<usize>>,
+    /// The current u's homogeneous sums, and the next u.
+    acc: Vec<DVec4>,
+    next_u: usize,
+}
+
+impl<'a> GridPositions<'a> {
+    fn new(surface: &'a TensorSurface, [us, vs]: &'a [Vec<f64>; 2]) -> Self {
+        let du = surface.degree()[0];
+        Self {
+            surface,
+            us,
+            bv: vs.iter().map(|&v| probe_basis(surface, 1, v)).collect(),
+            ring: vec![DVec4::ZERO; (du + 1) * vs.len()],
+            ring_rows: vec![None; du + 1],
+            acc: Vec::with_capacity(vs.len()),
+            next_u: 0,
+        }
+    }
+
+    /// Makes sure row i of the net, combined for every v, is in its ring slot.
+    fn combine_row(&mut self, i: usize) {
+        let slot = i % self.ring_rows.len();
+        if self.ring_rows[slot] == Some(i) {
+            return;
+        }
+        let s = self.surface;
+        let (dv, nv) = (s.degree()[1], s.count()[1]);
+        let (points, weights) = (s.points(), s.weights());
+        let m = self.bv.len();
+        for (r, (span, n)) in self.ring[slot * m..(slot + 1) * m].iter_mut().zip(&self.bv) {
+            let first = i * nv + span - dv;
+            *r = n
+                .iter()
+                .enumerate()
+                .map(|(l, &w)| {
+                    let k = first + l;
+                    let h = weights.map_or(1.0, |ws| ws[k]);
+                    (points[k] * h).extend(h) * w
+                })
+                .sum();
+        }
+        self.ring_rows[slot] = Some(i);
+    }
+
+    /// The positions at the next u, if any is left.
+    fn next_row(&mut self) -> Option<Vec<DVec3>> {
+        let &u = self.us.get(self.next_u)?;
+        self.next_u += 1;
+        let du = self.surface.degree()[0];
+        let (span, n) = probe_basis(self.surface, 0, u);
+        for i in span - du..=span {
+            self.combine_row(i);
+        }
+        let m = self.bv.len();
+        let mut acc = std::mem::take(&mut self.acc);
+        acc.clear();
+        acc.resize(m, DVec4::ZERO);
+        for (i, &w) in (span - du..=span).zip(&n) {
+            let slot = i % (du + 1);
+            for (a, r) in acc.iter_mut().zip(&self.ring[slot * m..(slot + 1) * m]) {
+                *a += *r * w;
+            }
+        }
+        // A polynomial net's w is the partition of unity: its positions need no division.
+        let row = if self.surface.is_rational() {
+            acc.iter().map(|p| p.truncate() / p.w).collect()
+        } else {
+            acc.iter().map(|p| p.truncate()).collect()
+        };
+        self.acc = acc;
+        Some(row)
+    }
+}
+
+impl Iterator for GridPositions<'_> {
+    type Item = Vec<DVec3>;
+
+    fn next(&mut self) -> Option<Vec<DVec3>> {
+        self.next_row()
+    }
 }
 
 impl Shape for TensorSurface {
     /// The grid `us × vs`.
     type Probes = [Vec<f64>; 2];
 
-    /// S(u, v) over the grid by the tensor structure: every row of the net that some u probe
-    /// uses is combined for each v first, then those rows for each u (BasisFuns once per
-    /// parameter, in homogeneous form), so the cost is that of the probes' own rows.
-    fn positions(&self, [us, vs]: &[Vec<f64>; 2]) -> Vec<DVec3> {
-        let [du, dv] = self.degree();
-        let nv = self.count()[1];
-        let h = self.homogeneous_points();
-        let (bu, bv) = (probe_bases(self, 0, us), probe_bases(self, 1, vs));
-        let Some(first) = bu.iter().map(|(span, _)| span - du).min() else {
-            return Vec::new();
-        };
-        let last = bu.iter().map(|(span, _)| *span).max().unwrap_or(first);
-        let m = vs.len();
-        let mut rows = vec![DVec4::ZERO; (last + 1 - first) * m];
-        for (i, row) in (first..=last).zip(rows.chunks_exact_mut(m)) {
-            for (r, (span, n)) in row.iter_mut().zip(&bv) {
-                let line = &h[i * nv + span - dv..=i * nv + span];
-                *r = line.iter().zip(n).map(|(p, &w)| *p * w).sum();
-            }
-        }
-        let mut out = Vec::with_capacity(us.len() * m);
-        let mut acc = vec![DVec4::ZERO; m];
-        for (span, n) in &bu {
-            acc.fill(DVec4::ZERO);
-            for (k, &w) in n.iter().enumerate() {
-                let row = &rows[(span - du + k - first) * m..][..m];
-                for (a, r) in acc.iter_mut().zip(row) {
-                    *a += *r * w;
-                }
-            }
-            out.extend(acc.iter().map(|p| p.truncate() / p.w));
-        }
-        out
+    fn positions<'a>(&'a self, at: &'a [Vec<f64>; 2]) -> Box<dyn Iterator<Item = Vec<DVec3>> + 'a> {
+        Box::new(GridPositions::new(self, at))
     }
 
-    fn each_control_point(&self, f: &mut dyn FnMut(DVec3)) {
-        self.points().iter().for_each(|&p| f(p));
+    fn each_control_net(&self, f: &mut dyn FnMut(&[DVec3])) {
+        f(self.points());
     }
 }
 
 impl Shape for LocalCurve {
     type Probes = [f64];
 
-    fn positions(&self, at: &[f64]) -> Vec<DVec3> {
-        at.iter().map(|&t| self.eval(t)).collect()
+    fn positions<'a>(&'a self, at: &'a [f64]) -> Box<dyn Iterator<Item = Vec<DVec3>> + 'a> {
+        Box::new(std::iter::once(at.iter().map(|&t| self.eval(t)).collect()))
     }
 
-    fn each_control_point(&self, f: &mut dyn FnMut(DVec3)) {
+    fn each_control_net(&self, f: &mut dyn FnMut(&[DVec3])) {
         match self {
-            LocalCurve::Spline { curve, .. } => curve.each_control_point(f),
-            LocalCurve::Erbs(e) => e.each_control_point(f),
+            LocalCurve::Spline { curve, .. } => curve.each_control_net(f),
+            LocalCurve::Erbs(e) => e.each_control_net(f),
         }
     }
 }
@@ -266,34 +344,39 @@ impl Shape for LocalCurve {
 impl Shape for ErbsCurve {
     type Probes = [f64];
 
-    fn positions(&self, at: &[f64]) -> Vec<DVec3> {
-        at.iter().map(|&t| self.eval(t)).collect()
+    fn positions<'a>(&'a self, at: &'a [f64]) -> Box<dyn Iterator<Item = Vec<DVec3>> + 'a> {
+        Box::new(std::iter::once(at.iter().map(|&t| self.eval(t)).collect()))
     }
 
-    fn each_control_point(&self, f: &mut dyn FnMut(DVec3)) {
+    fn each_control_net(&self, f: &mut dyn FnMut(&[DVec3])) {
         for l in self.local_curves() {
-            l.each_control_point(f);
+            l.each_control_net(f);
         }
     }
 }
 
-/// Every pair of a grid `us × vs`, row by row.
-fn grid_pairs<'a>(us: &'a [f64], vs: &'a [f64]) -> impl Iterator<Item = (f64, f64)> + 'a {
-    us.iter()
-        .flat_map(move |&u| vs.iter().map(move |&v| (u, v)))
+/// `f` over a grid `us × vs`, a row of v for each u.
+fn grid_rows<'a>(
+    [us, vs]: &'a [Vec<f64>; 2],
+    f: impl Fn(f64, f64) -> DVec3 + 'a,
+) -> Box<dyn Iterator<Item = Vec<DVec3>> + 'a> {
+    Box::new(
+        us.iter()
+            .map(move |&u| vs.iter().map(|&v| f(u, v)).collect()),
+    )
 }
 
 impl Shape for LocalPatch {
     type Probes = [Vec<f64>; 2];
 
-    fn positions(&self, [us, vs]: &[Vec<f64>; 2]) -> Vec<DVec3> {
-        grid_pairs(us, vs).map(|(u, v)| self.eval(u, v)).collect()
+    fn positions<'a>(&'a self, at: &'a [Vec<f64>; 2]) -> Box<dyn Iterator<Item = Vec<DVec3>> + 'a> {
+        grid_rows(at, |u, v| self.eval(u, v))
     }
 
-    fn each_control_point(&self, f: &mut dyn FnMut(DVec3)) {
+    fn each_control_net(&self, f: &mut dyn FnMut(&[DVec3])) {
         match self {
-            LocalPatch::Spline { surface, .. } => surface.each_control_point(f),
-            LocalPatch::Erbs(e) => e.each_control_point(f),
+            LocalPatch::Spline { surface, .. } => surface.each_control_net(f),
+            LocalPatch::Erbs(e) => e.each_control_net(f),
         }
     }
 }
@@ -301,13 +384,13 @@ impl Shape for LocalPatch {
 impl Shape for ErbsSurface {
     type Probes = [Vec<f64>; 2];
 
-    fn positions(&self, [us, vs]: &[Vec<f64>; 2]) -> Vec<DVec3> {
-        grid_pairs(us, vs).map(|(u, v)| self.eval(u, v)).collect()
+    fn positions<'a>(&'a self, at: &'a [Vec<f64>; 2]) -> Box<dyn Iterator<Item = Vec<DVec3>> + 'a> {
+        grid_rows(at, |u, v| self.eval(u, v))
     }
 
-    fn each_control_point(&self, f: &mut dyn FnMut(DVec3)) {
+    fn each_control_net(&self, f: &mut dyn FnMut(&[DVec3])) {
         for l in self.local_patches() {
-            l.each_control_point(f);
+            l.each_control_net(f);
         }
     }
 }
