@@ -386,7 +386,7 @@ fn check_per_order(
     let over: Vec<String> = e
         .iter()
         .enumerate()
-        .filter(|&(r, &x)| !(x <= STRUCTURAL_ORDER_TOL[r]))
+        .filter(|&(r, &x)| x.is_nan() || x > STRUCTURAL_ORDER_TOL[r])
         .map(|(r, x)| format!("order {r}: {x:.2e} > {:e}", STRUCTURAL_ORDER_TOL[r]))
         .collect();
     if over.is_empty() {

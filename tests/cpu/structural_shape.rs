@@ -276,7 +276,7 @@ fn run_chain<E: KindEdit + Clone>(
 /// `--nocapture` for the measured worst case over the property space).
 fn record(worst: &std::sync::Mutex<f64>, test: &str, e: f64, what: impl FnOnce() -> String) {
     let mut w = worst.lock().unwrap_or_else(|p| p.into_inner());
-    if !(e <= *w) {
+    if e.is_nan() || e > *w {
         *w = e;
         eprintln!("{test}: new worst {e:.2e} of the size: {}", what());
     }
