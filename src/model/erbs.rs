@@ -845,3 +845,51 @@ impl ErbsNet for ErbsSurface {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::BezierCurve;
+    use crate::geom::erbs::ErbsKnots;
+
+    /// Four cubic locals on knots 0..3.
+    fn curve() -> ErbsCurve {
+        let local = (0..4)
+            .map(|l| {
+                let x = l as f64;
+                BezierCurve::new(vec![
+                    DVec3::new(x - 1.0, 0.3 * x, 0.0),
+                    DVec3::new(x - 0.3, 1.0 + x.sin(), 0.5),
+                    DVec3::new(x + 0.3, -0.5, 0.2 * x),
+                    DVec3::new(x + 1.0, 0.1, 0.0),
+                ])
+                .unwrap()
+            })
+            .collect();
+        ErbsCurve::new(vec![0., 0., 1., 2., 3., 3.], local, BFunctionKind::default()).unwrap()
+    }
+
+    /// Negative controls: refinement and construction keep the shape where they promise to,
+    /// and a local moved there, by 1e-6 of the size, is caught.
+    #[test]
+    fn erbs_refinement_and_construction_are_compared_where_they_keep_the_shape() {
+        let c = curve();
+        let (refined, new) = c.insert_knot(1.5, None).unwrap();
+        assert!(c.refinement_change(&refined, 1.5).is_kept());
+        // The local beside the refined interval (its restriction), and the new local at t.
+        for local in [0, new] {
+            let mut moved = refined.clone();
+            moved.transform_local(&[local], &DMat4::from_translation(DVec3::Y * 1e-5));
+            let change = c.refinement_change(&moved, 1.5);
+            assert!(!change.is_kept(), "local {local}: {change:?}");
+        }
+        let local = c.local_curves()[2].clone();
+        let built = ErbsCurve::build(&local, 3, 3, BFunctionKind::default()).unwrap();
+        assert!(ErbsCurve::build_change(&local, &built).is_kept());
+        let mut moved = built.clone();
+        moved.transform_local(&[1], &DMat4::from_translation(DVec3::X * 1e-5));
+        assert!(!ErbsCurve::build_change(&local, &moved).is_kept());
+        let knots = ErbsKnots::open(vec![0., 0., 1., 2., 3., 3.], 4).unwrap();
+        assert_eq!(erbs_knot_probes(&knots), vec![0., 1., 2., 3.]);
+    }
+}
