@@ -866,7 +866,12 @@ mod tests {
                 .unwrap()
             })
             .collect();
-        ErbsCurve::new(vec![0., 0., 1., 2., 3., 3.], local, BFunctionKind::default()).unwrap()
+        ErbsCurve::new(
+            vec![0., 0., 1., 2., 3., 3.],
+            local,
+            BFunctionKind::default(),
+        )
+        .unwrap()
     }
 
     /// Negative controls: refinement and construction keep the shape where they promise to,
