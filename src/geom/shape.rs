@@ -164,12 +164,12 @@ pub fn greville(knots: &[f64], degree: usize, n: usize, (a, b): (f64, f64)) -> V
 }
 
 /// Where an ERBS direction refined inside interval `changed` keeps its shape: the knots around
-/// it and d+1 parameters inside each neighbouring interval, where the two restricted locals
+/// it and `per` parameters inside each neighbouring interval, where the two restricted locals
 /// blend with unchanged ones; with `None`, every knot and every interval (a direction that was
 /// not refined). Held to the domain window. An ERBS blend is no polynomial, so these are
 /// samples, not a proof: they are where a wrong restriction or placement of a local shows.
 #[must_use]
-pub fn erbs_probes(knots: &ErbsKnots, degree: usize, changed: Option<usize>) -> Vec<f64> {
+pub fn erbs_probes(knots: &ErbsKnots, per: usize, changed: Option<usize>) -> Vec<f64> {
     let count = knots.intervals();
     let intervals: Vec<usize> = match changed {
         None => (0..count).collect(),
@@ -184,7 +184,9 @@ pub fn erbs_probes(knots: &ErbsKnots, degree: usize, changed: Option<usize>) -> 
     for i in intervals {
         let (lo, hi) = knots.interval(i);
         out.extend([lo, hi].into_iter().filter(|t| (a..=b).contains(t)));
-        out.extend(span_probes(&[lo, hi], degree, (a, b)));
+        if per > 0 {
+            out.extend(span_probes(&[lo, hi], per - 1, (a, b)));
+        }
     }
     out
 }

@@ -677,11 +677,8 @@ impl ErbsNet for ErbsCurve {
 
     fn refinement_change(&self, refined: &Self, t: f64) -> ShapeChange {
         let degree = self.local_curves().iter().map(LocalCurve::degree).max();
-        let mut at = erbs_probes(
-            self.knots(),
-            degree.unwrap_or(0),
-            Some(self.knots().locate(t)),
-        );
+        let per = degree.unwrap_or(0) + 1;
+        let mut at = erbs_probes(self.knots(), per, Some(self.knots().locate(t)));
         at.push(t);
         shape_change(self, refined, &at)
     }
@@ -812,18 +809,15 @@ impl ErbsNet for ErbsSurface {
     const NOUN: &'static str = "surface";
     const LOCAL_NOUN: &'static str = "local patch";
 
-    /// On a grid: the probes beside the refined interval in its direction against every knot
-    /// and interval of the other, and the line u = t (or v = t) at the other's knots only
-    /// (the new patches interpolate there, at their knot crossings).
+    /// On a grid: the knots and two parameters inside each interval beside the refined one in
+    /// its direction, against every knot and interval midpoint of the other, and the line
+    /// u = t (or v = t) at the other's knots only (the new patches interpolate there, at their
+    /// knot crossings). Fewer probes than a curve gets: an ERBS patch costs dozens of Bézier
+    /// evaluations, and a misplaced restriction shows at any of them.
     fn refinement_change(&self, refined: &Self, (dir, t): (usize, f64)) -> ShapeChange {
         let knots = self.knots();
-        let degree = self
-            .local_patches()
-            .iter()
-            .map(LocalPatch::degree)
-            .fold([0, 0], |a, d| [a[0].max(d[0]), a[1].max(d[1])]);
-        let mut beside = [0, 1].map(|d| erbs_probes(&knots[d], degree[d], None));
-        beside[dir] = erbs_probes(&knots[dir], degree[dir], Some(knots[dir].locate(t)));
+        let mut beside = [0, 1].map(|d| erbs_probes(&knots[d], 1, None));
+        beside[dir] = erbs_probes(&knots[dir], 2, Some(knots[dir].locate(t)));
         let mut line = [0, 1].map(|d| erbs_knot_probes(&knots[d]));
         line[dir] = vec![t];
         shape_change(self, refined, &beside).worse(shape_change(self, refined, &line))
