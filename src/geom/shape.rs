@@ -188,6 +188,9 @@ pub fn erbs_probes(knots: &ErbsKnots, per: usize, changed: Option<usize>) -> Vec
             out.extend(span_probes(&[lo, hi], per - 1, (a, b)));
         }
     }
+    // Neighbouring intervals share their knots.
+    out.sort_by(f64::total_cmp);
+    out.dedup();
     out
 }
 
