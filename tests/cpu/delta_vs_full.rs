@@ -254,7 +254,9 @@ fn point_delta(edit: &mut ObjectEdit) -> Option<&mut DVec3> {
 /// vanishes there, as above a polynomial's degree). The delta path keeps the samples of the
 /// net the user edited; `--full` evaluates the refined net, which carries the same shape on
 /// shorter spans and at higher degree, and rounding its control points moves the r-th
-/// derivative by about ε·|P|·(d/h)^r. Measured worst over the seeds below, with a margin.
+/// derivative by about ε·|P|·(d/h)^r. Measured worst over 1000 seeds per kind (4000 runs):
+/// 4.6e-15, 2.6e-14, 3.0e-13, 1.6e-11, 1.2e-9, 6.1e-10, 3.8e-10, 2.8e-10, 2.3e-10 for orders
+/// 0 to 8 (the same over the 200 the test runs, but for orders 0 and 1: 3.0e-15, 1.2e-14).
 const STRUCTURAL_ORDER_TOL: [f64; 9] = [2e-14, 1e-13, 1e-12, 5e-11, 5e-9, 2e-9, 2e-9, 1e-9, 1e-9];
 
 /// Seeds per kind: `PRESPLINE_STRUCTURAL_SEEDS` (default 200).
