@@ -36,8 +36,12 @@ struct Viewer {
 
 impl Viewer {
     fn new(save_path: PathBuf) -> Self {
+        Self::with_scene(SCENE, save_path)
+    }
+
+    fn with_scene(text: &str, save_path: PathBuf) -> Self {
         let (mut renderer, sink) = common::renderer();
-        let scene = parse_scene(SCENE).unwrap();
+        let scene = parse_scene(text).unwrap();
         let session = Session::open(
             &mut renderer,
             &scene,
@@ -597,5 +601,61 @@ fn structural_edits_over_the_memory_budget_are_refused() {
         other => panic!("not a B-spline curve: {other:?}"),
     }
     assert_eq!(v.session.undo_depth(), (1, 0));
+    v.finish();
+}
+
+/// Issue 25's viewer path: a degree-10 B-spline curve with interior knots 0.5 and 0.5001.
+const DEGREE_10: &str = r#"{"objects": [
+  {"name": "c", "type": "bspline_curve", "degree": 10,
+   "knots": [0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0.5, 0.5001, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1],
+   "points": [[-2.0, 1.8, 0.6], [-1.6, 2.7, 1.0], [-1.2, -2.9, -0.2], [-0.8, -2.5, -0.4],
+              [-0.4, -1.1, -3.0], [0.0, 0.1, -1.8], [0.4, -2.7, -1.7], [0.8, 1.2, 0.3],
+              [1.2, 2.2, 0.9], [1.6, -0.6, 1.4], [2.0, 0.4, -0.9], [2.4, 1.9, 0.2],
+              [2.8, -1.0, 0.5]], "samples": 200}
+]}"#;
+
+/// E on that curve used to send its net far away while the samples still showed the old curve,
+/// and Ctrl+S wrote a curve 0.59 away from the one shown. Now the saved curve is the one shown
+/// (to 1e-10 of its size), after one E and after two.
+#[test]
+fn elevating_beside_a_short_span_saves_the_curve_shown() {
+    let scratch = common::Scratch::new("view-session");
+    let path = scratch.join("saved.json");
+    let mut v = Viewer::with_scene(DEGREE_10, path.clone());
+    let curve = |scene: &Scene| match &scene.objects[0].model {
+        Model::Curve(c) => c.curve().clone(),
+        other => panic!("not a B-spline curve: {other:?}"),
+    };
+    let shown = curve(&v.scene());
+    let size = {
+        let p = shown.points();
+        let lo = p.iter().fold(DVec3::INFINITY, |a, q| a.min(*q));
+        let hi = p.iter().fold(DVec3::NEG_INFINITY, |a, q| a.max(*q));
+        (hi - lo).length()
+    };
+    for presses in [1, 2] {
+        v.select(Handle::Point {
+            object: 0,
+            point: Index2::One(3),
+        });
+        v.key('e', false, false);
+        v.key('s', true, false);
+        let saved = curve(&Scene::load(&path).unwrap());
+        let degree = if presses == 1 { 11 } else { 12 };
+        assert_eq!(saved.degree(), degree, "status: {}", v.session.status());
+        let moved = (0..=4000)
+            .map(|i| {
+                let t = i as f64 / 4000.0;
+                shown.eval(t).distance(saved.eval(t))
+            })
+            .fold(
+                0.0f64,
+                |m, d| if d.is_nan() { f64::INFINITY } else { m.max(d) },
+            );
+        assert!(
+            moved <= 1e-10 * size,
+            "after {presses} E: the saved curve is {moved:e} from the one shown"
+        );
+    }
     v.finish();
 }

@@ -19,6 +19,7 @@ pub mod error;
 pub mod knots;
 pub mod point;
 pub mod refine;
+pub mod shape;
 pub mod spline;
 pub mod surface;
 

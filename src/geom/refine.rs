@@ -1,7 +1,11 @@
 //! Refinement that keeps the shape: knot insertion (NURBS Book A5.1 CurveKnotIns, A5.3 per
-//! surface direction), clamping, and degree elevation (A5.9 DegreeElevateCurve, A5.10 per
-//! surface direction).
+//! surface direction, A5.4 RefineKnotVectCurve for many knots at once), clamping, and degree
+//! elevation (what A5.9 DegreeElevateCurve computes, A5.10 per surface direction, by a stable
+//! route: see [`degree_elevate`]).
 //!
+//! Every new control point is a convex combination of old ones (Böhm's and Oslo's insertion
+//! coefficients lie in [0, 1]); nothing here extrapolates, so a refined net is as accurate as
+//! the net it came from, whatever the degree and however short the spans.
 //! Everything works on homogeneous control points (w·P, w), so rational curves and surfaces
 //! refine exactly like polynomial ones; callers project back. Surfaces refine one direction by
 //! running the curve algorithm on every line of the net in that direction: the knots and the
@@ -190,31 +194,141 @@ fn reverse<P: Point>(c: &Spline<P>) -> Spline<P> {
 /// Degree elevation by `t` (DegreeElevateCurve): the same curve of degree d+t; every knot's
 /// multiplicity grows by t, so the continuity there is kept. Unclamped curves are clamped first;
 /// interior knots of multiplicity d+1 (jumps) split the curve into pieces elevated separately.
+///
+/// The NURBS Book's A5.9 removes again, on the fly, the knots its Bézier decomposition
+/// inserted, and knot removal extrapolates: beside a short span, or at a high degree, it
+/// amplifies rounding without bound (a degree-11 elevation next to a span of 1e-4 moved a curve
+/// 3 units across by 5.5). Here every new control point is a convex combination of old ones
+/// ([`elevate_once`]), so the elevated net is accurate to a few roundings of the net's size at
+/// every degree and knot spacing.
 #[must_use]
 pub fn degree_elevate<P: Point>(c: &Spline<P>, t: usize) -> Spline<P> {
     if t == 0 {
         return c.clone();
     }
-    let c = clamp(c);
-    let p = c.degree;
-    let mut out: Option<Spline<P>> = None;
-    for piece in split_at_jumps(&c) {
-        let e = if piece.points.len() == p + 1 {
-            elevate_bezier(&piece, t)
-        } else {
-            degree_elevate_clamped(&piece, t)
-        };
-        out = Some(match out {
-            None => e,
-            Some(mut acc) => {
-                // Both pieces are clamped at the jump: keep d+t+1 copies of it once.
-                acc.knots.extend_from_slice(&e.knots[e.degree + 1..]);
-                acc.points.extend_from_slice(&e.points);
-                acc
-            }
-        });
+    let pieces = split_at_jumps(&clamp(c));
+    join_at_jumps(pieces.iter().map(|piece| elevate_piece(piece, t)))
+}
+
+/// DegreeElevateCurve for many curves on one knot vector (the lines of a net, A5.10): the
+/// elevation is linear, Q_j = Σ_l E_{j,l} P_l on the clamped points, and E depends on the knots
+/// alone, so it is computed once and every line costs d+2 products per new point.
+///
+/// E comes from [`degree_elevate`] itself, run on unit points: E_{j,l} ≠ 0 only where the new
+/// B-spline N'_j has its support inside the old N_l's (on a span outside it N_l vanishes and the
+/// N'_j there are independent), which leaves at most d+1 consecutive l for each j. So unit
+/// points d+2 apart share a lane without meeting in any new point, and one run of 16 lanes
+/// gives E for up to degree 14. Its entries are convex weights (rows sum to 1), like those of
+/// the elevation they record: E·P is as stable.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Elevation {
+    /// The elevated degree and knots.
+    degree: usize,
+    knots: Vec<f64>,
+    /// Per new point j: the first clamped point it weighs and the weights.
+    rows: Vec<(usize, Vec<f64>)>,
+}
+
+impl Elevation {
+    /// The elevation by `t` of degree-`degree` curves on `knots` (any count of points).
+    #[must_use]
+    pub fn new(degree: usize, knots: &[f64], t: usize) -> Self {
+        let count = knots.len() - degree - 1;
+        let lanes = 4 * LINES;
+        let clamped = clamp(&Spline {
+            degree,
+            knots: knots.to_vec(),
+            points: vec![0.0; count],
+        })
+        .knots;
+        let n = clamped.len() - degree - 1;
+        // Unit points l ≡ c (mod apart) share lane c.
+        let apart = degree + 2;
+        let runs: Vec<Spline<Pack>> = (0..apart)
+            .step_by(lanes)
+            .map(|base| {
+                let points = (0..n)
+                    .map(|l| {
+                        let mut p = Pack::default();
+                        if let Some(lane) = (l % apart).checked_sub(base).filter(|&c| c < lanes) {
+                            p.0[lane] = 1.0;
+                        }
+                        p
+                    })
+                    .collect();
+                let unit = Spline {
+                    degree,
+                    knots: clamped.clone(),
+                    points,
+                };
+                degree_elevate(&unit, t)
+            })
+            .collect();
+        let (q, raised) = (runs[0].degree, &runs[0].knots);
+        let rows = (0..runs[0].points.len())
+            .map(|j| {
+                // The first l with N'_j's support inside N_l's: u_{l+d+1} ≥ û_{j+q+1}.
+                let first = clamped.partition_point(|&x| x < raised[j + q + 1]);
+                let lo = first.saturating_sub(degree + 1);
+                let weights = (lo..(lo + apart).min(n))
+                    .map(|l| {
+                        let c = l % apart;
+                        runs[c / lanes].points[j].0[c % lanes]
+                    })
+                    .collect();
+                (lo, weights)
+            })
+            .collect();
+        Self {
+            degree: q,
+            knots: runs[0].knots.clone(),
+            rows,
+        }
     }
-    out.expect("a curve has at least one piece")
+
+    /// The elevated curve of `c`, whose degree and knots are the ones this was made for.
+    #[must_use]
+    pub fn apply<P: Point>(&self, c: &Spline<P>) -> Spline<P> {
+        let c = clamp(c);
+        let points = self
+            .rows
+            .iter()
+            .map(|(lo, w)| {
+                w.iter()
+                    .zip(&c.points[*lo..])
+                    .fold(P::default(), |acc, (&w, &p)| acc + p * w)
+            })
+            .collect();
+        Spline {
+            degree: self.degree,
+            knots: self.knots.clone(),
+            points,
+        }
+    }
+}
+
+/// One clamped piece without jumps elevated by t: a Bézier span in one step, a B-spline by t
+/// steps of one.
+fn elevate_piece<P: Point>(piece: &Spline<P>, t: usize) -> Spline<P> {
+    if piece.points.len() == piece.degree + 1 {
+        return elevate_bezier(piece, t);
+    }
+    let mut c = elevate_once(piece);
+    for _ in 1..t {
+        c = elevate_once(&c);
+    }
+    c
+}
+
+/// Pieces clamped at shared jumps joined again: d+1 copies of each jump, once.
+fn join_at_jumps<P: Point>(pieces: impl Iterator<Item = Spline<P>>) -> Spline<P> {
+    pieces
+        .reduce(|mut acc, e| {
+            acc.knots.extend_from_slice(&e.knots[e.degree + 1..]);
+            acc.points.extend_from_slice(&e.points);
+            acc
+        })
+        .expect("a curve has at least one piece")
 }
 
 /// Pieces between interior knots of multiplicity d+1, each clamped at both ends.
@@ -290,134 +404,156 @@ fn elevate_bezier<P: Point>(c: &Spline<P>, t: usize) -> Spline<P> {
     }
 }
 
-/// A5.9 on a clamped curve whose interior knots have multiplicity at most d: Bézier segments
-/// are extracted by knot insertion, elevated, and the inserted knots removed again on the fly.
-fn degree_elevate_clamped<P: Point>(c: &Spline<P>, t: usize) -> Spline<P> {
+/// Elevation by one of a clamped curve whose interior knots have multiplicity at most d, by
+/// blossoming (Prautzsch and Piper, "A fast algorithm to raise the degree of spline curves",
+/// CAGD 8, 1991). The elevated knots û repeat every distinct knot once more. New control point
+/// j is the degree-(d+1) blossom at û_{j+1}, …, û_{j+d+1}, the mean of the d+1 degree-d blossoms
+/// that leave one of those arguments out. Leaving out û_k with k ≡ r (mod d+1) leaves d
+/// consecutive knots of τ_r, û without every (d+1)-th knot from index r on ([`Thinning`]). Each
+/// τ_r refines the old knots (a value loses at most one of its m+1 copies), so that blossom is a
+/// control point of the curve refined to τ_r (RefineKnotVectCurve, A5.4), and every new point
+/// is the mean of one point of each of the d+1 refinements: convex combinations throughout.
+fn elevate_once<P: Point>(c: &Spline<P>) -> Spline<P> {
     let p = c.degree;
-    let u = &c.knots;
-    let pw = &c.points;
-    let n = pw.len() - 1;
-    let m = n + p + 1;
-    let ph = p + t;
-    let ph2 = ph / 2;
-    let bezalfs = bezier_alphas(p, t);
-    // The book computes half and mirrors; the closed form above gives the same values, and the
-    // mirror symmetry is kept exactly by construction of the binomials.
-    debug_assert!((ph2 + 1..ph).all(|i| (0..=p).all(|j| bezalfs[i][j] == bezalfs[ph - i][p - j])));
-    let mut mh = ph;
-    let mut kind = ph + 1;
-    let mut r: isize = -1;
-    let mut a = p;
-    let mut b = p + 1;
-    let mut cind = 1;
-    let mut ua = u[0];
-    let mut qw = vec![P::default(); (n + 1) * (t + 1) + 1];
-    qw[0] = pw[0];
-    let mut uh = vec![ua; ph + 1];
-    let mut bpts: Vec<P> = pw[..=p].to_vec();
-    let mut next_bpts = vec![P::default(); p.max(1)];
-    let mut ebpts = vec![P::default(); ph + 1];
-    let mut alfs = vec![0.0; p.max(1)];
-    while b < m {
-        let i0 = b;
-        while b < m && u[b] == u[b + 1] {
-            b += 1;
-        }
-        let mul = b - i0 + 1;
-        mh += mul + t;
-        let ub = u[b];
-        let oldr = r;
-        r = p as isize - mul as isize;
-        // Bézier points of the previous and this segment that knot removal keeps.
-        let lbz = if oldr > 0 {
-            ((oldr + 2) / 2) as usize
-        } else {
-            1
-        };
-        let rbz = if r > 0 {
-            ph - ((r + 1) / 2) as usize
-        } else {
-            ph
-        };
-        if r > 0 {
-            // Insert u[b] r times to get the Bézier segment [ua, ub].
-            let numer = ub - ua;
-            for k in (mul + 1..=p).rev() {
-                alfs[k - mul - 1] = numer / (u[a + k] - ua);
-            }
-            for j in 1..=r as usize {
-                let save = r as usize - j;
-                let s = mul + j;
-                for k in (s..=p).rev() {
-                    bpts[k] = bpts[k] * alfs[k - s] + bpts[k - 1] * (1.0 - alfs[k - s]);
-                }
-                next_bpts[save] = bpts[p];
-            }
-        }
-        for (i, e) in ebpts.iter_mut().enumerate().skip(lbz) {
-            *e = (i.saturating_sub(t)..=p.min(i))
-                .fold(P::default(), |acc, j| acc + bpts[j] * bezalfs[i][j]);
-        }
-        if oldr > 1 {
-            // Remove the knot u = ua oldr − 1 times.
-            let oldr = oldr as usize;
-            let den = ub - ua;
-            let bet = (ub - uh[kind - 1]) / den;
-            // Each removal step widens the window [first, last] by one on both sides.
-            for tr in 1..oldr {
-                let (first, last) = (kind - 1 - tr, kind - 1 + tr);
-                let (mut i, mut j) = (first, last);
-                let mut kj = (j - kind + 1) as isize;
-                while j - i > tr {
-                    if i < cind {
-                        let alf = (ub - uh[i]) / (ua - uh[i]);
-                        qw[i] = qw[i] * alf + qw[i - 1] * (1.0 - alf);
-                    }
-                    if j >= lbz {
-                        let k = kj as usize;
-                        if j - tr <= kind - ph + oldr {
-                            let gam = (ub - uh[j - tr]) / den;
-                            ebpts[k] = ebpts[k] * gam + ebpts[k + 1] * (1.0 - gam);
-                        } else {
-                            ebpts[k] = ebpts[k] * bet + ebpts[k + 1] * (1.0 - bet);
-                        }
-                    }
-                    i += 1;
-                    j -= 1;
-                    kj -= 1;
-                }
-            }
-        }
-        if a != p {
-            // Load the knot ua.
-            for _ in 0..(ph as isize - oldr) {
-                uh.push(ua);
-                kind += 1;
-            }
-        }
-        for e in &ebpts[lbz..=rbz] {
-            qw[cind] = *e;
-            cind += 1;
-        }
-        if b < m {
-            let r0 = r.max(0) as usize;
-            bpts[..r0].copy_from_slice(&next_bpts[..r0]);
-            for j in r0..=p {
-                bpts[j] = pw[b - p + j];
-            }
-            a = b;
-            b += 1;
-            ua = ub;
-        } else {
-            uh.extend(std::iter::repeat_n(ub, ph + 1));
+    let knots = raised_knots(&c.knots);
+    let count = knots.len() - (p + 2);
+    let share = 1.0 / (p + 1) as f64;
+    let mut points = vec![P::default(); count];
+    for r in 0..=p {
+        let thinning = Thinning::new(&knots, p, r);
+        let refined = refine_knot_vect(c, &missing(&c.knots, &thinning.knots));
+        debug_assert_eq!(refined.knots, thinning.knots);
+        for (j, q) in points.iter_mut().enumerate() {
+            *q += refined.points[thinning.point(j)] * share;
         }
     }
-    let count = mh - ph;
-    qw.truncate(count);
-    debug_assert_eq!(uh.len(), count + ph + 1);
     Spline {
-        degree: ph,
-        knots: uh,
+        degree: p + 1,
+        knots,
+        points,
+    }
+}
+
+/// Every distinct knot once more: the knots of the curve elevated by one.
+fn raised_knots(u: &[f64]) -> Vec<f64> {
+    let mut out = Vec::with_capacity(2 * u.len());
+    for (i, &x) in u.iter().enumerate() {
+        out.push(x);
+        if u.get(i + 1) != Some(&x) {
+            out.push(x);
+        }
+    }
+    out
+}
+
+/// The knots of `finer` that `coarser` lacks (both sorted, `finer` ⊇ `coarser` as multisets).
+fn missing(coarser: &[f64], finer: &[f64]) -> Vec<f64> {
+    let mut out = Vec::with_capacity(finer.len() - coarser.len());
+    let mut next = coarser.iter().peekable();
+    for &x in finer {
+        if next.peek() == Some(&&x) {
+            next.next();
+        } else {
+            out.push(x);
+        }
+    }
+    out
+}
+
+/// τ_r for the elevation by one of a degree-d curve: the raised knots û without those at
+/// indices ≡ r (mod d+1), each end topped up to d+1 copies again.
+struct Thinning {
+    knots: Vec<f64>,
+    degree: usize,
+    r: usize,
+    /// 1 when the thinning dropped two copies of the first knot (r = 0) and one was put back.
+    front: usize,
+}
+
+impl Thinning {
+    fn new(raised: &[f64], degree: usize, r: usize) -> Self {
+        let m = degree + 1;
+        let front = usize::from(r == 0);
+        let mut knots = Vec::with_capacity(raised.len());
+        knots.extend(std::iter::repeat_n(raised[0], front));
+        knots.extend(
+            raised
+                .iter()
+                .enumerate()
+                .filter(|(k, _)| k % m != r)
+                .map(|(_, &x)| x),
+        );
+        let last = raised[raised.len() - 1];
+        if knots.iter().rev().take_while(|&&x| x == last).count() == degree {
+            knots.push(last);
+        }
+        Self {
+            knots,
+            degree,
+            r,
+            front,
+        }
+    }
+
+    /// The control point of the curve refined to τ_r whose knots are those of elevated point j,
+    /// û_{j+1}, …, û_{j+d+1}, without the one at an index ≡ r (mod d+1).
+    fn point(&self, j: usize) -> usize {
+        let m = self.degree + 1;
+        // The knot left out is û_{j+l}, 1 ≤ l ≤ d+1 (l = 0 below stands for d+1), and the
+        // blossom's first knot û_s.
+        let l = (self.r + m - j % m) % m;
+        let s = if l == 1 { j + 2 } else { j + 1 };
+        // Knots before û_s that τ_r dropped: indices i < s with i ≡ r.
+        let dropped = (s + self.degree - self.r) / m;
+        s - dropped + self.front - 1
+    }
+}
+
+/// RefineKnotVectCurve (NURBS Book A5.4): inserts the sorted knots `x`, all inside the domain,
+/// in one pass from the right. Every new point is a convex combination of two others, so the
+/// refinement is stable however short the spans.
+fn refine_knot_vect<P: Point>(c: &Spline<P>, x: &[f64]) -> Spline<P> {
+    if x.is_empty() {
+        return c.clone();
+    }
+    let (p, u, pw) = (c.degree, &c.knots, &c.points);
+    let n = pw.len() - 1;
+    let m = n + p + 1;
+    let r = x.len() - 1;
+    let a = find_span(u, p, n + 1, x[0]);
+    let b = find_span(u, p, n + 1, x[r]) + 1;
+    let mut qw = vec![P::default(); n + r + 2];
+    let mut ubar = vec![0.0; m + r + 2];
+    qw[..=a - p].copy_from_slice(&pw[..=a - p]);
+    qw[b + r..].copy_from_slice(&pw[b - 1..]);
+    ubar[..=a].copy_from_slice(&u[..=a]);
+    ubar[b + p + r + 1..].copy_from_slice(&u[b + p..]);
+    let mut i = b + p - 1;
+    let mut k = b + p + r;
+    for &xj in x.iter().rev() {
+        while xj <= u[i] && i > a {
+            qw[k - p - 1] = pw[i - p - 1];
+            ubar[k] = u[i];
+            k -= 1;
+            i -= 1;
+        }
+        qw[k - p - 1] = qw[k - p];
+        for l in 1..=p {
+            let ind = k - p + l;
+            let num = ubar[k + l] - xj;
+            qw[ind - 1] = if num == 0.0 {
+                qw[ind]
+            } else {
+                let alfa = num / (ubar[k + l] - u[i - p + l]);
+                qw[ind - 1] * alfa + qw[ind] * (1.0 - alfa)
+            };
+        }
+        ubar[k] = xj;
+        k -= 1;
+    }
+    Spline {
+        degree: p,
+        knots: ubar,
         points: qw,
     }
 }
@@ -557,4 +693,200 @@ pub fn refine_net(
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// de Boor's algorithm on raw knots (FindSpan, then the triangle): an evaluator of its own.
+    fn eval(c: &Spline<DVec4>, t: f64) -> DVec3 {
+        let p = c.degree;
+        let k = find_span(&c.knots, p, c.points.len(), t);
+        let mut d = c.points[k - p..=k].to_vec();
+        for r in 1..=p {
+            for j in (r..=p).rev() {
+                let (lo, hi) = (c.knots[j + k - p], c.knots[j + 1 + k - r]);
+                let a = (t - lo) / (hi - lo);
+                d[j] = d[j] * a + d[j - 1] * (1.0 - a);
+            }
+        }
+        d[p].truncate() / d[p].w
+    }
+
+    /// A clamped curve of degree `p` on [0, 1] with interior knots `inner`, wavy points and,
+    /// when `rational`, weights between 0.5 and 2.
+    fn curve(p: usize, inner: &[f64], rational: bool) -> Spline<DVec4> {
+        let mut knots = vec![0.0; p + 1];
+        knots.extend_from_slice(inner);
+        knots.extend(std::iter::repeat_n(1.0, p + 1));
+        let n = knots.len() - p - 1;
+        let points = (0..n)
+            .map(|i| {
+                let x = i as f64;
+                let w = if rational {
+                    1.25 + 0.75 * (1.7 * x).sin()
+                } else {
+                    1.0
+                };
+                (DVec3::new((0.9 * x).sin(), (1.3 * x).cos(), (0.4 * x).sin() * 2.0) * w).extend(w)
+            })
+            .collect();
+        Spline {
+            degree: p,
+            knots,
+            points,
+        }
+    }
+
+    /// The bounding box of the projected points, grown by `slack` of its diagonal.
+    fn bounds(c: &Spline<DVec4>) -> (DVec3, DVec3, f64) {
+        let pts = c.points.iter().map(|h| h.truncate() / h.w);
+        let (lo, hi) = pts.fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(p), hi.max(p))
+        });
+        (lo, hi, (hi - lo).length())
+    }
+
+    /// Largest distance between the two curves at 40 points per span of `b`, over the size.
+    fn moved(a: &Spline<DVec4>, b: &Spline<DVec4>) -> f64 {
+        let (_, _, size) = bounds(a);
+        let mut worst = 0.0f64;
+        for w in b.knots.windows(2).filter(|w| w[0] < w[1]) {
+            for i in 0..=40 {
+                let t = w[0] + (w[1] - w[0]) * i as f64 / 40.0;
+                worst = super::super::point::nan_max(worst, (eval(a, t) - eval(b, t)).length());
+            }
+        }
+        worst / size
+    }
+
+    #[test]
+    fn refine_knot_vect_equals_insertion_one_knot_at_a_time() {
+        let c = curve(4, &[0.2, 0.2, 0.5, 0.7], true);
+        let x = [0.1, 0.2, 0.2, 0.35, 0.5, 0.5, 0.9, 0.9];
+        let all = refine_knot_vect(&c, &x);
+        let mut one = c.clone();
+        for &t in &x {
+            one = curve_knot_ins(&one, t, 1);
+        }
+        assert_eq!(all.knots, one.knots);
+        for (a, b) in all.points.iter().zip(&one.points) {
+            assert!((*a - *b).length() < 1e-14, "{a} {b}");
+        }
+        assert_eq!(refine_knot_vect(&c, &[]), c);
+    }
+
+    #[test]
+    fn thinned_knots_refine_the_old_ones_and_index_the_blossoms() {
+        // Knots of multiplicity 1 to d, the ends d+1.
+        let c = curve(3, &[0.25, 0.5, 0.5, 0.75, 0.75, 0.75], false);
+        let raised = raised_knots(&c.knots);
+        assert_eq!(raised.len(), c.knots.len() + 5);
+        for r in 0..=3 {
+            let t = Thinning::new(&raised, 3, r);
+            assert_eq!(
+                missing(&c.knots, &t.knots).len() + c.knots.len(),
+                t.knots.len()
+            );
+            assert_eq!(&t.knots[..4], &[0.0; 4]);
+            assert_eq!(&t.knots[t.knots.len() - 4..], &[1.0; 4]);
+            let n = t.knots.len() - 4;
+            // Point j's knots in τ_r are û_{j+1..=j+4} less the one at an index ≡ r (mod 4).
+            for j in 0..raised.len() - 5 {
+                let i = t.point(j);
+                assert!(i < n, "r {r} j {j}");
+                let mut want: Vec<f64> = (j + 1..=j + 4)
+                    .filter(|k| k % 4 != r)
+                    .map(|k| raised[k])
+                    .collect();
+                want.truncate(3);
+                assert_eq!(&t.knots[i + 1..=i + 3], &want[..], "r {r} j {j}");
+            }
+        }
+    }
+
+    /// The curves: high degrees next to a short span. A5.9's knot removal sent the net
+    /// far outside the old one (5.5 on a curve 3 across); convex combinations stay inside it.
+    #[test]
+    fn elevation_beside_short_spans_stays_inside_the_net_and_on_the_curve() {
+        for (p, inner) in [
+            (10, vec![0.5, 0.5001]),
+            (10, vec![0.0001]),
+            (30, vec![0.3, 0.3 + 1e-6, 0.9]),
+            (63, vec![1e-6, 0.5]),
+        ] {
+            for rational in [false, true] {
+                let c = curve(p, &inner, rational);
+                let (lo, hi, size) = bounds(&c);
+                for by in [1, 2, 5] {
+                    if p + by > 64 {
+                        continue;
+                    }
+                    let e = degree_elevate(&c, by);
+                    assert_eq!(e.degree, p + by);
+                    assert_eq!(e.knots.len(), c.knots.len() + by * (inner.len() + 2));
+                    for q in e.points.iter().map(|h| h.truncate() / h.w) {
+                        let slack = 1e-13 * size;
+                        assert!(
+                            q.cmpge(lo - slack).all() && q.cmple(hi + slack).all(),
+                            "degree {p} + {by}: {q} outside [{lo}, {hi}]"
+                        );
+                    }
+                    let m = moved(&c, &e);
+                    assert!(
+                        m < 1e-13,
+                        "degree {p} + {by} (rational {rational}): moved {m:e}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// The net form (E computed once) equals elevating each curve, on clamped and unclamped
+    /// knots, with jumps, at degrees that need one and several runs of lanes.
+    #[test]
+    fn the_elevation_matrix_equals_elevating_each_curve() {
+        let mut cases = vec![
+            curve(3, &[0.25, 0.5, 0.5, 0.5001], true),
+            curve(2, &[0.3, 0.3, 0.3, 0.6], false),
+            curve(20, &[1e-6, 0.5, 0.7], true),
+            curve(40, &[0.5], false),
+        ];
+        let mut unclamped = curve(4, &[0.2, 0.4, 0.6], true);
+        unclamped.knots = (0..unclamped.knots.len()).map(|i| i as f64 * 0.1).collect();
+        cases.push(unclamped);
+        for c in cases {
+            for by in [1, 3] {
+                if c.degree + by > 64 {
+                    continue;
+                }
+                let (direct, plan) = (
+                    degree_elevate(&c, by),
+                    Elevation::new(c.degree, &c.knots, by),
+                );
+                let net = plan.apply(&c);
+                assert_eq!((net.degree, &net.knots), (direct.degree, &direct.knots));
+                let (_, _, size) = bounds(&c);
+                for (a, b) in net.points.iter().zip(&direct.points) {
+                    let d = (a.truncate() / a.w - b.truncate() / b.w).length();
+                    assert!(d < 1e-13 * size, "degree {} + {by}: {a} {b}", c.degree);
+                }
+                for (_, w) in &plan.rows {
+                    let sum: f64 = w.iter().sum();
+                    assert!((sum - 1.0).abs() < 1e-13 && w.iter().all(|&x| x >= 0.0));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn elevation_by_one_equals_the_bezier_elevation_on_one_span() {
+        let c = curve(5, &[], true);
+        let (a, b) = (elevate_once(&c), elevate_bezier(&c, 1));
+        assert_eq!(a.knots, b.knots);
+        for (x, y) in a.points.iter().zip(&b.points) {
+            assert!((*x - *y).length() < 1e-14, "{x} {y}");
+        }
+    }
 }

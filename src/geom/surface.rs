@@ -7,7 +7,7 @@ use super::control::{check_points, check_weights};
 use super::error::{GeomError, GeomResult};
 use super::knots::KnotVector;
 use super::point::{Point, binomial, homogeneous, to_homogeneous};
-use super::refine::{KnotInsertion, Pack, Spline, degree_elevate, refine_net};
+use super::refine::{Elevation, KnotInsertion, Pack, Spline, refine_net};
 use glam::{DVec3, DVec4};
 
 /// S(u,v) = Σ_i Σ_j P_ij N_i(u) N_j(v). Control points are row-major, `points[i * nv + j]`, with
@@ -347,7 +347,8 @@ impl TensorSurface {
     /// every line of the net). An unclamped direction comes back clamped on its domain.
     #[must_use]
     pub fn elevate_degree(&self, dir: usize, by: usize) -> Self {
-        self.refined(dir, |c| degree_elevate(c, by))
+        let elevation = Elevation::new(self.degree[dir], &self.knots[dir], by);
+        self.refined(dir, |c| elevation.apply(c))
     }
 
     fn refined(&self, dir: usize, refine: impl Fn(&Spline<Pack>) -> Spline<Pack>) -> Self {

@@ -1,8 +1,9 @@
 //! Bézier, B-spline and NURBS curves: the model and its edits.
 
-use super::edit::{EditError, KindEdit, ObjectEdit, Target};
+use super::edit::{EditError, KindEdit, ObjectEdit, Target, check_shape_kept};
 use super::points::PointEdit;
 use super::{MAX_CURVE_SAMPLES, MAX_DEGREE, SplineForm, check_samples};
+use crate::geom::shape::{insertion_window, shape_change, span_probes};
 use crate::geom::{BSplineCurve, GeomError, KnotVector};
 
 /// A Bézier or B-spline (NURBS with weights) curve with its sample count.
@@ -76,9 +77,14 @@ impl KindEdit for CurveEdit {
         match *self {
             CurveEdit::Point(p) => p.validate(c),
             CurveEdit::InsertKnot { t, times } => {
-                check_insertion(c.domain(), c.degree(), c.knots().multiplicity(t), t, times)
+                check_insertion(c.domain(), c.degree(), c.knots().multiplicity(t), t, times)?;
+                let window = insertion_window(c.knots(), c.degree(), t, c.domain());
+                check_curve_kept("insert_knot", c, c.insert_knot(t, times), window)
             }
-            CurveEdit::ElevateDegree { by } => check_elevation("elevate_degree", c.degree(), by),
+            CurveEdit::ElevateDegree { by } => {
+                check_elevation("elevate_degree", c.degree(), by)?;
+                check_curve_kept("elevate_degree", c, c.elevate_degree(by), c.domain())
+            }
             CurveEdit::Restore { ref model, .. } => check_restore(model.samples == m.samples),
         }
     }
@@ -136,6 +142,19 @@ impl KindEdit for CurveEdit {
             _ => None,
         }
     }
+}
+
+/// A refinement of `old` (an edit's `field`) that keeps its shape: the refined curve agrees
+/// with it at d+1 points per span of the refined knots inside `window`, where it can differ.
+fn check_curve_kept(
+    field: &'static str,
+    old: &BSplineCurve,
+    refined: Result<BSplineCurve, GeomError>,
+    window: (f64, f64),
+) -> Result<(), EditError> {
+    let new = refined.map_err(|e| EditError::new(field, e.message))?;
+    let at = span_probes(new.knots(), new.degree(), window);
+    check_shape_kept(field, "curve", shape_change(old, &new, &at))
 }
 
 /// Takes a refinement's result. Refining a valid model with validated arguments cannot fail;

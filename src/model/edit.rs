@@ -5,6 +5,7 @@ use super::{
     BezierSplineEdit, CatmullRomEdit, CurveEdit, ErbsCurveEdit, ErbsSurfaceEdit, Index2, LocalPath,
     Model, ModelRef, SurfaceEdit,
 };
+use crate::geom::shape::{SHAPE_TOLERANCE, ShapeChange};
 use std::fmt::Debug;
 
 /// A rejected edit: which field of the edit is wrong and why (callers add the object and the
@@ -22,6 +23,44 @@ impl EditError {
             field,
             message: message.into(),
         }
+    }
+}
+
+/// Refuses a structural edit whose result would move the shape (`what`: "curve", "surface",
+/// …) by more than [`ShapeChange::tolerance`]: one line with the field, how far, and against
+/// what. Validation runs it, so nothing is applied.
+pub(super) fn check_shape_kept(
+    field: &'static str,
+    what: &str,
+    change: ShapeChange,
+) -> Result<(), EditError> {
+    if change.is_kept() {
+        return Ok(());
+    }
+    Err(EditError::new(
+        field,
+        format!(
+            "would move the {what} by {:.1e} (tolerance {SHAPE_TOLERANCE:e} of its size {}); refused, nothing changed",
+            change.moved,
+            significant(change.size)
+        ),
+    ))
+}
+
+/// `x` to three significant digits, without trailing zeros (4.1, 0.0123, 1.2e6).
+fn significant(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    if !(1e-3..1e5).contains(&x.abs()) {
+        return format!("{x:.2e}");
+    }
+    let digits = (2 - x.abs().log10().floor() as i32).max(0) as usize;
+    let s = format!("{x:.digits$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
     }
 }
 
@@ -239,4 +278,47 @@ pub fn merge_edits(edits: &[Edit]) -> Vec<Edit> {
     }
     flush(&mut groups, &mut out);
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_moving_refinement_is_refused_in_one_line() {
+        let change = ShapeChange {
+            moved: 3.2e-3,
+            size: 4.1,
+            magnitude: 3.0,
+        };
+        let e = check_shape_kept("elevate_degree", "curve", change).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "field 'elevate_degree': would move the curve by 3.2e-3 (tolerance 1e-9 of its size 4.1); refused, nothing changed"
+        );
+        let nan = ShapeChange {
+            moved: f64::NAN,
+            ..change
+        };
+        assert!(check_shape_kept("insert_knot", "surface", nan).is_err());
+        let kept = ShapeChange {
+            moved: 1e-15,
+            ..change
+        };
+        assert_eq!(check_shape_kept("insert_knot", "surface", kept), Ok(()));
+    }
+
+    #[test]
+    fn sizes_print_with_three_significant_digits() {
+        for (x, s) in [
+            (4.1, "4.1"),
+            (4.123456, "4.12"),
+            (123.4, "123"),
+            (0.012345, "0.0123"),
+            (0.0, "0"),
+            (2.5e7, "2.50e7"),
+        ] {
+            assert_eq!(significant(x), s);
+        }
+    }
 }

@@ -3,10 +3,11 @@
 //! into the object or into an ERBS local, a polynomial local turned into an ERBS local of its own.
 //! One generic edit type serves both kinds through [`ErbsNet`].
 
-use super::edit::{EditError, KindEdit, ObjectEdit, Target};
+use super::edit::{EditError, KindEdit, ObjectEdit, Target, check_shape_kept};
 use super::points::check_vector;
 use super::{Index2, MAX_CURVE_SAMPLES, MAX_DEGREE, check_samples, check_surface_samples};
 use crate::geom::erbs::{ErbsCurve, ErbsSurface, LocalCurve, LocalPatch, MAX_NESTING};
+use crate::geom::shape::{ShapeChange, erbs_knot_probes, erbs_probes, shape_change};
 use crate::geom::{BFunctionKind, GeomError};
 use glam::{DMat4, DVec3, DVec4};
 use std::fmt::Debug;
@@ -204,6 +205,16 @@ pub trait ErbsNet: Clone + PartialEq + Debug + Sized {
     fn bfunction(&self) -> BFunctionKind;
     fn check_degree(d: Self::Degree) -> Result<(), EditError>;
 
+    /// What the kind is called in messages ("curve", "surface"), and one of its locals.
+    const NOUN: &'static str;
+    const LOCAL_NOUN: &'static str;
+    /// How far `refined` (this net refined at `at`) moved the shape where local refinement
+    /// keeps it: at the knots, at `at`, and on the intervals beside the refined one.
+    fn refinement_change(&self, refined: &Self, at: Self::Knot) -> ShapeChange;
+    /// How far `built` (an ERBS local built from `local`) lies from `local` at its knots, where
+    /// it interpolates it.
+    fn build_change(local: &Self::Local, built: &Self) -> ShapeChange;
+
     fn into_object(e: ErbsEdit<Self>) -> ObjectEdit;
     fn from_object(e: &ObjectEdit) -> Option<&ErbsEdit<Self>>;
 }
@@ -388,7 +399,12 @@ impl<N: ErbsNet> ErbsEdit<N> {
                         )
                     })?,
                 };
-                target.refine(*at, *degree).map(|_| ()).map_err(geom)
+                let refined = target.refine(*at, *degree).map_err(geom)?;
+                check_shape_kept(
+                    "insert_knot",
+                    N::NOUN,
+                    target.refinement_change(&refined, *at),
+                )
             }
             ErbsEdit::ToErbs {
                 local,
@@ -405,9 +421,8 @@ impl<N: ErbsNet> ErbsEdit<N> {
                         format!("ERBS locals nest at most {MAX_NESTING} levels deep"),
                     ));
                 }
-                N::build(l, *count, *degree, net.bfunction())
-                    .map(|_| ())
-                    .map_err(geom)
+                let built = N::build(l, *count, *degree, net.bfunction()).map_err(geom)?;
+                check_shape_kept("to_erbs", N::LOCAL_NOUN, N::build_change(l, &built))
             }
             ErbsEdit::SetLocal { local, .. } => local_of(net, local).map(|_| ()),
             ErbsEdit::Restore(_) => Ok(()),
@@ -670,6 +685,22 @@ impl ErbsNet for ErbsCurve {
         check_max_degree("degree", d)
     }
 
+    const NOUN: &'static str = "curve";
+    const LOCAL_NOUN: &'static str = "local curve";
+
+    fn refinement_change(&self, refined: &Self, t: f64) -> ShapeChange {
+        let degree = self.local_curves().iter().map(LocalCurve::degree).max();
+        let per = degree.unwrap_or(0) + 1;
+        let mut at = erbs_probes(self.knots(), per, Some(self.knots().locate(t)));
+        at.push(t);
+        shape_change(self, refined, &at)
+    }
+
+    fn build_change(local: &LocalCurve, built: &Self) -> ShapeChange {
+        let at = erbs_knot_probes(built.knots());
+        shape_change(local, &Self::wrap(built.clone()), &at)
+    }
+
     fn into_object(e: ErbsEdit<Self>) -> ObjectEdit {
         ObjectEdit::ErbsCurve(e)
     }
@@ -788,6 +819,28 @@ impl ErbsNet for ErbsSurface {
         check_max_degree("degree", du.max(dv))
     }
 
+    const NOUN: &'static str = "surface";
+    const LOCAL_NOUN: &'static str = "local patch";
+
+    /// On a grid: the knots and two parameters inside each interval beside the refined one in
+    /// its direction, against every knot of the other, and the line u = t (or v = t) there too
+    /// (the new patches interpolate at their knot crossings). Fewer probes than a curve gets:
+    /// an ERBS surface point costs a few microseconds, and a misplaced restriction of a row of
+    /// patches shows all along it.
+    fn refinement_change(&self, refined: &Self, (dir, t): (usize, f64)) -> ShapeChange {
+        let knots = self.knots();
+        let mut beside = [0, 1].map(|d| erbs_probes(&knots[d], 0, None));
+        beside[dir] = erbs_probes(&knots[dir], 2, Some(knots[dir].locate(t)));
+        let mut line = [0, 1].map(|d| erbs_knot_probes(&knots[d]));
+        line[dir] = vec![t];
+        shape_change(self, refined, &beside).worse(shape_change(self, refined, &line))
+    }
+
+    fn build_change(local: &LocalPatch, built: &Self) -> ShapeChange {
+        let at = built.knots().each_ref().map(erbs_knot_probes);
+        shape_change(local, &Self::wrap(built.clone()), &at)
+    }
+
     fn into_object(e: ErbsEdit<Self>) -> ObjectEdit {
         ObjectEdit::ErbsSurface(e)
     }
@@ -797,5 +850,58 @@ impl ErbsNet for ErbsSurface {
             ObjectEdit::ErbsSurface(e) => Some(e),
             _ => None,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::BezierCurve;
+    use crate::geom::erbs::ErbsKnots;
+
+    /// Four cubic locals on knots 0..3.
+    fn curve() -> ErbsCurve {
+        let local = (0..4)
+            .map(|l| {
+                let x = l as f64;
+                BezierCurve::new(vec![
+                    DVec3::new(x - 1.0, 0.3 * x, 0.0),
+                    DVec3::new(x - 0.3, 1.0 + x.sin(), 0.5),
+                    DVec3::new(x + 0.3, -0.5, 0.2 * x),
+                    DVec3::new(x + 1.0, 0.1, 0.0),
+                ])
+                .unwrap()
+            })
+            .collect();
+        ErbsCurve::new(
+            vec![0., 0., 1., 2., 3., 3.],
+            local,
+            BFunctionKind::default(),
+        )
+        .unwrap()
+    }
+
+    /// Negative controls: refinement and construction keep the shape where they promise to,
+    /// and a local moved there, by 1e-6 of the size, is caught.
+    #[test]
+    fn erbs_refinement_and_construction_are_compared_where_they_keep_the_shape() {
+        let c = curve();
+        let (refined, new) = c.insert_knot(1.5, None).unwrap();
+        assert!(c.refinement_change(&refined, 1.5).is_kept());
+        // The local beside the refined interval (its restriction), and the new local at t.
+        for local in [0, new] {
+            let mut moved = refined.clone();
+            moved.transform_local(&[local], &DMat4::from_translation(DVec3::Y * 1e-5));
+            let change = c.refinement_change(&moved, 1.5);
+            assert!(!change.is_kept(), "local {local}: {change:?}");
+        }
+        let local = c.local_curves()[2].clone();
+        let built = ErbsCurve::build(&local, 3, 3, BFunctionKind::default()).unwrap();
+        assert!(ErbsCurve::build_change(&local, &built).is_kept());
+        let mut moved = built.clone();
+        moved.transform_local(&[1], &DMat4::from_translation(DVec3::X * 1e-5));
+        assert!(!ErbsCurve::build_change(&local, &moved).is_kept());
+        let knots = ErbsKnots::open(vec![0., 0., 1., 2., 3., 3.], 4).unwrap();
+        assert_eq!(erbs_knot_probes(&knots), vec![0., 1., 2., 3.]);
     }
 }

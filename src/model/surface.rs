@@ -1,9 +1,10 @@
 //! Tensor-product Bézier, B-spline and NURBS surfaces: the model and its edits.
 
 use super::curve::{check_elevation, check_insertion, check_restore, replace};
-use super::edit::{EditError, KindEdit, ObjectEdit, Target};
+use super::edit::{EditError, KindEdit, ObjectEdit, Target, check_shape_kept};
 use super::points::PointEdit;
 use super::{SplineForm, check_surface_samples};
+use crate::geom::shape::{greville, insertion_window, shape_change, span_probes};
 use crate::geom::{KnotVector, TensorSurface};
 use glam::DVec3;
 
@@ -98,7 +99,18 @@ impl KindEdit for SurfaceEdit {
                     t,
                     times,
                 )
-                .map_err(|e| in_direction(e, dir))
+                .map_err(|e| in_direction(e, dir))?;
+                let refined = s
+                    .insert_knot(dir, t, times)
+                    .map_err(|e| EditError::new("insert_knot", e.message))?;
+                let mut windows = [None; 2];
+                windows[dir] = Some(insertion_window(
+                    &s.knots()[dir],
+                    s.degree()[dir],
+                    t,
+                    s.domain()[dir],
+                ));
+                check_surface_kept("insert_knot", s, &refined, windows)
             }
             SurfaceEdit::ElevateDegree { by } => {
                 if by == [0, 0] {
@@ -113,7 +125,8 @@ impl KindEdit for SurfaceEdit {
                             .map_err(|e| in_direction(e, dir))?;
                     }
                 }
-                Ok(())
+                let windows = [0, 1].map(|dir| (by[dir] > 0).then(|| s.domain()[dir]));
+                check_surface_kept("elevate_degree", s, &elevated(s, by), windows)
             }
             SurfaceEdit::Restore { ref model, .. } => check_restore(model.samples == m.samples),
         }
@@ -128,13 +141,7 @@ impl KindEdit for SurfaceEdit {
                     m.form = SplineForm::BSpline;
                 }
             }
-            SurfaceEdit::ElevateDegree { by } => {
-                for (dir, &b) in by.iter().enumerate() {
-                    if b > 0 {
-                        m.surface = m.surface.elevate_degree(dir, b);
-                    }
-                }
-            }
+            SurfaceEdit::ElevateDegree { by } => m.surface = elevated(&m.surface, *by),
             SurfaceEdit::Restore { model, .. } => *m = (**model).clone(),
         }
     }
@@ -177,6 +184,37 @@ impl KindEdit for SurfaceEdit {
             _ => None,
         }
     }
+}
+
+/// The surface elevated by `by` per direction (u first).
+fn elevated(s: &TensorSurface, by: [usize; 2]) -> TensorSurface {
+    let mut out = s.clone();
+    for (dir, &b) in by.iter().enumerate() {
+        if b > 0 {
+            out = out.elevate_degree(dir, b);
+        }
+    }
+    out
+}
+
+/// A refinement of `old` (an edit's `field`) that keeps its shape: the surfaces agree on a
+/// grid of d+1 parameters per span of each refined direction inside its window (where the
+/// refinement can change it) and the Greville abscissae of an unrefined one (where its
+/// B-splines are independent, so every line of the net is compared).
+fn check_surface_kept(
+    field: &'static str,
+    old: &TensorSurface,
+    new: &TensorSurface,
+    windows: [Option<(f64, f64)>; 2],
+) -> Result<(), EditError> {
+    let at = [0, 1].map(|dir| {
+        let (d, knots) = (new.degree()[dir], &new.knots()[dir]);
+        match windows[dir] {
+            Some(window) => span_probes(knots, d, window),
+            None => greville(knots, d, new.count()[dir], new.domain()[dir]),
+        }
+    });
+    check_shape_kept(field, "surface", shape_change(old, new, &at))
 }
 
 fn in_direction(mut e: EditError, dir: usize) -> EditError {

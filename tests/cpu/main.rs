@@ -24,3 +24,4 @@ mod profile_outputs;
 mod splines;
 mod structural_cli;
 mod structural_edits;
+mod structural_shape;
