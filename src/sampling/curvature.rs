@@ -6,10 +6,10 @@
 //! with the normal Su × Sv (a sphere with outward normals has H = −1/r). Principal curvatures
 //! are κ = H ± √(H² − K).
 
-use super::axis::HermiteTable;
 use super::grid::SampleGrid;
 use super::normals::NormalSource;
 use super::shading::{LANES, unit_normals_inv};
+use super::tables::axis::HermiteTable;
 use crate::geom::surface::regular_normal;
 use glam::DVec3;
 use std::ops::Range;

@@ -13,11 +13,8 @@
 mod avx;
 
 use super::shading::{LANES, Lanes, NormalStage, QCol, partials, unit_normals};
+use super::tables::erbs_patch::DenseRow;
 use glam::DVec3;
-
-/// Rows 0 and 1 of a dense basis of width W at one sample: the W functions' values and first
-/// derivatives.
-pub(crate) type DenseRow<const W: usize> = [[f64; W]; 2];
 
 /// Where a pass writes: `rows` consecutive grid rows from `row0`, columns from `col0`, of a
 /// row-major grid of S, Su, Sv per sample with `width` samples per row, and the unit normals

@@ -14,7 +14,7 @@
 //!   of in a second sweep over the grid (25 MB for 512² samples). Samples where Su × Sv
 //!   degenerates are only recorded; the caller gives them the model fallback.
 
-use super::axis::HermiteTable;
+use super::tables::axis::HermiteTable;
 use crate::geom::surface::regular_normal;
 use glam::DVec3;
 use std::ops::Range;

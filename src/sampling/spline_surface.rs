@@ -1,6 +1,5 @@
 //! Pre-evaluated tensor-product Bézier, B-spline and NURBS surfaces.
 
-use super::axis::HermiteTable;
 use super::dirty::DirtyRegion;
 use super::grid::{PartialSet, SampleGrid};
 use super::normals::NormalSource;
@@ -8,7 +7,7 @@ use super::object::Sampler;
 use super::rational::QuotientRule;
 use super::shading::{self, ShadingGrid};
 use super::spline_curve::PointState;
-use super::spline_curve::dot;
+use super::tables::axis::{HermiteTable, dot};
 use crate::geom::TensorSurface;
 use crate::model::{KindEdit, SurfaceEdit, SurfaceModel};
 use glam::{DVec3, DVec4};

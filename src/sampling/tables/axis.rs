@@ -237,6 +237,19 @@ fn influence_ranges(spans: &[usize], degree: usize, n: usize) -> Vec<Range<usize
     ranges
 }
 
+/// Σ_k row[k]·p[k]: a row of M (or of a blended table) against the points it weights.
+#[inline]
+pub(crate) fn dot<P>(row: &[f64], p: &[P]) -> P
+where
+    P: Copy + Default + std::ops::Add<Output = P> + std::ops::Mul<f64, Output = P>,
+{
+    let mut acc = P::default();
+    for (c, &q) in row.iter().zip(p) {
+        acc = acc + q * *c;
+    }
+    acc
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

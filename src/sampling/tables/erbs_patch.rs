@@ -4,14 +4,16 @@
 //! a net, like a B-spline surface's, and a change of the patch is a change of the net: nothing
 //! per sample is stored beyond the level's own grid.
 
-use super::axis::HermiteTable;
-use super::dense::DenseRow;
+use super::axis::{HermiteTable, dot};
 use super::erbs_axis::ErbsAxis;
-use super::grid::PartialSet;
-use super::spline_curve::dot;
 use crate::geom::TensorSurface;
+use crate::sampling::grid::PartialSet;
 use glam::DVec3;
 use std::ops::Range;
+
+/// Rows 0 and 1 of a dense basis of width W at one sample: the W functions' values and first
+/// derivatives (the dense kernel's input, one per sample row or column).
+pub(crate) type DenseRow<const W: usize> = [[f64; W]; 2];
 
 /// Widest dense patch: a single Bézier piece of degree ≤ 3 each way.
 pub(crate) const DENSE: usize = 4;
