@@ -7,8 +7,8 @@
 //! are κ = H ± √(H² − K).
 
 use super::grid::SampleGrid;
+use super::kernels::lanes::{LANES, unit_normals_inv};
 use super::normals::NormalSource;
-use super::shading::{LANES, unit_normals_inv};
 use super::tables::axis::HermiteTable;
 use crate::geom::surface::regular_normal;
 use glam::DVec3;
@@ -227,7 +227,7 @@ fn shape_lanes(d: &[[DVec3; 6]; LANES]) -> [[f64; LANES]; 6] {
     // EG − F² = |Su × Sv|², so the normal's reciprocal length squared saves a division.
     let r: [f64; L] = std::array::from_fn(|l| inv[l] * inv[l]);
     // Through memory, so that the caller's stores do not pull the lanes apart (see
-    // shading::normals_of).
+    // lanes::normals_of).
     std::hint::black_box([
         nn[0],
         nn[1],

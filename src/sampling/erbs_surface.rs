@@ -6,9 +6,9 @@
 //! that level's samples over the edited patch's support, and each parent blends it in by the
 //! Leibniz rule over the same samples.
 
-use super::dense::{self, Target};
 use super::dirty::DirtyRegion;
 use super::grid::{PartialSet, SampleGrid};
+use super::kernels::dense::{self, Target};
 use super::normals::NormalSource;
 use super::object::Sampler;
 use super::tables::erbs_axis::ErbsAxis;

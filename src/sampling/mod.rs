@@ -8,16 +8,15 @@
 pub mod budget;
 pub mod chain_curve;
 pub mod curvature;
-mod dense;
 pub mod dirty;
 pub mod erbs_curve;
 pub mod erbs_surface;
 pub mod exact;
 pub mod grid;
+mod kernels;
 pub mod normals;
 pub mod object;
 pub mod rational;
-mod shading;
 pub mod spline_curve;
 pub mod spline_surface;
 pub mod tables;

@@ -1,7 +1,7 @@
 //! Unit normals of surface samples, with the geometry layer's fallback where Su × Sv vanishes.
 
 use super::grid::{PartialSet, SampleGrid};
-use super::shading;
+use super::kernels::lanes;
 use crate::geom::surface::{normal_with_fallback, regular_normal};
 use glam::DVec3;
 use std::ops::Range;
@@ -77,7 +77,7 @@ fn update_shading(
     for i in rows {
         let (a, b) = (i * mv + cols.start, i * mv + cols.end);
         let data = grid.data[a * 3..b * 3].as_chunks::<3>().0;
-        shading::normals_of(data, &mut normals[a..b], |jj| {
+        lanes::normals_of(data, &mut normals[a..b], |jj| {
             degenerate.push((i, cols.start + jj))
         });
     }

@@ -2,9 +2,9 @@
 
 use super::dirty::DirtyRegion;
 use super::grid::{PartialSet, SampleGrid};
+use super::kernels::shading;
 use super::object::Sampler;
 use super::rational::QuotientRule;
-use super::shading;
 use super::tables::axis::{HermiteTable, dot};
 use crate::geom::BSplineCurve;
 use crate::geom::point::to_homogeneous;

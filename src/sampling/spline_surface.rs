@@ -2,10 +2,10 @@
 
 use super::dirty::DirtyRegion;
 use super::grid::{PartialSet, SampleGrid};
+use super::kernels::shading::{self, ShadingGrid};
 use super::normals::NormalSource;
 use super::object::Sampler;
 use super::rational::QuotientRule;
-use super::shading::{self, ShadingGrid};
 use super::spline_curve::PointState;
 use super::tables::axis::{HermiteTable, dot};
 use crate::geom::TensorSurface;

@@ -22,7 +22,7 @@
 //! path's bits).
 
 use super::{DenseRow, Pass};
-use crate::sampling::shading::LANES;
+use crate::sampling::kernels::lanes::LANES;
 use glam::DVec3;
 use safe_arch::{
     blend_varying_m256d, cmp_op, cmp_op_mask_m256d, load_f64_splat_m256d, m256d, move_mask_m256d,
@@ -122,7 +122,7 @@ impl<const WU: usize, const WV: usize> Group<'_, '_, WU, WV> {
         let d = d.map(|row| &mut row[..nc]);
         let q = self
             .pass
-            .fill_q::<LANES>(rows)
+            .q_of::<LANES>(rows)
             .map(|col| col.map(|lanes| m256d::from_array(lanes.0)));
         // Per net column k, each row's Q0 x, y, z, Q1 x (for its grid values 0..4: S, Su x)
         // and Q1 y, z, Q0 x, y (values 4..8: Su y, z, Sv x, y), so that the sums come out in
@@ -136,7 +136,7 @@ impl<const WU: usize, const WV: usize> Group<'_, '_, WU, WV> {
             // take M_v[0] twice, then M_v[1] twice.
             let a: [m256d; WV] = std::array::from_fn(|k| load_f64_splat_m256d(&c[0][k]));
             let b: [m256d; WV] = std::array::from_fn(|k| load_f64_splat_m256d(&c[1][k]));
-            // `shading::partials`' products and sums, in its order, for each value.
+            // `lanes::partials`' products and sums, in its order, for each value.
             let mut head: [m256d; LANES] = std::array::from_fn(|l| q_head[0][l] * a[0]);
             let mut tail: [m256d; LANES] = std::array::from_fn(|l| q_tail[0][l] * ab[0]);
             let mut svz = q[0][2] * b[0];
@@ -225,7 +225,7 @@ fn store_sample(d: &mut [DVec3; 3], head: m256d, tail: m256d, last: f64) {
     ];
 }
 
-/// `shading::unit_normals` in AVX (the same operations in the same order): the normals, and
+/// `lanes::unit_normals` in AVX (the same operations in the same order): the normals, and
 /// per lane an all-ones mask where the normal is regular.
 #[inline(always)]
 fn unit_normals(u: [m256d; 3], v: [m256d; 3]) -> ([m256d; 3], m256d) {
@@ -252,9 +252,9 @@ fn unit_normals(u: [m256d; 3], v: [m256d; 3]) -> ([m256d; 3], m256d) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sampling::shading::tests::{assert_is_regular_normal, normal_cases};
+    use crate::sampling::kernels::testing::{assert_is_regular_normal, normal_cases};
 
-    /// The AVX normals against `regular_normal`, bit for bit, over the shading tests' cases
+    /// The AVX normals against `regular_normal`, bit for bit, over the kernels' test cases
     /// (zero, tiny, huge, NaN, infinite, near-parallel); a wrong lane order must fail.
     #[test]
     fn avx_normals_are_regular_normals() {
