@@ -7,9 +7,9 @@
 //! Leibniz rule over the same samples.
 
 use super::dirty::DirtyRegion;
+use super::fallback::{NormalSource, resolve_degenerate};
 use super::grid::{PartialSet, SampleGrid};
 use super::kernels::dense::{self, Target};
-use super::normals::NormalSource;
 use super::object::Sampler;
 use super::tables::erbs_axis::ErbsAxis;
 use super::tables::erbs_patch::{
@@ -844,7 +844,7 @@ impl ErbsSurfaceSampler {
                 self.level.axes[0].params.as_slice(),
                 self.level.axes[1].params.as_slice(),
             ];
-            super::normals::resolve_degenerate(
+            resolve_degenerate(
                 &mut self.level.grid,
                 &degenerate,
                 params,

@@ -12,6 +12,7 @@ pub mod dirty;
 pub mod erbs_curve;
 pub mod erbs_surface;
 pub mod exact;
+pub mod fallback;
 pub mod grid;
 mod kernels;
 pub mod normals;
