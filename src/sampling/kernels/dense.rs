@@ -150,13 +150,13 @@ impl<const WU: usize, const WV: usize> Pass<'_, WU, WV> {
         // roots and divisions bound it, so they are solved afterwards through a stage, packed.
         // Over an 8-wide net (a knot cell of the full pass) the column loop's products are
         // twice as many and hide the scalar ones LLVM makes in the loop, while the stage's
-        // loop of its own would not overlap them (measured: the full pass 15 % slower).
+        // loop of its own would not overlap them.
         let staged = N && WV <= 4;
         let mut stage = NormalStage::new(if staged { nc * L } else { 0 });
         for (g, rows) in cu.chunks_exact(L).enumerate() {
             let q = self.q_of::<L>(rows);
             // The rows and stage columns resliced to exactly `nc`, so that indexing them by
-            // the column needs no bounds check (13 of the loop's 220 instructions).
+            // the column needs no bounds check.
             let d: [&mut [[DVec3; 3]]; L] = std::array::from_fn(|_| {
                 let row = data.next().expect("one grid row per sample row");
                 &mut row.as_chunks_mut::<3>().0[..nc]

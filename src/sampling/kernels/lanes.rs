@@ -8,8 +8,9 @@
 use crate::geom::surface::regular_normal;
 use glam::DVec3;
 
-/// Sample rows per group: four f64 lanes fill two SSE2 registers (one AVX register). Measured on
-/// the portable x86-64 build: 2 lanes leave the coefficient loads unshared, 8 spill.
+/// Sample rows per group: four f64 lanes fill two SSE2 registers (one AVX register). With two,
+/// each coefficient load serves too few rows to pay for itself; with eight, a column's
+/// accumulators no longer fit the registers and spill.
 pub(crate) const LANES: usize = 4;
 
 /// Q0 = M_u[0]·C and Q1 = M_u[1]·C at one control column for L sample rows: x, y, z of Q0, then
@@ -156,9 +157,8 @@ pub(crate) fn unit_normals_inv<const L: usize>(
 /// unit normals in the same layout. A kernel that computes L samples per lane group stores its
 /// lanes here and solves the normals in a loop of their own: over plain arrays the loop
 /// vectoriser takes it whole, with packed square roots and divisions. Inside the kernel's lane
-/// loop LLVM paired x and y of one sample for the stores into the grid and left every square
-/// root and division scalar, four of each per lane group on the one divider (5 ns a sample on
-/// the reference machine, against 1.2 packed).
+/// loop LLVM pairs x and y of one sample for the stores into the grid and leaves every square
+/// root and division scalar, four of each per lane group on the one divider.
 pub(crate) struct NormalStage {
     /// Ten columns of `len` values: Su x, y, z, Sv x, y, z, normal x, y, z, and 1 where the
     /// normal is regular, else 0.

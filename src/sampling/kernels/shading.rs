@@ -163,8 +163,8 @@ impl<const WU: usize, const WV: usize> Kernel<'_, WU, WV> {
         // The normal goes through memory on purpose: computed from registers and stored
         // straight into the rows, LLVM's SLP vectoriser pairs x and y of one lane to suit the
         // stores and leaves the square root and divisions scalar; from and to lane-layout
-        // memory they vectorise across the lanes (measured: ~15–20% of the whole pass with
-        // 4 lanes; with 2 lanes LLVM forwards through the buffer and pairs x and y again).
+        // memory they vectorise across the lanes. (With two lanes LLVM forwards through the
+        // buffer and pairs x and y again.)
         let mut stage = Box::new([Lanes([0.0; L]); 10]);
         let (j0, j1) = (self.cols.start, self.cols.end);
         for i0 in rows.step_by(L) {

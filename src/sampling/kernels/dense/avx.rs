@@ -1,9 +1,9 @@
 //! The dense kernel's groups of four sample rows in explicit AVX, for x86-64 builds that have it
 //! (`.cargo/config.toml` builds for the host CPU). The portable kernel computes a column's nine
 //! values (S, Su, Sv) with one lane per row and leaves the layout to LLVM, and for a patch edit
-//! about half of its instructions only move data: every old value is gathered as a scalar into
-//! its lane, each sum is scattered to four grid rows, and the normals go out to the rows in a
-//! loop of their own. Here:
+//! much of its work only moves data: every old value is gathered as a scalar into its lane,
+//! each sum is scattered to four grid rows, and the normals go out to the rows in a loop of
+//! their own. Here:
 //! - the sums are formed in the grid's own order: per row, one vector of its values 0..4
 //!   (S, Su x) and one of 4..8 (Su y, z, Sv x, y), from the row group's Q values transposed
 //!   once per group, so a column needs no transpose, and the old values are added as two
@@ -14,12 +14,8 @@
 //!   row its normal.
 //!
 //! Every value is the portable kernel's product and sum, in its order, so the two paths agree
-//! bit for bit (`dense`'s tests compare them). On the reference machine (Zen 3) an ERBS
-//! local-patch rotation (113 × 113 samples) took 92–119 µs against the portable kernel's
-//! 119–182 µs, in alternating criterion runs (README "Performance"). Measured and dropped: the
-//! normals in the column loop (7 % slower), in three loops (10 % slower), or staged in the
-//! grid's order (5 % slower); fused multiply-adds (5 % faster, but no longer the portable
-//! path's bits).
+//! bit for bit (`dense`'s tests compare them). That is also why no product and sum is fused
+//! into a multiply-add: it would round once where the portable path rounds twice.
 
 use super::{DenseRow, Pass};
 use crate::sampling::kernels::lanes::LANES;
