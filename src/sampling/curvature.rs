@@ -13,6 +13,7 @@ use std::ops::Range;
 
 /// [K, H] from Su, Sv, Suu, Suv, Svv and the unit normal n.
 #[inline]
+#[must_use]
 pub fn fundamental_forms(p: &[DVec3; 5], n: DVec3) -> [f64; 2] {
     let [su, sv, suu, suv, svv] = *p;
     let (e, f, g) = (su.dot(su), su.dot(sv), sv.dot(sv));
@@ -31,12 +32,14 @@ pub fn fundamental_forms(p: &[DVec3; 5], n: DVec3) -> [f64; 2] {
 /// Principal curvatures [κ_max, κ_min] from [K, H] (the discriminant clamped at 0 against
 /// rounding at umbilics).
 #[inline]
+#[must_use]
 pub fn principal([k, h]: [f64; 2]) -> [f64; 2] {
     let r = (h * h - k).max(0.0).sqrt();
     [h + r, h - r]
 }
 
 /// Storage slots of Su, Sv, Suu, Suv, Svv.
+#[must_use]
 fn slots(grid: &SampleGrid) -> Option<[usize; 5]> {
     let p = &grid.partials;
     Some([

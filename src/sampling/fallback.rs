@@ -9,11 +9,14 @@ use glam::DVec3;
 /// Exact first partials of the model, for the rare degenerate samples (collapsed edges, cusps).
 pub trait NormalSource {
     /// (Su, Sv, Suv) at (u, v).
+    #[must_use]
     fn first_partials(&self, u: f64, v: f64) -> (DVec3, DVec3, DVec3);
+    #[must_use]
     fn domain(&self) -> [(f64, f64); 2];
 
     /// [K, H] next to (u, v) where the samples' Su × Sv vanishes (the limit from the inside of
     /// the domain), or `None` when the model cannot say (such samples show as undefined).
+    #[must_use]
     fn curvature_near(&self, _u: f64, _v: f64) -> Option<[f64; 2]> {
         None
     }
@@ -65,6 +68,7 @@ fn resolve_normals(
 }
 
 /// Storage slots of Su and Sv.
+#[must_use]
 pub(crate) fn first_partial_slots(grid: &SampleGrid) -> (usize, usize) {
     (
         grid.partials.index(1, 0).expect("normals need Su"),
@@ -73,6 +77,7 @@ pub(crate) fn first_partial_slots(grid: &SampleGrid) -> (usize, usize) {
 }
 
 /// The model's one-sided limit where the sampled Su × Sv vanishes.
+#[must_use]
 fn fallback(su: DVec3, sv: DVec3, u: f64, v: f64, model: &impl NormalSource) -> DVec3 {
     let (_, _, suv) = model.first_partials(u, v);
     normal_with_fallback(su, sv, suv, model.domain(), u, v, |u, v| {

@@ -297,6 +297,7 @@ impl Sampler for SplineSurfaceSampler {
 }
 
 /// The sample parameters of both directions.
+#[must_use]
 fn params(tables: &[HermiteTable; 2]) -> [&[f64]; 2] {
     [tables[0].params.as_slice(), tables[1].params.as_slice()]
 }

@@ -15,6 +15,7 @@ use std::ops::Range;
 /// products in its order), and their normals and [K, H] are recomputed in the same pass.
 /// Samples with a degenerate Su × Sv are appended to `degenerate` (normal and curvature left
 /// for the caller's fallback). Returns the touched rectangle.
+#[must_use]
 pub(crate) fn translate(
     tables: [&HermiteTable; 2],
     point: [usize; 2],
@@ -116,6 +117,7 @@ pub(crate) fn shape_of(
 
 /// Normal (3 rows), K, H and the regular flag of L samples, lane by lane.
 #[inline(always)]
+#[must_use]
 fn shape_lanes(d: &[[DVec3; 6]; LANES]) -> [[f64; LANES]; 6] {
     const L: usize = LANES;
     // Plain loops, not `array::map`: the map was left as an out-of-line call per partial.

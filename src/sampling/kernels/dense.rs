@@ -235,6 +235,7 @@ impl<const WU: usize, const WV: usize> Pass<'_, WU, WV> {
     /// Q0 = Σ_a U_a P_ab and Q1 = Σ_a U'_a P_ab at every net column b, for L sample rows
     /// (each sum from +0).
     #[inline(always)]
+    #[must_use]
     fn q_of<const L: usize>(&self, rows: &[DenseRow<WU>]) -> [QCol<L>; WV] {
         let mut q = [[Lanes([0.0; L]); 6]; WV];
         fill_q::<WU, L, true>(&mut q, |r, a, l| rows[l][r][a], |_, a, b| self.net[a][b]);
@@ -329,6 +330,7 @@ mod tests {
     }
 
     /// Exact comparison (NaN-aware: equal bits).
+    #[must_use]
     fn bits(v: &[DVec3]) -> Vec<[u64; 3]> {
         v.iter().map(|p| p.to_array().map(f64::to_bits)).collect()
     }

@@ -91,6 +91,7 @@ pub(crate) fn fill_q<const W: usize, const L: usize, const FROM_ZERO: bool>(
 
 /// S, Su, Sv (x, y, z each) of one sample column for L rows.
 #[inline(always)]
+#[must_use]
 pub(crate) fn partials<const W: usize, const L: usize>(
     win: &[QCol<L>; W],
     cv: &[[Lanes<L>; W]; 2],
@@ -115,6 +116,7 @@ pub(crate) fn partials<const W: usize, const L: usize>(
 /// without branches so that each step is one SIMD operation across the lanes: the normals, and
 /// per lane 1 if regular (the normal is exactly `regular_normal`'s) else 0.
 #[inline(always)]
+#[must_use]
 pub(crate) fn unit_normals<const L: usize>(
     u: [[f64; L]; 3],
     v: [[f64; L]; 3],
@@ -125,6 +127,7 @@ pub(crate) fn unit_normals<const L: usize>(
 
 /// [`unit_normals`] with 1/|Su × Sv| per lane, for kernels that need the area element too.
 #[inline(always)]
+#[must_use]
 pub(crate) fn unit_normals_inv<const L: usize>(
     u: [[f64; L]; 3],
     v: [[f64; L]; 3],
@@ -167,6 +170,7 @@ pub(crate) struct NormalStage {
 }
 
 impl NormalStage {
+    #[must_use]
     pub(crate) fn new(len: usize) -> Self {
         Self {
             buf: vec![0.0; 10 * len],
@@ -174,6 +178,7 @@ impl NormalStage {
         }
     }
 
+    #[must_use]
     fn columns(&mut self) -> [&mut [f64]; 10] {
         let len = self.len;
         let mut rest = self.buf.as_mut_slice();
@@ -188,6 +193,7 @@ impl NormalStage {
     /// group k), for a kernel to store its lanes into. Exactly `groups` long, so that a loop
     /// over as many grid columns indexes them without bounds checks.
     #[inline(always)]
+    #[must_use]
     pub(crate) fn inputs<const L: usize>(&mut self, groups: usize) -> [&mut [[f64; L]]; 6] {
         let mut cols = self.columns().into_iter();
         std::array::from_fn(|_| {
@@ -198,6 +204,7 @@ impl NormalStage {
 
     /// The normals of every sample (exactly `regular_normal`'s where regular); returns how
     /// many are degenerate.
+    #[must_use]
     pub(crate) fn solve(&mut self) -> usize {
         let [ux, uy, uz, vx, vy, vz, nx, ny, nz, ok] = self.columns();
         let mut bad = 0usize;
@@ -218,6 +225,7 @@ impl NormalStage {
     /// The normals' x, y, z columns as `groups` lane groups of L samples, as in
     /// [`Self::inputs`].
     #[inline(always)]
+    #[must_use]
     pub(crate) fn normals<const L: usize>(&self, groups: usize) -> [&[[f64; L]]; 3] {
         std::array::from_fn(|c| {
             let col = &self.buf[(6 + c) * self.len..(7 + c) * self.len];
@@ -226,6 +234,7 @@ impl NormalStage {
     }
 
     /// Whether sample k's normal is regular (after [`Self::solve`]).
+    #[must_use]
     pub(crate) fn regular(&self, k: usize) -> bool {
         self.buf[9 * self.len + k] != 0.0
     }

@@ -29,6 +29,7 @@ pub(crate) struct ShadingGrid<'a> {
 
 /// Whether [`sample_surface`] handles degrees `[du, dv]`: 1 to 3 each way. Degree 0 has no
 /// first derivative row; higher degrees are rare enough to stay on the generic path.
+#[must_use]
 pub(crate) fn surface_supported(degree: [usize; 2]) -> bool {
     degree.iter().all(|d| (1..=3).contains(d))
 }
@@ -237,6 +238,7 @@ pub(crate) fn normals_staged<const L: usize>(stage: &mut [Lanes<L>; 10]) {
 /// Moves control point (k, l) of a polynomial surface on a `Shading` grid by `delta`: S, Su, Sv
 /// of the samples in I_k × I_l gain M_u[a][k]·M_v[b][l]·Δ and get new normals in the same pass.
 /// Returns the touched rectangle; degenerate normals are appended as in [`sample_surface`].
+#[must_use]
 pub(crate) fn translate_surface(
     tables: [&HermiteTable; 2],
     point: [usize; 2],
@@ -277,6 +279,7 @@ pub(crate) fn translate_surface(
 }
 
 /// Whether [`sample_curve`] handles a curve of this degree sampled with C, C'.
+#[must_use]
 pub(crate) fn curve_supported(degree: usize) -> bool {
     (1..=3).contains(&degree)
 }
@@ -351,6 +354,7 @@ mod tests {
     use crate::sampling::{DirtyRegion, Sampler};
 
     /// Clamped knots on [0, 1] with random interior knots, some repeated (up to the degree).
+    #[must_use]
     fn knots(rng: &mut Rng, d: usize, n: usize) -> Vec<f64> {
         let mut interior: Vec<f64> = (0..n - d - 1).map(|_| rng.range(0.05, 0.95)).collect();
         interior.sort_by(f64::total_cmp);
@@ -369,6 +373,7 @@ mod tests {
         k
     }
 
+    #[must_use]
     fn surface(rng: &mut Rng, degree: [usize; 2], rational: bool) -> TensorSurface {
         let count = [degree[0] + 1 + rng.below(6), degree[1] + 1 + rng.below(6)];
         let n = count[0] * count[1];

@@ -9,21 +9,26 @@ use glam::DVec3;
 pub(crate) struct Rng(pub u64);
 
 impl Rng {
+    #[must_use]
     pub(crate) fn next(&mut self) -> u64 {
         self.0 ^= self.0 << 13;
         self.0 ^= self.0 >> 7;
         self.0 ^= self.0 << 17;
         self.0
     }
+    #[must_use]
     pub(crate) fn unit(&mut self) -> f64 {
         (self.next() >> 11) as f64 / (1u64 << 53) as f64
     }
+    #[must_use]
     pub(crate) fn range(&mut self, a: f64, b: f64) -> f64 {
         a + (b - a) * self.unit()
     }
+    #[must_use]
     pub(crate) fn below(&mut self, n: usize) -> usize {
         (self.next() % n as u64) as usize
     }
+    #[must_use]
     pub(crate) fn vec(&mut self, s: f64) -> DVec3 {
         DVec3::new(self.range(-s, s), self.range(-s, s), self.range(-s, s))
     }
@@ -31,6 +36,7 @@ impl Rng {
 
 /// Largest difference of S, Su, Sv (relative to max(1, |value|)) and of the normals between
 /// a `Shading` grid and a `Square(1)` grid of the same surface.
+#[must_use]
 pub(crate) fn difference(fast: &SampleGrid, generic: &SampleGrid) -> f64 {
     assert_eq!(fast.partials, PartialSet::Shading);
     let n = fast.dims[0] * fast.dims[1];
@@ -53,6 +59,7 @@ pub(crate) fn difference(fast: &SampleGrid, generic: &SampleGrid) -> f64 {
 
 /// (Su, Sv) pairs: zero, tiny, huge, NaN and infinite partials, then random ones over 20
 /// decades, every third pair nearly parallel (near the regularity threshold).
+#[must_use]
 pub(crate) fn normal_cases() -> Vec<(DVec3, DVec3)> {
     let mut rng = Rng(99);
     let special = [

@@ -189,6 +189,7 @@ impl<const WU: usize, const WV: usize> Group<'_, '_, WU, WV> {
 
 /// Row l of the result is lane l of every input.
 #[inline(always)]
+#[must_use]
 fn transpose(r: [m256d; 4]) -> [m256d; 4] {
     let (lo01, hi01) = (unpack_lo_m256d(r[0], r[1]), unpack_hi_m256d(r[0], r[1]));
     let (lo23, hi23) = (unpack_lo_m256d(r[2], r[3]), unpack_hi_m256d(r[2], r[3]));
@@ -202,6 +203,7 @@ fn transpose(r: [m256d; 4]) -> [m256d; 4] {
 
 /// A sample's grid values 0..4 and 4..8 (LLVM makes each one load).
 #[inline(always)]
+#[must_use]
 fn load_sample(d: &[DVec3; 3]) -> (m256d, m256d) {
     (
         m256d::from_array([d[0].x, d[0].y, d[0].z, d[1].x]),
@@ -224,6 +226,7 @@ fn store_sample(d: &mut [DVec3; 3], head: m256d, tail: m256d, last: f64) {
 /// `lanes::unit_normals` in AVX (the same operations in the same order): the normals, and
 /// per lane an all-ones mask where the normal is regular.
 #[inline(always)]
+#[must_use]
 fn unit_normals(u: [m256d; 3], v: [m256d; 3]) -> ([m256d; 3], m256d) {
     let cx = u[1] * v[2] - v[1] * u[2];
     let cy = u[2] * v[0] - v[2] * u[0];
