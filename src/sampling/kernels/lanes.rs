@@ -277,7 +277,48 @@ pub(crate) fn normals_of(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sampling::kernels::testing::{assert_is_regular_normal, normal_cases};
+    use crate::sampling::kernels::testing::{Rng, assert_is_regular_normal, normal_cases};
+    use std::array::from_fn;
+
+    /// `fill_q` against the ordered sum it stands for, bit for bit, both ways a sum may start,
+    /// with every lane reading its own points and basis values; and where every product is −0,
+    /// the sum from +0 is +0 (the generic code's) while the sum from the first product stays −0.
+    #[test]
+    fn fill_q_is_the_ordered_sum() {
+        const W: usize = 3;
+        const L: usize = 4;
+        let mut rng = Rng(5);
+        let m: [[[f64; L]; W]; 2] = from_fn(|_| from_fn(|_| from_fn(|_| rng.range(-1.0, 1.0))));
+        // Per control column, lane and k.
+        let pts: Vec<[[DVec3; W]; L]> = (0..5)
+            .map(|_| from_fn(|_| from_fn(|_| rng.vec(3.0))))
+            .collect();
+        let basis = |r: usize, k: usize, l: usize| m[r][k][l];
+        let point = |l: usize, k: usize, c: usize| pts[c][l][k];
+        for from_zero in [false, true] {
+            let mut q = vec![[Lanes([f64::NAN; L]); 6]; pts.len()];
+            match from_zero {
+                true => fill_q::<W, L, true>(&mut q, basis, point),
+                false => fill_q::<W, L, false>(&mut q, basis, point),
+            }
+            for (c, qc) in q.iter().enumerate() {
+                for (l, r, x) in (0..L).flat_map(|l| (0..6).map(move |v| (l, v / 3, v % 3))) {
+                    let term = |k: usize| pts[c][l][k][x] * m[r][k][l];
+                    let mut want = if from_zero { 0.0 + term(0) } else { term(0) };
+                    for k in 1..W {
+                        want += term(k);
+                    }
+                    assert_eq!(qc[3 * r + x][l].to_bits(), want.to_bits(), "{from_zero}");
+                }
+            }
+        }
+        let minus_zero = |_: usize, _: usize, _: usize| DVec3::splat(-0.0);
+        let mut q = [[Lanes([f64::NAN; 1]); 6]];
+        fill_q::<W, 1, true>(&mut q, |_, _, _| 1.0, minus_zero);
+        assert!(q[0].iter().all(|v| v[0].to_bits() == 0.0f64.to_bits()));
+        fill_q::<W, 1, false>(&mut q, |_, _, _| 1.0, minus_zero);
+        assert!(q[0].iter().all(|v| v[0].to_bits() == (-0.0f64).to_bits()));
+    }
 
     #[test]
     fn lane_normal_is_regular_normal() {
