@@ -116,7 +116,8 @@ impl<const WU: usize, const WV: usize> Pass<'_, WU, WV> {
     ) {
         #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
         if !self.portable {
-            avx::groups::<WU, WV, ADD, N>(self, cu, cv, data, normals, degenerate);
+            let q_of = |rows: &[DenseRow<WU>; LANES]| self.q_of::<LANES>(rows);
+            avx::groups::<WU, WV, ADD, N>(q_of, self.origin, cu, cv, data, normals, degenerate);
             return;
         }
         let split = cu.len() / LANES * LANES;

@@ -17,8 +17,8 @@
 //! bit for bit (`dense`'s tests compare them). That is also why no product and sum is fused
 //! into a multiply-add: it would round once where the portable path rounds twice.
 
-use super::{DenseRow, Pass};
-use crate::sampling::kernels::lanes::LANES;
+use crate::sampling::kernels::lanes::{LANES, QCol};
+use crate::sampling::tables::erbs_patch::DenseRow;
 use glam::DVec3;
 use safe_arch::{
     blend_varying_m256d, cmp_op, cmp_op_mask_m256d, load_f64_splat_m256d, m256d, move_mask_m256d,
@@ -28,11 +28,14 @@ use safe_arch::{
 // A group is one AVX register of f64 lanes.
 const _: () = assert!(LANES == 4);
 
-/// All rows `cu` in groups of four, as `Pass::rows` does; the last group padded with copies
-/// of its last row, their results written to scratch rows and dropped (one padded group costs
-/// less than one to three rows one by one).
+/// All rows `cu` in groups of four, as the portable kernel's row pass does; the last group
+/// padded with copies of its last row, their results written to scratch rows and dropped (one
+/// padded group costs less than one to three rows one by one). `q_of` gives a group's Q0, Q1
+/// at the net columns (the portable kernel's, so the sums below continue its sums); `origin`
+/// is the grid index of the pass's first row and column.
 pub(super) fn groups<'g, const WU: usize, const WV: usize, const ADD: bool, const N: bool>(
-    pass: &Pass<'_, WU, WV>,
+    q_of: impl Fn(&[DenseRow<WU>; LANES]) -> [QCol<LANES>; WV],
+    origin: (usize, usize),
     cu: &[DenseRow<WU>],
     cv: &[DenseRow<WV>],
     data: &mut impl Iterator<Item = &'g mut [DVec3]>,
@@ -41,7 +44,8 @@ pub(super) fn groups<'g, const WU: usize, const WV: usize, const ADD: bool, cons
 ) {
     let nc = cv.len();
     let mut group = Group {
-        pass,
+        q_of,
+        origin,
         cv,
         mixed: cv
             .iter()
@@ -62,7 +66,7 @@ pub(super) fn groups<'g, const WU: usize, const WV: usize, const ADD: bool, cons
         let rows = rows.try_into().expect("LANES rows");
         let d = std::array::from_fn(|_| data_row());
         let n = std::array::from_fn(|_| normal_row());
-        group.run::<ADD, N>(rows, d, n, g * LANES, LANES, degenerate);
+        group.run::<WU, ADD, N>(rows, d, n, g * LANES, LANES, degenerate);
     }
     let rest = whole.remainder();
     let Some(last) = rest.last() else {
@@ -86,12 +90,13 @@ pub(super) fn groups<'g, const WU: usize, const WV: usize, const ADD: bool, cons
         (false, false) => &mut [],
     });
     let first = cu.len() - rest.len();
-    group.run::<ADD, N>(&rows, d, n, first, rest.len(), degenerate);
+    group.run::<WU, ADD, N>(&rows, d, n, first, rest.len(), degenerate);
 }
 
 /// What the row groups of one pass share.
-struct Group<'a, 'p, const WU: usize, const WV: usize> {
-    pass: &'a Pass<'p, WU, WV>,
+struct Group<'a, Q, const WV: usize> {
+    q_of: Q,
+    origin: (usize, usize),
     cv: &'a [DenseRow<WV>],
     /// Per column and net column k: M_v[0][k], M_v[0][k], M_v[1][k], M_v[1][k].
     mixed: Vec<[m256d; WV]>,
@@ -99,10 +104,10 @@ struct Group<'a, 'p, const WU: usize, const WV: usize> {
     stage: Vec<[m256d; 6]>,
 }
 
-impl<const WU: usize, const WV: usize> Group<'_, '_, WU, WV> {
+impl<Q, const WV: usize> Group<'_, Q, WV> {
     /// Four rows, the first being the pass's rectangle row `first`, into the grid row segments
     /// `d` and normal row segments `n`; only the first `valid` lanes report degenerate normals.
-    fn run<const ADD: bool, const N: bool>(
+    fn run<const WU: usize, const ADD: bool, const N: bool>(
         &mut self,
         rows: &[DenseRow<WU>; LANES],
         d: [&mut [[DVec3; 3]]; LANES],
@@ -110,16 +115,15 @@ impl<const WU: usize, const WV: usize> Group<'_, '_, WU, WV> {
         first: usize,
         valid: usize,
         degenerate: &mut Vec<(usize, usize)>,
-    ) {
+    ) where
+        Q: Fn(&[DenseRow<WU>; LANES]) -> [QCol<LANES>; WV],
+    {
         let zero = zeroed_m256d();
         // Resliced to exactly the column count, so that indexing by the column needs no bounds
         // checks.
         let nc = self.cv.len();
         let d = d.map(|row| &mut row[..nc]);
-        let q = self
-            .pass
-            .q_of::<LANES>(rows)
-            .map(|col| col.map(|lanes| m256d::from_array(lanes.0)));
+        let q = (self.q_of)(rows).map(|col| col.map(|lanes| m256d::from_array(lanes.0)));
         // Per net column k, each row's Q0 x, y, z, Q1 x (for its grid values 0..4: S, Su x)
         // and Q1 y, z, Q0 x, y (values 4..8: Su y, z, Sv x, y), so that the sums come out in
         // the grid's order and need no transpose; Q0 z (for Sv z) stays one lane per row.
@@ -167,7 +171,7 @@ impl<const WU: usize, const WV: usize> Group<'_, '_, WU, WV> {
         if !N {
             return;
         }
-        let (r0, c0) = self.pass.origin;
+        let (r0, c0) = self.origin;
         let i = r0 + first;
         let valid = (1 << valid) - 1;
         let n = n.map(|row| &mut row[..nc]);
