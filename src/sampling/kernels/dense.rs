@@ -4,8 +4,8 @@
 //! patches active over one knot cell side by side (width 8 each way): over a cell the ERBS
 //! surface is a tensor product on an 8 × 8 net, so a sample costs one pass instead of four.
 //!
-//! The lane layout is [`super::lanes`]': L sample rows share each column's v-coefficients, held
-//! lane-minor so that the autovectoriser emits SIMD across the rows. The normals of a row group
+//! The lane layout is the toolkit's ([`super::lanes`]): L sample rows share each column's
+//! v-coefficients, held lane-minor so that the autovectoriser emits SIMD across the rows. The normals of a row group
 //! are solved after its columns, through a [`NormalStage`]. Where the build has AVX, groups of
 //! four rows take the same steps in explicit AVX instead ([`avx`]).
 
