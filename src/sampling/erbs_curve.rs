@@ -4,11 +4,11 @@
 //! of that level's samples over the edited local's support; each parent blends it in over the
 //! same samples, so the cost at every level is what the edit touches.
 
-use super::axis::HermiteTable;
 use super::dirty::DirtyRegion;
-use super::erbs_axis::{ErbsAxis, leibniz_terms};
 use super::grid::{PartialSet, SampleGrid};
 use super::object::Sampler;
+use super::tables::axis::{HermiteTable, dot};
+use super::tables::erbs_axis::{ErbsAxis, leibniz_terms};
 use crate::geom::erbs::{ErbsCurve, LocalCurve};
 use crate::geom::knots::uniform_params;
 use crate::model::{ErbsCurveEdit, ErbsCurveModel, ErbsEdit, KindEdit, LocalEdit};
@@ -58,7 +58,7 @@ impl LocalLevel {
                     let first = table.first(j);
                     for k in 0..g1 {
                         samples[j * g1 + k] = match table.row(j, k) {
-                            Some(row) => super::spline_curve::dot(row, &pts[first..]),
+                            Some(row) => dot(row, &pts[first..]),
                             None => DVec3::ZERO,
                         };
                     }

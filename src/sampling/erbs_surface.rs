@@ -6,13 +6,15 @@
 //! that level's samples over the edited patch's support, and each parent blends it in by the
 //! Leibniz rule over the same samples.
 
-use super::dense::{self, DenseRow, Target};
 use super::dirty::DirtyRegion;
-use super::erbs_axis::ErbsAxis;
-use super::erbs_patch::{BlendTerm, DENSE, Out, SplinePatch, add_share, clip};
+use super::fallback::{NormalSource, resolve_degenerate};
 use super::grid::{PartialSet, SampleGrid};
-use super::normals::NormalSource;
+use super::kernels::dense::{self, Target};
 use super::object::Sampler;
+use super::tables::erbs_axis::ErbsAxis;
+use super::tables::erbs_patch::{
+    self, BlendTerm, DENSE, DenseRow, Out, SplinePatch, add_share, clip,
+};
 use crate::geom::erbs::{ErbsKnots, ErbsSurface, LocalPatch};
 use crate::geom::knots::uniform_params;
 use crate::geom::point::binomial;
@@ -566,7 +568,7 @@ impl SurfaceLevel {
                         let lc = cols.start - pv.samples.start + pv.offset;
                         let cu = &d.rows[0][lr..lr + rows.len()];
                         let cv = &d.rows[1][lc..lc + cols.len()];
-                        let net = super::erbs_patch::padded(delta, p.count);
+                        let net = erbs_patch::padded(delta, p.count);
                         if *record {
                             let target = Target {
                                 data: &mut values,
@@ -842,7 +844,7 @@ impl ErbsSurfaceSampler {
                 self.level.axes[0].params.as_slice(),
                 self.level.axes[1].params.as_slice(),
             ];
-            super::normals::resolve_degenerate(
+            resolve_degenerate(
                 &mut self.level.grid,
                 &degenerate,
                 params,

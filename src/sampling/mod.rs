@@ -5,26 +5,24 @@
 //!
 //! `geom` knows the curves; this module knows where they are sampled. Nothing here knows Vulkan.
 
-pub mod axis;
 pub mod budget;
 pub mod chain_curve;
 pub mod curvature;
-mod dense;
 pub mod dirty;
-pub mod erbs_axis;
 pub mod erbs_curve;
-mod erbs_patch;
 pub mod erbs_surface;
 pub mod exact;
+pub mod fallback;
 pub mod grid;
+mod kernels;
 pub mod normals;
 pub mod object;
 pub mod rational;
-mod shading;
 pub mod spline_curve;
 pub mod spline_surface;
+pub mod tables;
 
-pub use axis::HermiteTable;
 pub use dirty::{DirtyRegion, DirtySet};
 pub use grid::{PartialSet, SampleGrid};
 pub use object::{SampleMode, SampledObject, Sampler, Tracked};
+pub use tables::axis::HermiteTable;

@@ -1,11 +1,11 @@
 //! Pre-evaluated Bézier, B-spline and NURBS curves.
 
-use super::axis::HermiteTable;
 use super::dirty::DirtyRegion;
 use super::grid::{PartialSet, SampleGrid};
+use super::kernels::shading;
 use super::object::Sampler;
 use super::rational::QuotientRule;
-use super::shading;
+use super::tables::axis::{HermiteTable, dot};
 use crate::geom::BSplineCurve;
 use crate::geom::point::to_homogeneous;
 use crate::model::{CurveEdit, CurveModel, KindEdit, PointNet};
@@ -232,17 +232,4 @@ impl PointState {
             to_homogeneous(after.position, w1 - w0)
         }
     }
-}
-
-/// Σ_k row[k]·p[k].
-#[inline]
-pub(crate) fn dot<P>(row: &[f64], p: &[P]) -> P
-where
-    P: Copy + Default + std::ops::Add<Output = P> + std::ops::Mul<f64, Output = P>,
-{
-    let mut acc = P::default();
-    for (c, &q) in row.iter().zip(p) {
-        acc = acc + q * *c;
-    }
-    acc
 }

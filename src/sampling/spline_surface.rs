@@ -1,14 +1,14 @@
 //! Pre-evaluated tensor-product Bézier, B-spline and NURBS surfaces.
 
-use super::axis::HermiteTable;
 use super::dirty::DirtyRegion;
+use super::fallback::{NormalSource, resolve_degenerate};
 use super::grid::{PartialSet, SampleGrid};
-use super::normals::NormalSource;
+use super::kernels::curvature;
+use super::kernels::shading::{self, ShadingGrid};
 use super::object::Sampler;
 use super::rational::QuotientRule;
-use super::shading::{self, ShadingGrid};
 use super::spline_curve::PointState;
-use super::spline_curve::dot;
+use super::tables::axis::{HermiteTable, dot};
 use crate::geom::TensorSurface;
 use crate::model::{KindEdit, SurfaceEdit, SurfaceModel};
 use glam::{DVec3, DVec4};
@@ -79,7 +79,8 @@ impl SplineSurfaceSampler {
                 shading_grid(&mut self.grid),
                 &mut degenerate,
             );
-            self.resolve_degenerate(&degenerate);
+            let params = params(&self.tables);
+            resolve_degenerate(&mut self.grid, &degenerate, params, surface);
             return DirtyRegion::surface(rows, cols);
         }
         let stride = self.grid.stride();
@@ -154,31 +155,18 @@ impl SplineSurfaceSampler {
                 shading_grid(&mut self.grid),
                 &mut degenerate,
             );
-            self.resolve_degenerate(&degenerate);
+            let params = params(&self.tables);
+            resolve_degenerate(&mut self.grid, &degenerate, params, self.model.surface());
             return DirtyRegion::surface(rows, cols);
         }
         if self.grid.curvatures.is_some() {
             // Curvature maps: the six partials, normals and [K, H] in one pass.
             let mut degenerate = Vec::new();
             let [tu, tv] = &self.tables;
-            let (rows, cols) = super::curvature::translate(
-                [tu, tv],
-                [k, l],
-                delta,
-                &mut self.grid,
-                &mut degenerate,
-            );
-            self.resolve_degenerate(&degenerate);
-            let params = [
-                self.tables[0].params.as_slice(),
-                self.tables[1].params.as_slice(),
-            ];
-            super::curvature::resolve_degenerate(
-                &mut self.grid,
-                &degenerate,
-                params,
-                self.model.surface(),
-            );
+            let (rows, cols) =
+                curvature::translate([tu, tv], [k, l], delta, &mut self.grid, &mut degenerate);
+            let params = params(&self.tables);
+            resolve_degenerate(&mut self.grid, &degenerate, params, self.model.surface());
             return DirtyRegion::surface(rows, cols);
         }
         let (rows, cols) = (self.tables[0].range(k), self.tables[1].range(l));
@@ -252,19 +240,8 @@ impl SplineSurfaceSampler {
             && s.degree().iter().all(|&d| d >= 1)
     }
 
-    fn resolve_degenerate(&mut self, samples: &[(usize, usize)]) {
-        let params = [
-            self.tables[0].params.as_slice(),
-            self.tables[1].params.as_slice(),
-        ];
-        super::normals::resolve_degenerate(&mut self.grid, samples, params, self.model.surface());
-    }
-
     fn update_normals(&mut self, rows: Range<usize>, cols: Range<usize>) {
-        let params = [
-            self.tables[0].params.as_slice(),
-            self.tables[1].params.as_slice(),
-        ];
+        let params = params(&self.tables);
         super::normals::update(&mut self.grid, rows, cols, params, self.model.surface());
     }
 }
@@ -317,6 +294,12 @@ impl Sampler for SplineSurfaceSampler {
         let [mu, mv] = self.grid.dims;
         self.rebuild_rect(0..mu, 0..mv)
     }
+}
+
+/// The sample parameters of both directions.
+#[must_use]
+fn params(tables: &[HermiteTable; 2]) -> [&[f64]; 2] {
+    [tables[0].params.as_slice(), tables[1].params.as_slice()]
 }
 
 fn shading_grid(grid: &mut SampleGrid) -> ShadingGrid<'_> {

@@ -461,7 +461,7 @@ fn tensor_surface_high_order_partials_agree_with_oracle() {
     run_all("surface-high-order", cases);
 }
 
-/// Whether the product samples `object` for drawing through `sampling::shading`'s fast
+/// Whether the product samples `object` for drawing through `sampling::kernels::shading`'s fast
 /// kernels (polynomial, degree 1–3 in every direction; ERBS surfaces use them per local patch).
 fn takes_fast_path(object: &oracle::scene::Object) -> bool {
     use oracle::eval::Basis;

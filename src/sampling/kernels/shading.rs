@@ -14,55 +14,10 @@
 //!   of in a second sweep over the grid (25 MB for 512² samples). Samples where Su × Sv
 //!   degenerates are only recorded; the caller gives them the model fallback.
 
-use super::axis::HermiteTable;
-use crate::geom::surface::regular_normal;
+use super::lanes::{LANES, Lanes, QCol, fill_q, normals_of, partials, unit_normals};
+use crate::sampling::tables::axis::HermiteTable;
 use glam::DVec3;
 use std::ops::Range;
-
-/// Sample rows per group: four f64 lanes fill two SSE2 registers (one AVX register). Measured on
-/// the portable x86-64 build: 2 lanes leave the coefficient loads unshared, 8 spill.
-pub(crate) const LANES: usize = 4;
-
-/// Q0 = M_u[0]·C and Q1 = M_u[1]·C at one control column for L sample rows: x, y, z of Q0, then
-/// of Q1, each with one lane per row.
-pub(crate) type QCol<const L: usize> = [Lanes<L>; 6];
-
-/// One value for each of L sample rows. Aligned so that SSE2 arithmetic may take its operands
-/// straight from memory (legacy SSE memory operands must be 16-byte aligned).
-#[derive(Debug, Clone, Copy)]
-#[repr(C, align(16))]
-pub(crate) struct Lanes<const L: usize>(pub [f64; L]);
-
-impl<const L: usize> std::ops::Index<usize> for Lanes<L> {
-    type Output = f64;
-    #[inline(always)]
-    fn index(&self, l: usize) -> &f64 {
-        &self.0[l]
-    }
-}
-
-impl<const L: usize> std::ops::IndexMut<usize> for Lanes<L> {
-    #[inline(always)]
-    fn index_mut(&mut self, l: usize) -> &mut f64 {
-        &mut self.0[l]
-    }
-}
-
-impl<const L: usize> std::ops::Add for Lanes<L> {
-    type Output = Self;
-    #[inline(always)]
-    fn add(self, o: Self) -> Self {
-        Lanes(std::array::from_fn(|l| self.0[l] + o.0[l]))
-    }
-}
-
-impl<const L: usize> std::ops::Mul for Lanes<L> {
-    type Output = Self;
-    #[inline(always)]
-    fn mul(self, o: Self) -> Self {
-        Lanes(std::array::from_fn(|l| self.0[l] * o.0[l]))
-    }
-}
 
 /// The `Shading` grid a kernel writes: `data[(i * width + j) * 3 + p]` with p over S, Su, Sv,
 /// and `normals[i * width + j]` when there are normals.
@@ -74,6 +29,7 @@ pub(crate) struct ShadingGrid<'a> {
 
 /// Whether [`sample_surface`] handles degrees `[du, dv]`: 1 to 3 each way. Degree 0 has no
 /// first derivative row; higher degrees are rare enough to stay on the generic path.
+#[must_use]
 pub(crate) fn surface_supported(degree: [usize; 2]) -> bool {
     degree.iter().all(|d| (1..=3).contains(d))
 }
@@ -208,12 +164,12 @@ impl<const WU: usize, const WV: usize> Kernel<'_, WU, WV> {
         // The normal goes through memory on purpose: computed from registers and stored
         // straight into the rows, LLVM's SLP vectoriser pairs x and y of one lane to suit the
         // stores and leaves the square root and divisions scalar; from and to lane-layout
-        // memory they vectorise across the lanes (measured: ~15–20% of the whole pass with
-        // 4 lanes; with 2 lanes LLVM forwards through the buffer and pairs x and y again).
+        // memory they vectorise across the lanes. (With two lanes LLVM forwards through the
+        // buffer and pairs x and y again.)
         let mut stage = Box::new([Lanes([0.0; L]); 10]);
         let (j0, j1) = (self.cols.start, self.cols.end);
         for i0 in rows.step_by(L) {
-            self.fill_q(i0, &mut q);
+            self.q_of(i0, &mut q);
             let d: [&mut [[DVec3; 3]]; L] = std::array::from_fn(|_| {
                 data.next().expect("one grid row per sample row")[j0 * 3..j1 * 3]
                     .as_chunks_mut::<3>()
@@ -251,8 +207,8 @@ impl<const WU: usize, const WV: usize> Kernel<'_, WU, WV> {
     }
 
     /// Q0, Q1 of sample rows i0..i0+L at the rectangle's control columns (two_pass's first
-    /// pass, each sum in the same order), accumulated in registers one column at a time.
-    fn fill_q<const L: usize>(&self, i0: usize, q: &mut [QCol<L>]) {
+    /// pass, each sum in the same order, from its first product).
+    fn q_of<const L: usize>(&self, i0: usize, q: &mut [QCol<L>]) {
         // Per lane: the control rows it reads; per derivative order and k: the lanes' basis
         // values.
         let rows: [[&[DVec3]; WU]; L] = std::array::from_fn(|l| {
@@ -264,55 +220,8 @@ impl<const WU: usize, const WV: usize> Kernel<'_, WU, WV> {
                 std::array::from_fn(|l| self.tu.row(i0 + l, r).expect("order 0 and 1 rows")[k])
             })
         });
-        for (ci, qc) in q.iter_mut().enumerate() {
-            let mut acc = [Lanes([0.0; L]); 6];
-            for l in 0..L {
-                let p = rows[l][0][ci];
-                let (a, b) = (m[0][0][l], m[1][0][l]);
-                acc[0][l] = p.x * a;
-                acc[1][l] = p.y * a;
-                acc[2][l] = p.z * a;
-                acc[3][l] = p.x * b;
-                acc[4][l] = p.y * b;
-                acc[5][l] = p.z * b;
-            }
-            for k in 1..WU {
-                for l in 0..L {
-                    let p = rows[l][k][ci];
-                    let (a, b) = (m[0][k][l], m[1][k][l]);
-                    acc[0][l] += p.x * a;
-                    acc[1][l] += p.y * a;
-                    acc[2][l] += p.z * a;
-                    acc[3][l] += p.x * b;
-                    acc[4][l] += p.y * b;
-                    acc[5][l] += p.z * b;
-                }
-            }
-            *qc = acc;
-        }
+        fill_q::<WU, L, false>(q, |r, k, l| m[r][k][l], |l, k, c| rows[l][k][c]);
     }
-}
-
-/// S, Su, Sv (x, y, z each) of one sample column for L rows.
-#[inline(always)]
-pub(crate) fn partials<const W: usize, const L: usize>(
-    win: &[QCol<L>; W],
-    cv: &[[Lanes<L>; W]; 2],
-) -> [Lanes<L>; 9] {
-    let [a, b] = cv;
-    let mut s = [Lanes([0.0; L]); 9];
-    for c in 0..3 {
-        // Starting from the first product rather than from 0 saves an addition per value; the
-        // only possible difference to the generic path is the sign of an exact zero.
-        let (mut p, mut pu, mut pv) = (win[0][c] * a[0], win[0][3 + c] * a[0], win[0][c] * b[0]);
-        for k in 1..W {
-            p = p + win[k][c] * a[k];
-            pu = pu + win[k][3 + c] * a[k];
-            pv = pv + win[k][c] * b[k];
-        }
-        (s[c], s[3 + c], s[6 + c]) = (p, pu, pv);
-    }
-    s
 }
 
 /// Normals from Su, Sv in `stage[0..6]` into `stage[6..9]`, and 1 in `stage[9]` where regular.
@@ -326,130 +235,10 @@ pub(crate) fn normals_staged<const L: usize>(stage: &mut [Lanes<L>; 10]) {
     stage[9] = Lanes(ok);
 }
 
-/// `regular_normal` of L lanes of (Su, Sv), spelled out (same operations in the same order) and
-/// without branches so that each step is one SIMD operation across the lanes: the normals, and
-/// per lane 1 if regular (the normal is exactly `regular_normal`'s) else 0.
-#[inline(always)]
-pub(crate) fn unit_normals<const L: usize>(
-    u: [[f64; L]; 3],
-    v: [[f64; L]; 3],
-) -> ([[f64; L]; 3], [f64; L]) {
-    let (n, ok, _) = unit_normals_inv(u, v);
-    (n, ok)
-}
-
-/// [`unit_normals`] with 1/|Su × Sv| per lane, for kernels that need the area element too.
-#[inline(always)]
-pub(crate) fn unit_normals_inv<const L: usize>(
-    u: [[f64; L]; 3],
-    v: [[f64; L]; 3],
-) -> ([[f64; L]; 3], [f64; L], [f64; L]) {
-    let lanes = |f: &dyn Fn(usize) -> f64| -> [f64; L] { std::array::from_fn(f) };
-    let cx = lanes(&|l| u[1][l] * v[2][l] - v[1][l] * u[2][l]);
-    let cy = lanes(&|l| u[2][l] * v[0][l] - v[2][l] * u[0][l]);
-    let cz = lanes(&|l| u[0][l] * v[1][l] - v[0][l] * u[1][l]);
-    let lu = lanes(&|l| u[0][l] * u[0][l] + u[1][l] * u[1][l] + u[2][l] * u[2][l]);
-    let lv = lanes(&|l| v[0][l] * v[0][l] + v[1][l] * v[1][l] + v[2][l] * v[2][l]);
-    // A plain select, not `f64::max` (whose NaN rule costs two more instructions): they differ
-    // only when Su or Sv has a NaN, and then |Su × Sv|² is NaN and the lane is not regular
-    // either way, so the flags and normals stay exactly `regular_normal`'s.
-    let scale = lanes(&|l| if lu[l] > lv[l] { lu[l] } else { lv[l] });
-    let len2 = lanes(&|l| cx[l] * cx[l] + cy[l] * cy[l] + cz[l] * cz[l]);
-    let ok = lanes(&|l| {
-        let ok = (scale[l] > 0.0) & (len2[l] > 1e-20 * scale[l] * scale[l]) & len2[l].is_finite();
-        if ok { 1.0 } else { 0.0 }
-    });
-    let inv = lanes(&|l| 1.0 / len2[l].sqrt());
-    let n = [
-        lanes(&|l| cx[l] * inv[l]),
-        lanes(&|l| cy[l] * inv[l]),
-        lanes(&|l| cz[l] * inv[l]),
-    ];
-    (n, ok, inv)
-}
-
-/// Su, Sv of a block of samples component by component (one array per coordinate), and their
-/// unit normals in the same layout. A kernel that computes L samples per lane group stores its
-/// lanes here and solves the normals in a loop of their own: over plain arrays the loop
-/// vectoriser takes it whole, with packed square roots and divisions. Inside the kernel's lane
-/// loop LLVM paired x and y of one sample for the stores into the grid and left every square
-/// root and division scalar, four of each per lane group on the one divider (5 ns a sample on
-/// the reference machine, against 1.2 packed).
-pub(crate) struct NormalStage {
-    /// Ten columns of `len` values: Su x, y, z, Sv x, y, z, normal x, y, z, and 1 where the
-    /// normal is regular, else 0.
-    buf: Vec<f64>,
-    len: usize,
-}
-
-impl NormalStage {
-    pub(crate) fn new(len: usize) -> Self {
-        Self {
-            buf: vec![0.0; 10 * len],
-            len,
-        }
-    }
-
-    fn columns(&mut self) -> [&mut [f64]; 10] {
-        let len = self.len;
-        let mut rest = self.buf.as_mut_slice();
-        std::array::from_fn(|_| {
-            let (col, tail) = std::mem::take(&mut rest).split_at_mut(len);
-            rest = tail;
-            col
-        })
-    }
-
-    /// The Su, Sv columns as `groups` lane groups of L samples (sample k·L + l is lane l of
-    /// group k), for a kernel to store its lanes into. Exactly `groups` long, so that a loop
-    /// over as many grid columns indexes them without bounds checks.
-    #[inline(always)]
-    pub(crate) fn inputs<const L: usize>(&mut self, groups: usize) -> [&mut [[f64; L]]; 6] {
-        let mut cols = self.columns().into_iter();
-        std::array::from_fn(|_| {
-            let col = cols.next().expect("six input columns");
-            &mut col.as_chunks_mut::<L>().0[..groups]
-        })
-    }
-
-    /// The normals of every sample (exactly `regular_normal`'s where regular); returns how
-    /// many are degenerate.
-    pub(crate) fn solve(&mut self) -> usize {
-        let [ux, uy, uz, vx, vy, vz, nx, ny, nz, ok] = self.columns();
-        let mut bad = 0usize;
-        let inputs = ux.iter().zip(uy.iter()).zip(uz.iter());
-        let inputs = inputs.zip(vx.iter().zip(vy.iter()).zip(vz.iter()));
-        let outputs = nx
-            .iter_mut()
-            .zip(ny.iter_mut())
-            .zip(nz.iter_mut().zip(ok.iter_mut()));
-        for ((((ux, uy), uz), ((vx, vy), vz)), ((nx, ny), (nz, ok))) in inputs.zip(outputs) {
-            let (n, regular) = unit_normals::<1>([[*ux], [*uy], [*uz]], [[*vx], [*vy], [*vz]]);
-            (*nx, *ny, *nz, *ok) = (n[0][0], n[1][0], n[2][0], regular[0]);
-            bad += (regular[0] == 0.0) as usize;
-        }
-        bad
-    }
-
-    /// The normals' x, y, z columns as `groups` lane groups of L samples, as in
-    /// [`Self::inputs`].
-    #[inline(always)]
-    pub(crate) fn normals<const L: usize>(&self, groups: usize) -> [&[[f64; L]]; 3] {
-        std::array::from_fn(|c| {
-            let col = &self.buf[(6 + c) * self.len..(7 + c) * self.len];
-            &col.as_chunks::<L>().0[..groups]
-        })
-    }
-
-    /// Whether sample k's normal is regular (after [`Self::solve`]).
-    pub(crate) fn regular(&self, k: usize) -> bool {
-        self.buf[9 * self.len + k] != 0.0
-    }
-}
-
 /// Moves control point (k, l) of a polynomial surface on a `Shading` grid by `delta`: S, Su, Sv
 /// of the samples in I_k × I_l gain M_u[a][k]·M_v[b][l]·Δ and get new normals in the same pass.
 /// Returns the touched rectangle; degenerate normals are appended as in [`sample_surface`].
+#[must_use]
 pub(crate) fn translate_surface(
     tables: [&HermiteTable; 2],
     point: [usize; 2],
@@ -489,41 +278,8 @@ pub(crate) fn translate_surface(
     (rows, cols)
 }
 
-/// Unit normals of `data`'s samples (S, Su, Sv each) into `normals`, `LANES` at a time so that
-/// the square roots and divisions vectorise; reports the index of every degenerate sample.
-pub(crate) fn normals_of(
-    data: &[[DVec3; 3]],
-    normals: &mut [DVec3],
-    mut degenerate: impl FnMut(usize),
-) {
-    let mut stage = [Lanes([0.0; LANES]); 4];
-    let (data4, rest) = data.as_chunks::<LANES>();
-    let (normals4, normals_rest) = normals.as_chunks_mut::<LANES>();
-    for (g, (d, n)) in data4.iter().zip(normals4).enumerate() {
-        let u = [0, 1, 2].map(|c| std::array::from_fn(|l| d[l][1][c]));
-        let v = [0, 1, 2].map(|c| std::array::from_fn(|l| d[l][2][c]));
-        let (nn, ok) = unit_normals::<LANES>(u, v);
-        stage[..3].copy_from_slice(&nn.map(Lanes));
-        stage[3] = Lanes(ok);
-        // Through memory, so that the stores below do not pull the lanes apart (see `rows`).
-        let st = std::hint::black_box(&stage);
-        for l in 0..LANES {
-            n[l] = DVec3::new(st[0][l], st[1][l], st[2][l]);
-            if st[3][l] == 0.0 {
-                degenerate(g * LANES + l);
-            }
-        }
-    }
-    let base = data4.len() * LANES;
-    for (jj, (s, n)) in rest.iter().zip(normals_rest).enumerate() {
-        match regular_normal(s[1], s[2]) {
-            Some(v) => *n = v,
-            None => degenerate(base + jj),
-        }
-    }
-}
-
 /// Whether [`sample_curve`] handles a curve of this degree sampled with C, C'.
+#[must_use]
 pub(crate) fn curve_supported(degree: usize) -> bool {
     (1..=3).contains(&degree)
 }
@@ -584,47 +340,21 @@ pub(crate) fn translate_curve(t: &HermiteTable, k: usize, delta: DVec3, data: &m
 }
 
 #[cfg(test)]
-pub(crate) mod tests {
+mod tests {
     //! The fast paths against the generic code: `Square(1)` grids (which hold S, Su, Sv among
     //! other partials) and curve orders above 1 never take them.
-    use super::*;
     use crate::geom::point::{Point, nan_max};
-    use crate::geom::{BFunctionKind, BSplineCurve, ErbsSurface, TensorSurface};
-    use crate::model::{
-        CurveEdit, CurveModel, ErbsSurfaceEdit, ErbsSurfaceModel, LocalEdit, LocalPath, PointEdit,
-        SplineForm, SurfaceEdit, SurfaceModel,
-    };
-    use crate::sampling::erbs_surface::ErbsSurfaceSampler;
-    use crate::sampling::grid::{PartialSet, SampleGrid};
+    use crate::geom::surface::regular_normal;
+    use crate::geom::{BSplineCurve, TensorSurface};
+    use crate::model::{CurveEdit, CurveModel, PointEdit, SplineForm, SurfaceEdit, SurfaceModel};
+    use crate::sampling::grid::PartialSet;
+    use crate::sampling::kernels::testing::{Rng, difference};
     use crate::sampling::spline_curve::SplineCurveSampler;
     use crate::sampling::spline_surface::SplineSurfaceSampler;
     use crate::sampling::{DirtyRegion, Sampler};
-    use glam::DMat4;
-
-    struct Rng(u64);
-
-    impl Rng {
-        fn next(&mut self) -> u64 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            self.0
-        }
-        fn unit(&mut self) -> f64 {
-            (self.next() >> 11) as f64 / (1u64 << 53) as f64
-        }
-        fn range(&mut self, a: f64, b: f64) -> f64 {
-            a + (b - a) * self.unit()
-        }
-        fn below(&mut self, n: usize) -> usize {
-            (self.next() % n as u64) as usize
-        }
-        fn vec(&mut self, s: f64) -> DVec3 {
-            DVec3::new(self.range(-s, s), self.range(-s, s), self.range(-s, s))
-        }
-    }
 
     /// Clamped knots on [0, 1] with random interior knots, some repeated (up to the degree).
+    #[must_use]
     fn knots(rng: &mut Rng, d: usize, n: usize) -> Vec<f64> {
         let mut interior: Vec<f64> = (0..n - d - 1).map(|_| rng.range(0.05, 0.95)).collect();
         interior.sort_by(f64::total_cmp);
@@ -643,6 +373,7 @@ pub(crate) mod tests {
         k
     }
 
+    #[must_use]
     fn surface(rng: &mut Rng, degree: [usize; 2], rational: bool) -> TensorSurface {
         let count = [degree[0] + 1 + rng.below(6), degree[1] + 1 + rng.below(6)];
         let n = count[0] * count[1];
@@ -653,28 +384,6 @@ pub(crate) mod tests {
             knots(rng, degree[1], count[1]),
         ];
         TensorSurface::bspline(degree, kn, count, pts, weights).unwrap()
-    }
-
-    /// Largest difference of S, Su, Sv (relative to max(1, |value|)) and of the normals between
-    /// a `Shading` grid and a `Square(1)` grid of the same surface.
-    fn difference(fast: &SampleGrid, generic: &SampleGrid) -> f64 {
-        assert_eq!(fast.partials, PartialSet::Shading);
-        let n = fast.dims[0] * fast.dims[1];
-        let mut worst = 0.0f64;
-        for s in 0..n {
-            for (p, &(a, b)) in [(0, 0), (1, 0), (0, 1)].iter().enumerate() {
-                let x = fast.data[s * 3 + p];
-                let y = generic.data[s * 4 + generic.partials.index(a, b).unwrap()];
-                let scale = nan_max(x.max_abs(), y.max_abs()).max(1.0);
-                worst = nan_max(worst, (x - y).max_abs() / scale);
-            }
-            let (nf, ng) = (
-                &fast.normals.as_ref().unwrap(),
-                generic.normals.as_ref().unwrap(),
-            );
-            worst = nan_max(worst, (nf[s] - ng[s]).max_abs());
-        }
-        worst
     }
 
     #[test]
@@ -719,67 +428,6 @@ pub(crate) mod tests {
     }
 
     #[test]
-    fn erbs_shading_matches_the_generic_path() {
-        // Local patches through the fast kernel (degrees 1..=3) or two_pass (4), the written-out
-        // blend and the row-wise normals, against Square(1) grids that take none of them.
-        let mut rng = Rng(0x5151_7e57);
-        for case in 0..12 {
-            let count = [2 + rng.below(3), 2 + rng.below(3)];
-            let knots = count.map(|n| {
-                let mut k = vec![0.0];
-                let mut t = 0.0;
-                for _ in 0..n {
-                    k.push(t);
-                    t += rng.range(0.3, 2.0);
-                }
-                k.push(k[n]);
-                k
-            });
-            let patches = (0..count[0] * count[1])
-                .map(|_| {
-                    let c = [2 + rng.below(4), 2 + rng.below(4)];
-                    let pts = (0..c[0] * c[1]).map(|_| rng.vec(5.0)).collect();
-                    TensorSurface::bezier(c, pts, None).unwrap()
-                })
-                .collect();
-            let kind = if case % 2 == 0 {
-                BFunctionKind::ExpoRational
-            } else {
-                BFunctionKind::Smoothstep
-            };
-            let e = ErbsSurface::new(knots, count, patches, kind).unwrap();
-            let samples = [2 + rng.below(40), 2 + rng.below(40)];
-            let m = ErbsSurfaceModel::new(e, samples).unwrap();
-            let mut fast = ErbsSurfaceSampler::new(m.clone(), PartialSet::Shading, true);
-            let mut generic = ErbsSurfaceSampler::new(m, PartialSet::Square(1), true);
-            let d = difference(fast.grid(), generic.grid());
-            assert!(d < 1e-13, "case {case}: {d:e}");
-            for _ in 0..10 {
-                let local = LocalPath::top([rng.below(count[0]), rng.below(count[1])]);
-                let edit = if rng.below(2) == 0 {
-                    let matrix = DMat4::from_translation(rng.vec(1.0))
-                        * DMat4::from_axis_angle(rng.vec(1.0).normalize(), rng.range(-1.0, 1.0));
-                    LocalEdit::Transform { local, matrix }
-                } else {
-                    let [k, l] = local.steps()[0];
-                    let [da, db] = fast.model().surface().local_patch(k, l).degree();
-                    let point = [rng.below(da + 1), rng.below(db + 1)];
-                    let delta = rng.vec(1.0);
-                    LocalEdit::MovePoint {
-                        local,
-                        point,
-                        delta,
-                    }
-                };
-                fast.apply(&ErbsSurfaceEdit::Local(edit.clone()));
-                generic.apply(&ErbsSurfaceEdit::Local(edit));
-                let d = difference(fast.grid(), generic.grid());
-                assert!(d < 1e-12, "case {case}: {d:e}");
-            }
-        }
-    }
-
-    #[test]
     fn degenerate_normals_take_the_model_fallback() {
         // Row 0 of the control net collapsed to a point: Sv = 0 along u = 0, so the normals
         // there come from the model's one-sided limit, not from Su × Sv.
@@ -801,86 +449,6 @@ pub(crate) mod tests {
             );
             assert!(difference(g, generic.grid()) < 1e-13);
         }
-    }
-
-    /// (Su, Sv) pairs: zero, tiny, huge, NaN and infinite partials, then random ones over 20
-    /// decades, every third pair nearly parallel (near the regularity threshold).
-    pub(crate) fn normal_cases() -> Vec<(DVec3, DVec3)> {
-        let mut rng = Rng(99);
-        let special = [
-            DVec3::ZERO,
-            DVec3::X,
-            DVec3::new(1e-200, 0.0, 0.0),
-            DVec3::new(1e200, 1e200, 0.0),
-            DVec3::new(f64::NAN, 0.0, 1.0),
-            DVec3::new(f64::INFINITY, 1.0, 0.0),
-        ];
-        (0..10_000)
-            .map(|n| {
-                if n < 36 {
-                    return (special[n / 6], special[n % 6]);
-                }
-                let su = 10f64.powi(rng.below(20) as i32 - 10);
-                let sv = 10f64.powi(rng.below(20) as i32 - 10);
-                let u = rng.vec(su);
-                let v = match n % 3 {
-                    0 => u * rng.range(-2.0, 2.0) + rng.vec(1e-12),
-                    _ => rng.vec(sv),
-                };
-                (u, v)
-            })
-            .collect()
-    }
-
-    /// Bit for bit `regular_normal`'s normal, or flagged degenerate exactly where it says so.
-    pub(crate) fn assert_is_regular_normal(u: DVec3, v: DVec3, n: [f64; 3], ok: bool) {
-        match regular_normal(u, v) {
-            Some(r) => {
-                assert!(ok, "{u} × {v} is regular");
-                assert_eq!(r.to_array().map(f64::to_bits), n.map(f64::to_bits));
-            }
-            None => assert!(!ok, "{u} × {v} is degenerate"),
-        }
-    }
-
-    #[test]
-    fn lane_normal_is_regular_normal() {
-        for (u, v) in normal_cases() {
-            let (n, ok) = unit_normals(u.to_array().map(|c| [c]), v.to_array().map(|c| [c]));
-            let ([[x], [y], [z]], [ok]) = (n, ok);
-            assert_is_regular_normal(u, v, [x, y, z], ok == 1.0);
-        }
-    }
-
-    /// The stage's vectorised loop gives `regular_normal`'s normals and flags too, and counts
-    /// the degenerate samples.
-    #[test]
-    fn normal_stage_solves_regular_normals() {
-        let cases = normal_cases();
-        let groups = cases.len() / LANES;
-        let mut stage = NormalStage::new(groups * LANES);
-        let inputs = stage.inputs::<LANES>(groups);
-        for (k, chunk) in cases.chunks_exact(LANES).enumerate() {
-            for (l, (u, v)) in chunk.iter().enumerate() {
-                for c in 0..3 {
-                    inputs[c][k][l] = u[c];
-                    inputs[3 + c][k][l] = v[c];
-                }
-            }
-        }
-        let bad = stage.solve();
-        let [nx, ny, nz] = stage.normals::<LANES>(groups);
-        for (i, (u, v)) in cases.iter().enumerate().take(groups * LANES) {
-            let (k, l) = (i / LANES, i % LANES);
-            let n = [nx[k][l], ny[k][l], nz[k][l]];
-            assert_is_regular_normal(*u, *v, n, stage.regular(i));
-        }
-        let expected = cases[..groups * LANES]
-            .iter()
-            .filter(|(u, v)| regular_normal(*u, *v).is_none())
-            .count();
-        assert!(expected > 10, "the cases include degenerate ones");
-        assert_eq!(bad, expected);
     }
 
     #[test]

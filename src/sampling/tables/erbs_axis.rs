@@ -19,6 +19,7 @@ pub struct Piece {
 
 impl Piece {
     /// The level samples of local samples `local` (clipped to this piece), or `None`.
+    #[must_use]
     pub fn level_range(&self, local: &Range<usize>) -> Option<Range<usize>> {
         let lo = local.start.max(self.offset);
         let hi = local.end.min(self.offset + self.samples.len());
@@ -49,6 +50,7 @@ pub struct Cell {
 }
 
 impl ErbsAxis {
+    #[must_use]
     pub fn new(knots: &ErbsKnots, bf: BFunctionKind, params: Vec<f64>, order: usize) -> Self {
         let spans: Vec<usize> = params.iter().map(|&t| knots.locate(t)).collect();
         let mut blend = Vec::with_capacity(params.len() * 2 * (order + 1));
@@ -72,6 +74,7 @@ impl ErbsAxis {
     /// The same parameters on knots with one more centre inserted strictly inside interval i
     /// (see [`ErbsKnots::insert`]): samples outside that interval keep their weights (their
     /// interval's knots are the same), only those inside are evaluated again.
+    #[must_use]
     pub fn refined(&self, knots: &ErbsKnots, bf: BFunctionKind, i: usize) -> Self {
         let g1 = self.order + 1;
         let mut spans = Vec::with_capacity(self.params.len());
@@ -101,16 +104,19 @@ impl ErbsAxis {
         }
     }
 
+    #[must_use]
     pub fn len(&self) -> usize {
         self.params.len()
     }
 
+    #[must_use]
     pub fn is_empty(&self) -> bool {
         self.params.is_empty()
     }
 
     /// Blend weights W^(0..=g) of local l at sample j (l must be active there).
     #[inline]
+    #[must_use]
     pub fn weights(&self, j: usize, l: usize) -> &[f64] {
         let g1 = self.order + 1;
         let side = usize::from(self.spans[j] != l);
@@ -119,15 +125,18 @@ impl ErbsAxis {
     }
 
     /// Number of locals of the direction.
+    #[must_use]
     pub fn locals(&self) -> usize {
         self.pieces.len()
     }
 
+    #[must_use]
     pub fn pieces(&self, l: usize) -> &[Piece] {
         &self.pieces[l]
     }
 
     /// The parameters local l is evaluated at, in its own increasing order.
+    #[must_use]
     pub fn local_params(&self, l: usize) -> Vec<f64> {
         self.pieces[l]
             .iter()
@@ -140,6 +149,7 @@ impl ErbsAxis {
     }
 
     /// The level sample of each of local l's samples, in its own order.
+    #[must_use]
     pub fn local_rows(&self, l: usize) -> Vec<usize> {
         self.pieces[l]
             .iter()
@@ -148,6 +158,7 @@ impl ErbsAxis {
     }
 
     /// Local l's own index of level sample j (which it must cover).
+    #[must_use]
     pub fn local_index(&self, l: usize, j: usize) -> usize {
         let p = self.pieces[l]
             .iter()
@@ -156,11 +167,13 @@ impl ErbsAxis {
         j - p.samples.start + p.offset
     }
 
+    #[must_use]
     pub fn cells(&self) -> &[Cell] {
         &self.cells
     }
 
     /// How many samples local l covers.
+    #[must_use]
     pub fn local_len(&self, l: usize) -> usize {
         self.pieces[l].iter().map(|p| p.samples.len()).sum()
     }
@@ -168,6 +181,7 @@ impl ErbsAxis {
     /// The samples a refinement inside interval i changes: those strictly inside it, and
     /// those at its two knots as well when the B-function's derivatives up to the sampled
     /// order do not all vanish at 0 and 1 (the expo-rational one's all do).
+    #[must_use]
     pub fn touched_by_refinement(
         &self,
         knots: &ErbsKnots,
@@ -196,6 +210,7 @@ impl ErbsAxis {
 }
 
 /// The runs of samples with one interval, with the interval's two locals.
+#[must_use]
 fn cells(knots: &ErbsKnots, spans: &[usize]) -> Vec<Cell> {
     let mut cells: Vec<Cell> = Vec::new();
     for (j, &i) in spans.iter().enumerate() {
@@ -212,6 +227,7 @@ fn cells(knots: &ErbsKnots, spans: &[usize]) -> Vec<Cell> {
 
 /// For every local, the runs of consecutive samples where it is active with one shift, ordered
 /// by local parameter.
+#[must_use]
 fn pieces(knots: &ErbsKnots, params: &[f64], spans: &[usize]) -> Vec<Vec<Piece>> {
     let n = knots.locals();
     let mut runs: Vec<Vec<(Range<usize>, f64)>> = vec![Vec::new(); n];
@@ -247,6 +263,7 @@ fn pieces(knots: &ErbsKnots, params: &[f64], spans: &[usize]) -> Vec<Vec<Piece>>
 }
 
 /// Leibniz terms ∂^r(W·c) = Σ_k C(r,k) W^(r−k) c^(k), per output order, as (C(r,k), r−k, k).
+#[must_use]
 pub fn leibniz_terms(g: usize) -> Vec<Vec<(f64, usize, usize)>> {
     (0..=g)
         .map(|r| (0..=r).map(|k| (binomial(r, k), r - k, k)).collect())

@@ -4,14 +4,16 @@
 //! a net, like a B-spline surface's, and a change of the patch is a change of the net: nothing
 //! per sample is stored beyond the level's own grid.
 
-use super::axis::HermiteTable;
-use super::dense::DenseRow;
+use super::axis::{HermiteTable, dot};
 use super::erbs_axis::ErbsAxis;
-use super::grid::PartialSet;
-use super::spline_curve::dot;
 use crate::geom::TensorSurface;
+use crate::sampling::grid::PartialSet;
 use glam::DVec3;
 use std::ops::Range;
+
+/// Rows 0 and 1 of a dense basis of width W at one sample: the W functions' values and first
+/// derivatives (the dense kernel's input, one per sample row or column).
+pub(crate) type DenseRow<const W: usize> = [[f64; W]; 2];
 
 /// Widest dense patch: a single Bézier piece of degree ≤ 3 each way.
 pub(crate) const DENSE: usize = 4;
@@ -37,6 +39,7 @@ pub(crate) struct DensePatch {
 
 impl SplinePatch {
     /// Pre-evaluates local patch (k, l) of a level with these axes.
+    #[must_use]
     pub fn new(
         surface: &TensorSurface,
         axes: &[ErbsAxis; 2],
@@ -78,6 +81,7 @@ impl SplinePatch {
     }
 
     /// Whether `surface` has this patch's basis (only its points may differ).
+    #[must_use]
     pub fn holds(&self, surface: &TensorSurface) -> bool {
         let [du, dv] = surface.degree();
         let [ku, kv] = surface.knots();
@@ -101,6 +105,7 @@ impl SplinePatch {
     }
 
     /// The local samples a change of the net confined to points `a × b` touches.
+    #[must_use]
     pub fn touched(&self, a: Range<usize>, b: Range<usize>) -> [Range<usize>; 2] {
         let [tu, tv] = &*self.tables;
         [
@@ -111,6 +116,7 @@ impl SplinePatch {
 }
 
 /// A net of at most 4 × 4 points padded with zeros (their basis rows are padded with zeros too).
+#[must_use]
 pub(crate) fn padded(points: &[DVec3], [nu, nv]: [usize; 2]) -> [[DVec3; DENSE]; DENSE] {
     std::array::from_fn(|a| {
         std::array::from_fn(|b| {
@@ -124,6 +130,7 @@ pub(crate) fn padded(points: &[DVec3], [nu, nv]: [usize; 2]) -> [[DVec3; DENSE];
 }
 
 /// Rows 0 and 1 of a single-span table, padded to width 4.
+#[must_use]
 fn dense_rows(t: &HermiteTable) -> Vec<DenseRow<DENSE>> {
     (0..t.len())
         .map(|j| {
@@ -211,6 +218,7 @@ pub(crate) fn add_share(
     }
 }
 
+#[must_use]
 pub(crate) fn clip(a: &Range<usize>, b: &Range<usize>) -> Range<usize> {
     a.start.max(b.start)..a.end.min(b.end).max(a.start.max(b.start))
 }

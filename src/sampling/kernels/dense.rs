@@ -4,20 +4,17 @@
 //! patches active over one knot cell side by side (width 8 each way): over a cell the ERBS
 //! surface is a tensor product on an 8 × 8 net, so a sample costs one pass instead of four.
 //!
-//! The lane layout is `shading`'s: L sample rows share each column's v-coefficients, held
-//! lane-minor so that the autovectoriser emits SIMD across the rows. The normals of a row group
+//! The lane layout is the toolkit's ([`super::lanes`]): L sample rows share each column's
+//! v-coefficients, held lane-minor so that the autovectoriser emits SIMD across the rows. The normals of a row group
 //! are solved after its columns, through a [`NormalStage`]. Where the build has AVX, groups of
 //! four rows take the same steps in explicit AVX instead ([`avx`]).
 
 #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
 mod avx;
 
-use super::shading::{LANES, Lanes, NormalStage, QCol, partials, unit_normals};
+use super::lanes::{LANES, Lanes, NormalStage, QCol, fill_q, partials, unit_normals};
+use crate::sampling::tables::erbs_patch::DenseRow;
 use glam::DVec3;
-
-/// Rows 0 and 1 of a dense basis of width W at one sample: the W functions' values and first
-/// derivatives.
-pub(crate) type DenseRow<const W: usize> = [[f64; W]; 2];
 
 /// Where a pass writes: `rows` consecutive grid rows from `row0`, columns from `col0`, of a
 /// row-major grid of S, Su, Sv per sample with `width` samples per row, and the unit normals
@@ -119,7 +116,8 @@ impl<const WU: usize, const WV: usize> Pass<'_, WU, WV> {
     ) {
         #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
         if !self.portable {
-            avx::groups::<WU, WV, ADD, N>(self, cu, cv, data, normals, degenerate);
+            let q_of = |rows: &[DenseRow<WU>; LANES]| self.q_of::<LANES>(rows);
+            avx::groups::<WU, WV, ADD, N>(q_of, self.origin, cu, cv, data, normals, degenerate);
             return;
         }
         let split = cu.len() / LANES * LANES;
@@ -153,13 +151,13 @@ impl<const WU: usize, const WV: usize> Pass<'_, WU, WV> {
         // roots and divisions bound it, so they are solved afterwards through a stage, packed.
         // Over an 8-wide net (a knot cell of the full pass) the column loop's products are
         // twice as many and hide the scalar ones LLVM makes in the loop, while the stage's
-        // loop of its own would not overlap them (measured: the full pass 15 % slower).
+        // loop of its own would not overlap them.
         let staged = N && WV <= 4;
         let mut stage = NormalStage::new(if staged { nc * L } else { 0 });
         for (g, rows) in cu.chunks_exact(L).enumerate() {
-            let q = self.fill_q::<L>(rows);
+            let q = self.q_of::<L>(rows);
             // The rows and stage columns resliced to exactly `nc`, so that indexing them by
-            // the column needs no bounds check (13 of the loop's 220 instructions).
+            // the column needs no bounds check.
             let d: [&mut [[DVec3; 3]]; L] = std::array::from_fn(|_| {
                 let row = data.next().expect("one grid row per sample row");
                 &mut row.as_chunks_mut::<3>().0[..nc]
@@ -235,24 +233,13 @@ impl<const WU: usize, const WV: usize> Pass<'_, WU, WV> {
         }
     }
 
-    /// Q0 = Σ_a U_a P_ab and Q1 = Σ_a U'_a P_ab at every net column b, for L sample rows.
+    /// Q0 = Σ_a U_a P_ab and Q1 = Σ_a U'_a P_ab at every net column b, for L sample rows
+    /// (each sum from +0).
     #[inline(always)]
-    fn fill_q<const L: usize>(&self, rows: &[DenseRow<WU>]) -> [QCol<L>; WV] {
+    #[must_use]
+    fn q_of<const L: usize>(&self, rows: &[DenseRow<WU>]) -> [QCol<L>; WV] {
         let mut q = [[Lanes([0.0; L]); 6]; WV];
-        for (b, qb) in q.iter_mut().enumerate() {
-            for a in 0..WU {
-                let p = self.net[a][b];
-                for l in 0..L {
-                    let (c0, c1) = (rows[l][0][a], rows[l][1][a]);
-                    qb[0][l] += p.x * c0;
-                    qb[1][l] += p.y * c0;
-                    qb[2][l] += p.z * c0;
-                    qb[3][l] += p.x * c1;
-                    qb[4][l] += p.y * c1;
-                    qb[5][l] += p.z * c1;
-                }
-            }
-        }
+        fill_q::<WU, L, true>(&mut q, |r, a, l| rows[l][r][a], |_, a, b| self.net[a][b]);
         q
     }
 }
@@ -260,6 +247,74 @@ impl<const WU: usize, const WV: usize> Pass<'_, WU, WV> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geom::{BFunctionKind, ErbsSurface, TensorSurface};
+    use crate::model::{ErbsSurfaceEdit, ErbsSurfaceModel, LocalEdit, LocalPath};
+    use crate::sampling::Sampler;
+    use crate::sampling::erbs_surface::ErbsSurfaceSampler;
+    use crate::sampling::grid::PartialSet;
+    use crate::sampling::kernels::testing::{Rng, difference};
+    use glam::DMat4;
+
+    #[test]
+    fn erbs_shading_matches_the_generic_path() {
+        // Local patches through the fast kernel (degrees 1..=3) or two_pass (4), the written-out
+        // blend and the row-wise normals, against Square(1) grids that take none of them.
+        let mut rng = Rng(0x5151_7e57);
+        for case in 0..12 {
+            let count = [2 + rng.below(3), 2 + rng.below(3)];
+            let knots = count.map(|n| {
+                let mut k = vec![0.0];
+                let mut t = 0.0;
+                for _ in 0..n {
+                    k.push(t);
+                    t += rng.range(0.3, 2.0);
+                }
+                k.push(k[n]);
+                k
+            });
+            let patches = (0..count[0] * count[1])
+                .map(|_| {
+                    let c = [2 + rng.below(4), 2 + rng.below(4)];
+                    let pts = (0..c[0] * c[1]).map(|_| rng.vec(5.0)).collect();
+                    TensorSurface::bezier(c, pts, None).unwrap()
+                })
+                .collect();
+            let kind = if case % 2 == 0 {
+                BFunctionKind::ExpoRational
+            } else {
+                BFunctionKind::Smoothstep
+            };
+            let e = ErbsSurface::new(knots, count, patches, kind).unwrap();
+            let samples = [2 + rng.below(40), 2 + rng.below(40)];
+            let m = ErbsSurfaceModel::new(e, samples).unwrap();
+            let mut fast = ErbsSurfaceSampler::new(m.clone(), PartialSet::Shading, true);
+            let mut generic = ErbsSurfaceSampler::new(m, PartialSet::Square(1), true);
+            let d = difference(fast.grid(), generic.grid());
+            assert!(d < 1e-13, "case {case}: {d:e}");
+            for _ in 0..10 {
+                let local = LocalPath::top([rng.below(count[0]), rng.below(count[1])]);
+                let edit = if rng.below(2) == 0 {
+                    let matrix = DMat4::from_translation(rng.vec(1.0))
+                        * DMat4::from_axis_angle(rng.vec(1.0).normalize(), rng.range(-1.0, 1.0));
+                    LocalEdit::Transform { local, matrix }
+                } else {
+                    let [k, l] = local.steps()[0];
+                    let [da, db] = fast.model().surface().local_patch(k, l).degree();
+                    let point = [rng.below(da + 1), rng.below(db + 1)];
+                    let delta = rng.vec(1.0);
+                    LocalEdit::MovePoint {
+                        local,
+                        point,
+                        delta,
+                    }
+                };
+                fast.apply(&ErbsSurfaceEdit::Local(edit.clone()));
+                generic.apply(&ErbsSurfaceEdit::Local(edit));
+                let d = difference(fast.grid(), generic.grid());
+                assert!(d < 1e-12, "case {case}: {d:e}");
+            }
+        }
+    }
 
     /// The kernel against the definition, sample by sample, for a random dense basis and net,
     /// storing and adding, with and without normals; and a perturbed net must be told apart.
@@ -276,6 +331,7 @@ mod tests {
     }
 
     /// Exact comparison (NaN-aware: equal bits).
+    #[must_use]
     fn bits(v: &[DVec3]) -> Vec<[u64; 3]> {
         v.iter().map(|p| p.to_array().map(f64::to_bits)).collect()
     }

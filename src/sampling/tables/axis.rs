@@ -30,6 +30,7 @@ pub struct HermiteTable {
 impl HermiteTable {
     /// Pre-evaluates `samples` uniform parameters over the domain of a degree-`degree` B-spline
     /// with `n` control points, keeping derivatives up to order `order`.
+    #[must_use]
     pub fn new(knots: &KnotVector, degree: usize, n: usize, samples: usize, order: usize) -> Self {
         let (a, b) = knots.domain(degree, n);
         let params = uniform_params(a, b, samples);
@@ -37,6 +38,7 @@ impl HermiteTable {
     }
 
     /// Pre-evaluation at given parameters (non-decreasing, inside the domain).
+    #[must_use]
     pub fn at_params(
         knots: &KnotVector,
         degree: usize,
@@ -80,6 +82,7 @@ impl HermiteTable {
         let mut m = vec![0.0; self.m.len()];
         let mut spans = Vec::with_capacity(self.params.len());
         // M on span s reads the knots t_{s−d+1} … t_{s+d} (and t).
+        #[must_use]
         fn window(k: &[f64], s: usize, d: usize) -> &[f64] {
             &k[s + 1 - d..s + d + 1]
         }
@@ -141,6 +144,7 @@ impl HermiteTable {
 
     /// Whether both tables tabulate the same basis (degree, knots, control count) at the same
     /// parameters.
+    #[must_use]
     pub fn same_basis(&self, other: &Self) -> bool {
         self.degree == other.degree
             && self.ranges.len() == other.ranges.len()
@@ -150,29 +154,35 @@ impl HermiteTable {
 
     /// Whether this table is the pre-evaluation of a degree-`degree` B-spline with `n` control
     /// points on `knots`.
+    #[must_use]
     pub fn tabulates(&self, knots: &KnotVector, degree: usize, n: usize) -> bool {
         self.degree == degree && self.ranges.len() == n && self.knots == *knots
     }
 
+    #[must_use]
     pub fn degree(&self) -> usize {
         self.degree
     }
 
     /// Highest derivative order g this table was built for.
+    #[must_use]
     pub fn order(&self) -> usize {
         self.order
     }
 
+    #[must_use]
     pub fn len(&self) -> usize {
         self.params.len()
     }
 
+    #[must_use]
     pub fn is_empty(&self) -> bool {
         self.params.is_empty()
     }
 
     /// Index of the first control point active at sample j (span − d).
     #[inline]
+    #[must_use]
     pub fn first(&self, j: usize) -> usize {
         self.spans[j] - self.degree
     }
@@ -180,6 +190,7 @@ impl HermiteTable {
     /// Row r of M at sample j (the r-th derivatives of the d+1 active basis functions), or
     /// `None` when r exceeds the degree (all zero).
     #[inline]
+    #[must_use]
     pub fn row(&self, j: usize, r: usize) -> Option<&[f64]> {
         if r >= self.rows {
             return None;
@@ -191,6 +202,7 @@ impl HermiteTable {
 
     /// Derivative rows kept per sample (min(g, d) + 1).
     #[inline]
+    #[must_use]
     pub fn rows_kept(&self) -> usize {
         self.rows
     }
@@ -198,12 +210,14 @@ impl HermiteTable {
     /// All of M in storage order, per sample `rows_kept() × (d+1)` values, for kernels that
     /// walk it linearly instead of looking rows up one by one.
     #[inline]
+    #[must_use]
     pub fn matrix(&self) -> &[f64] {
         &self.m
     }
 
     /// Coefficient of control point k in the r-th derivative at sample j (0 if inactive).
     #[inline]
+    #[must_use]
     pub fn coeff(&self, j: usize, r: usize, k: usize) -> f64 {
         let first = self.first(j);
         if r >= self.rows || k < first || k > first + self.degree {
@@ -214,6 +228,7 @@ impl HermiteTable {
 
     /// The samples control point k influences (the paper's I_k).
     #[inline]
+    #[must_use]
     pub fn range(&self, k: usize) -> Range<usize> {
         self.ranges[k].clone()
     }
@@ -221,6 +236,7 @@ impl HermiteTable {
 
 /// I_k for every control point k: spans are non-decreasing in the sample index, so
 /// {j : span_j ∈ [k, k+d]} is an interval, found with two monotone cursors.
+#[must_use]
 fn influence_ranges(spans: &[usize], degree: usize, n: usize) -> Vec<Range<usize>> {
     let mut ranges = Vec::with_capacity(n);
     let (mut lo, mut hi) = (0usize, 0usize);
@@ -235,6 +251,20 @@ fn influence_ranges(spans: &[usize], degree: usize, n: usize) -> Vec<Range<usize
         ranges.push(lo..hi);
     }
     ranges
+}
+
+/// Σ_k row[k]·p[k]: a row of M (or of a blended table) against the points it weights.
+#[inline]
+#[must_use]
+pub(crate) fn dot<P>(row: &[f64], p: &[P]) -> P
+where
+    P: Copy + Default + std::ops::Add<Output = P> + std::ops::Mul<f64, Output = P>,
+{
+    let mut acc = P::default();
+    for (c, &q) in row.iter().zip(p) {
+        acc = acc + q * *c;
+    }
+    acc
 }
 
 #[cfg(test)]

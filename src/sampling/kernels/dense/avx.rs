@@ -1,9 +1,9 @@
 //! The dense kernel's groups of four sample rows in explicit AVX, for x86-64 builds that have it
 //! (`.cargo/config.toml` builds for the host CPU). The portable kernel computes a column's nine
 //! values (S, Su, Sv) with one lane per row and leaves the layout to LLVM, and for a patch edit
-//! about half of its instructions only move data: every old value is gathered as a scalar into
-//! its lane, each sum is scattered to four grid rows, and the normals go out to the rows in a
-//! loop of their own. Here:
+//! much of its work only moves data: every old value is gathered as a scalar into its lane,
+//! each sum is scattered to four grid rows, and the normals go out to the rows in a loop of
+//! their own. Here:
 //! - the sums are formed in the grid's own order: per row, one vector of its values 0..4
 //!   (S, Su x) and one of 4..8 (Su y, z, Sv x, y), from the row group's Q values transposed
 //!   once per group, so a column needs no transpose, and the old values are added as two
@@ -14,15 +14,11 @@
 //!   row its normal.
 //!
 //! Every value is the portable kernel's product and sum, in its order, so the two paths agree
-//! bit for bit (`dense`'s tests compare them). On the reference machine (Zen 3) an ERBS
-//! local-patch rotation (113 × 113 samples) took 92–119 µs against the portable kernel's
-//! 119–182 µs, in alternating criterion runs (README "Performance"). Measured and dropped: the
-//! normals in the column loop (7 % slower), in three loops (10 % slower), or staged in the
-//! grid's order (5 % slower); fused multiply-adds (5 % faster, but no longer the portable
-//! path's bits).
+//! bit for bit (`dense`'s tests compare them). That is also why no product and sum is fused
+//! into a multiply-add: it would round once where the portable path rounds twice.
 
-use super::{DenseRow, Pass};
-use crate::sampling::shading::LANES;
+use crate::sampling::kernels::lanes::{LANES, QCol};
+use crate::sampling::tables::erbs_patch::DenseRow;
 use glam::DVec3;
 use safe_arch::{
     blend_varying_m256d, cmp_op, cmp_op_mask_m256d, load_f64_splat_m256d, m256d, move_mask_m256d,
@@ -32,11 +28,14 @@ use safe_arch::{
 // A group is one AVX register of f64 lanes.
 const _: () = assert!(LANES == 4);
 
-/// All rows `cu` in groups of four, as `Pass::rows` does; the last group padded with copies
-/// of its last row, their results written to scratch rows and dropped (one padded group costs
-/// less than one to three rows one by one).
+/// All rows `cu` in groups of four, as the portable kernel's row pass does; the last group
+/// padded with copies of its last row, their results written to scratch rows and dropped (one
+/// padded group costs less than one to three rows one by one). `q_of` gives a group's Q0, Q1
+/// at the net columns (the portable kernel's, so the sums below continue its sums); `origin`
+/// is the grid index of the pass's first row and column.
 pub(super) fn groups<'g, const WU: usize, const WV: usize, const ADD: bool, const N: bool>(
-    pass: &Pass<'_, WU, WV>,
+    q_of: impl Fn(&[DenseRow<WU>; LANES]) -> [QCol<LANES>; WV],
+    origin: (usize, usize),
     cu: &[DenseRow<WU>],
     cv: &[DenseRow<WV>],
     data: &mut impl Iterator<Item = &'g mut [DVec3]>,
@@ -45,7 +44,8 @@ pub(super) fn groups<'g, const WU: usize, const WV: usize, const ADD: bool, cons
 ) {
     let nc = cv.len();
     let mut group = Group {
-        pass,
+        q_of,
+        origin,
         cv,
         mixed: cv
             .iter()
@@ -66,7 +66,7 @@ pub(super) fn groups<'g, const WU: usize, const WV: usize, const ADD: bool, cons
         let rows = rows.try_into().expect("LANES rows");
         let d = std::array::from_fn(|_| data_row());
         let n = std::array::from_fn(|_| normal_row());
-        group.run::<ADD, N>(rows, d, n, g * LANES, LANES, degenerate);
+        group.run::<WU, ADD, N>(rows, d, n, g * LANES, LANES, degenerate);
     }
     let rest = whole.remainder();
     let Some(last) = rest.last() else {
@@ -90,12 +90,13 @@ pub(super) fn groups<'g, const WU: usize, const WV: usize, const ADD: bool, cons
         (false, false) => &mut [],
     });
     let first = cu.len() - rest.len();
-    group.run::<ADD, N>(&rows, d, n, first, rest.len(), degenerate);
+    group.run::<WU, ADD, N>(&rows, d, n, first, rest.len(), degenerate);
 }
 
 /// What the row groups of one pass share.
-struct Group<'a, 'p, const WU: usize, const WV: usize> {
-    pass: &'a Pass<'p, WU, WV>,
+struct Group<'a, Q, const WV: usize> {
+    q_of: Q,
+    origin: (usize, usize),
     cv: &'a [DenseRow<WV>],
     /// Per column and net column k: M_v[0][k], M_v[0][k], M_v[1][k], M_v[1][k].
     mixed: Vec<[m256d; WV]>,
@@ -103,10 +104,10 @@ struct Group<'a, 'p, const WU: usize, const WV: usize> {
     stage: Vec<[m256d; 6]>,
 }
 
-impl<const WU: usize, const WV: usize> Group<'_, '_, WU, WV> {
+impl<Q, const WV: usize> Group<'_, Q, WV> {
     /// Four rows, the first being the pass's rectangle row `first`, into the grid row segments
     /// `d` and normal row segments `n`; only the first `valid` lanes report degenerate normals.
-    fn run<const ADD: bool, const N: bool>(
+    fn run<const WU: usize, const ADD: bool, const N: bool>(
         &mut self,
         rows: &[DenseRow<WU>; LANES],
         d: [&mut [[DVec3; 3]]; LANES],
@@ -114,16 +115,15 @@ impl<const WU: usize, const WV: usize> Group<'_, '_, WU, WV> {
         first: usize,
         valid: usize,
         degenerate: &mut Vec<(usize, usize)>,
-    ) {
+    ) where
+        Q: Fn(&[DenseRow<WU>; LANES]) -> [QCol<LANES>; WV],
+    {
         let zero = zeroed_m256d();
         // Resliced to exactly the column count, so that indexing by the column needs no bounds
         // checks.
         let nc = self.cv.len();
         let d = d.map(|row| &mut row[..nc]);
-        let q = self
-            .pass
-            .fill_q::<LANES>(rows)
-            .map(|col| col.map(|lanes| m256d::from_array(lanes.0)));
+        let q = (self.q_of)(rows).map(|col| col.map(|lanes| m256d::from_array(lanes.0)));
         // Per net column k, each row's Q0 x, y, z, Q1 x (for its grid values 0..4: S, Su x)
         // and Q1 y, z, Q0 x, y (values 4..8: Su y, z, Sv x, y), so that the sums come out in
         // the grid's order and need no transpose; Q0 z (for Sv z) stays one lane per row.
@@ -136,7 +136,7 @@ impl<const WU: usize, const WV: usize> Group<'_, '_, WU, WV> {
             // take M_v[0] twice, then M_v[1] twice.
             let a: [m256d; WV] = std::array::from_fn(|k| load_f64_splat_m256d(&c[0][k]));
             let b: [m256d; WV] = std::array::from_fn(|k| load_f64_splat_m256d(&c[1][k]));
-            // `shading::partials`' products and sums, in its order, for each value.
+            // `lanes::partials`' products and sums, in its order, for each value.
             let mut head: [m256d; LANES] = std::array::from_fn(|l| q_head[0][l] * a[0]);
             let mut tail: [m256d; LANES] = std::array::from_fn(|l| q_tail[0][l] * ab[0]);
             let mut svz = q[0][2] * b[0];
@@ -171,7 +171,7 @@ impl<const WU: usize, const WV: usize> Group<'_, '_, WU, WV> {
         if !N {
             return;
         }
-        let (r0, c0) = self.pass.origin;
+        let (r0, c0) = self.origin;
         let i = r0 + first;
         let valid = (1 << valid) - 1;
         let n = n.map(|row| &mut row[..nc]);
@@ -193,6 +193,7 @@ impl<const WU: usize, const WV: usize> Group<'_, '_, WU, WV> {
 
 /// Row l of the result is lane l of every input.
 #[inline(always)]
+#[must_use]
 fn transpose(r: [m256d; 4]) -> [m256d; 4] {
     let (lo01, hi01) = (unpack_lo_m256d(r[0], r[1]), unpack_hi_m256d(r[0], r[1]));
     let (lo23, hi23) = (unpack_lo_m256d(r[2], r[3]), unpack_hi_m256d(r[2], r[3]));
@@ -206,6 +207,7 @@ fn transpose(r: [m256d; 4]) -> [m256d; 4] {
 
 /// A sample's grid values 0..4 and 4..8 (LLVM makes each one load).
 #[inline(always)]
+#[must_use]
 fn load_sample(d: &[DVec3; 3]) -> (m256d, m256d) {
     (
         m256d::from_array([d[0].x, d[0].y, d[0].z, d[1].x]),
@@ -225,9 +227,10 @@ fn store_sample(d: &mut [DVec3; 3], head: m256d, tail: m256d, last: f64) {
     ];
 }
 
-/// `shading::unit_normals` in AVX (the same operations in the same order): the normals, and
+/// `lanes::unit_normals` in AVX (the same operations in the same order): the normals, and
 /// per lane an all-ones mask where the normal is regular.
 #[inline(always)]
+#[must_use]
 fn unit_normals(u: [m256d; 3], v: [m256d; 3]) -> ([m256d; 3], m256d) {
     let cx = u[1] * v[2] - v[1] * u[2];
     let cy = u[2] * v[0] - v[2] * u[0];
@@ -252,9 +255,9 @@ fn unit_normals(u: [m256d; 3], v: [m256d; 3]) -> ([m256d; 3], m256d) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sampling::shading::tests::{assert_is_regular_normal, normal_cases};
+    use crate::sampling::kernels::testing::{assert_is_regular_normal, normal_cases};
 
-    /// The AVX normals against `regular_normal`, bit for bit, over the shading tests' cases
+    /// The AVX normals against `regular_normal`, bit for bit, over the kernels' test cases
     /// (zero, tiny, huge, NaN, infinite, near-parallel); a wrong lane order must fail.
     #[test]
     fn avx_normals_are_regular_normals() {
