@@ -12,11 +12,12 @@
 use criterion::{BenchmarkId, Criterion, Throughput};
 use glam::{DMat4, DVec3};
 use prespline::geom::{BFunctionKind, BSplineCurve, ErbsSurface, KnotVector, TensorSurface};
+use prespline::model::SampledObject;
 use prespline::model::{
     CurveEdit, CurveModel, ErbsSurfaceEdit, ErbsSurfaceModel, KindEdit, LocalEdit, LocalPath,
     Model, ObjectEdit, PointEdit, SplineForm, SurfaceEdit, SurfaceModel,
 };
-use prespline::sampling::{SampleMode, SampledObject};
+use prespline::sampling::SampleMode;
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 

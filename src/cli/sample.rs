@@ -3,8 +3,9 @@
 
 use super::CliError;
 use crate::editor::{Editor, EditorOptions, ListRefused};
+use crate::model::SampledObject;
+use crate::sampling::SampleMode;
 use crate::sampling::budget::{MemoryBudget, Uses};
-use crate::sampling::{SampleMode, SampledObject};
 use crate::scene::EditList;
 use std::fmt::Write;
 use std::path::Path;

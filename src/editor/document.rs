@@ -6,11 +6,12 @@ use super::controls::{
     ControlDisplay, each_curve_leaf, each_curve_leaf_of, each_patch_leaf, each_patch_leaf_of,
 };
 use crate::geom::Bounds;
+use crate::model::SampledObject;
 use crate::model::{
     BezierSplineEdit, CatmullRomEdit, CurveEdit, Edit, ErbsCurveEdit, ErbsSurfaceEdit, Index2,
     KindEdit, LocalEdit, LocalPath, Model, ModelRef, ObjectEdit, PointEdit, SurfaceEdit,
 };
-use crate::sampling::{SampleMode, SampledObject};
+use crate::sampling::SampleMode;
 use crate::scene::{Scene, SceneObject};
 use glam::DVec3;
 

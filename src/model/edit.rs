@@ -1,10 +1,8 @@
 //! The edit vocabulary shared by every layer: one trait per-kind edits implement, the sum over
 //! kinds, and the frame-merging of edits.
 
-use super::{
-    BezierSplineEdit, CatmullRomEdit, CurveEdit, ErbsCurveEdit, ErbsSurfaceEdit, Index2, LocalPath,
-    Model, ModelRef, SurfaceEdit,
-};
+use super::registry::{IntoObject, ObjectEdit};
+use super::{Index2, LocalPath};
 use crate::geom::shape::{SHAPE_TOLERANCE, ShapeChange};
 use std::fmt::Debug;
 
@@ -79,7 +77,7 @@ pub enum Target {
 
 /// An edit of one object kind. Implemented once per kind: this is the table of what each edit
 /// means, written in one place per kind instead of one `match` per layer.
-pub trait KindEdit: Clone + Debug + PartialEq + Sized {
+pub trait KindEdit: Clone + Debug + PartialEq + Sized + IntoObject {
     /// The model this kind of edit acts on.
     type Model;
 
@@ -99,25 +97,16 @@ pub trait KindEdit: Clone + Debug + PartialEq + Sized {
     #[must_use]
     fn merge(&self, next: &Self) -> Option<Self>;
 
+    /// The edit as an edit of any kind.
     #[must_use]
-    fn into_object(self) -> ObjectEdit;
+    fn into_object(self) -> ObjectEdit {
+        self.wrap()
+    }
 
     /// The edit if `e` is of this kind.
-    fn from_object(e: &ObjectEdit) -> Option<&Self>;
-}
-
-/// An edit of any kind.
-#[derive(Debug, Clone, PartialEq)]
-pub enum ObjectEdit {
-    Curve(CurveEdit),
-    Surface(SurfaceEdit),
-    ErbsCurve(ErbsCurveEdit),
-    ErbsSurface(ErbsSurfaceEdit),
-    CatmullRom(CatmullRomEdit),
-    BezierSpline(BezierSplineEdit),
-    /// Replace the whole model, possibly by one of another kind with the same sample counts
-    /// (conversion of a Catmull–Rom or Bézier spline to its `bspline_curve`, and its undo).
-    Replace(Box<Model>),
+    fn from_object(e: &ObjectEdit) -> Option<&Self> {
+        Self::unwrap(e)
+    }
 }
 
 /// One edit of one object (`object` indexes the scene's objects).
@@ -125,123 +114,6 @@ pub enum ObjectEdit {
 pub struct Edit {
     pub object: usize,
     pub edit: ObjectEdit,
-}
-
-/// Calls `$f` on the kind's edit inside an [`ObjectEdit`]; `$replace` for a replacement.
-macro_rules! each_kind {
-    ($e:expr, $x:ident => $body:expr, $replace:expr) => {
-        match $e {
-            ObjectEdit::Curve($x) => $body,
-            ObjectEdit::Surface($x) => $body,
-            ObjectEdit::ErbsCurve($x) => $body,
-            ObjectEdit::ErbsSurface($x) => $body,
-            ObjectEdit::CatmullRom($x) => $body,
-            ObjectEdit::BezierSpline($x) => $body,
-            ObjectEdit::Replace(_) => $replace,
-        }
-    };
-}
-
-impl ObjectEdit {
-    pub fn target(&self) -> Target {
-        each_kind!(self, e => e.target(), Target::Structure)
-    }
-
-    /// Whether the edit changes the object's structure (knots, degree, control counts).
-    pub fn is_structural(&self) -> bool {
-        self.target() == Target::Structure
-    }
-
-    /// The two as one edit, when they act on one target and combine.
-    #[must_use]
-    pub fn merge(&self, next: &ObjectEdit) -> Option<ObjectEdit> {
-        each_kind!(self, e => {
-            let next = KindEdit::from_object(next)?;
-            e.merge(next).map(KindEdit::into_object)
-        }, None)
-    }
-
-    /// Checks the edit against a model (of its own kind).
-    pub fn validate(&self, model: ModelRef<'_>) -> Result<(), EditError> {
-        match (self, model) {
-            (ObjectEdit::Curve(e), ModelRef::Curve(m)) => e.validate(m),
-            (ObjectEdit::Surface(e), ModelRef::Surface(m)) => e.validate(m),
-            (ObjectEdit::ErbsCurve(e), ModelRef::ErbsCurve(m)) => e.validate(m),
-            (ObjectEdit::ErbsSurface(e), ModelRef::ErbsSurface(m)) => e.validate(m),
-            (ObjectEdit::CatmullRom(e), ModelRef::CatmullRom(m)) => e.validate(m),
-            (ObjectEdit::BezierSpline(e), ModelRef::BezierSpline(m)) => e.validate(m),
-            (ObjectEdit::Replace(new), m) => check_replacement(new.as_ref().as_ref(), m),
-            (e, m) => Err(edit_kind_mismatch(e, m.type_name())),
-        }
-    }
-
-    /// The edit restoring `model` as it is before this edit, or an error on a kind mismatch.
-    pub fn inverse(&self, model: ModelRef<'_>) -> Result<ObjectEdit, EditError> {
-        Ok(match (self, model) {
-            (ObjectEdit::Curve(e), ModelRef::Curve(m)) => e.inverse(m).into_object(),
-            (ObjectEdit::Surface(e), ModelRef::Surface(m)) => e.inverse(m).into_object(),
-            (ObjectEdit::ErbsCurve(e), ModelRef::ErbsCurve(m)) => e.inverse(m).into_object(),
-            (ObjectEdit::ErbsSurface(e), ModelRef::ErbsSurface(m)) => e.inverse(m).into_object(),
-            (ObjectEdit::CatmullRom(e), ModelRef::CatmullRom(m)) => e.inverse(m).into_object(),
-            (ObjectEdit::BezierSpline(e), ModelRef::BezierSpline(m)) => e.inverse(m).into_object(),
-            (ObjectEdit::Replace(_), m) => ObjectEdit::Replace(Box::new(m.to_model())),
-            (e, m) => return Err(edit_kind_mismatch(e, m.type_name())),
-        })
-    }
-
-    /// The kind's name, for messages.
-    pub fn kind_name(&self) -> &'static str {
-        match self {
-            ObjectEdit::Curve(_) => "curve",
-            ObjectEdit::Surface(_) => "surface",
-            ObjectEdit::ErbsCurve(_) => "ERBS curve",
-            ObjectEdit::ErbsSurface(_) => "ERBS surface",
-            ObjectEdit::CatmullRom(_) => "Catmull–Rom",
-            ObjectEdit::BezierSpline(_) => "Bézier spline",
-            ObjectEdit::Replace(_) => "replacement",
-        }
-    }
-}
-
-/// A replacement keeps the sample grid (curve or surface, and its counts), so samplers and GPU
-/// mirrors keep their size.
-fn check_replacement(new: ModelRef<'_>, old: ModelRef<'_>) -> Result<(), EditError> {
-    if new.is_surface() == old.is_surface() && new.sample_dims() == old.sample_dims() {
-        Ok(())
-    } else {
-        Err(EditError::new(
-            "object",
-            format!(
-                "a {} with samples {:?} cannot replace a {} with samples {:?}",
-                new.type_name(),
-                new.sample_dims(),
-                old.type_name(),
-                old.sample_dims()
-            ),
-        ))
-    }
-}
-
-/// The error for an edit paired with a model of another kind.
-pub fn edit_kind_mismatch(e: &ObjectEdit, model_type: &str) -> EditError {
-    EditError::new(
-        "object",
-        format!("a {} edit does not apply to a {model_type}", e.kind_name()),
-    )
-}
-
-pub(super) fn apply_to_model(model: &mut Model, edit: &ObjectEdit) -> Result<(), EditError> {
-    match (model, edit) {
-        (Model::Curve(m), ObjectEdit::Curve(e)) => e.apply(m),
-        (Model::Surface(m), ObjectEdit::Surface(e)) => e.apply(m),
-        (Model::ErbsCurve(m), ObjectEdit::ErbsCurve(e)) => e.apply(m),
-        (Model::ErbsSurface(m), ObjectEdit::ErbsSurface(e)) => e.apply(m),
-        (Model::CatmullRom(m), ObjectEdit::CatmullRom(e)) => e.apply(m),
-        (Model::BezierSpline(m), ObjectEdit::BezierSpline(e)) => e.apply(m),
-        (m, ObjectEdit::Replace(new)) => *m = (**new).clone(),
-        (m, e) => return Err(edit_kind_mismatch(e, m.type_name())),
-    }
-    Ok(())
 }
 
 /// Merges the edits of one frame so each touched target is updated once: consecutive edits of

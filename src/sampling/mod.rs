@@ -6,23 +6,17 @@
 //! `geom` knows the curves; this module knows where they are sampled. Nothing here knows Vulkan.
 
 pub mod budget;
-pub mod chain_curve;
 pub mod curvature;
 pub mod dirty;
-pub mod erbs_curve;
-pub mod erbs_surface;
-pub mod exact;
 pub mod fallback;
 pub mod grid;
-mod kernels;
+pub(crate) mod kernels;
 pub mod normals;
 pub mod object;
 pub mod rational;
-pub mod spline_curve;
-pub mod spline_surface;
 pub mod tables;
 
 pub use dirty::{DirtyRegion, DirtySet};
 pub use grid::{PartialSet, SampleGrid};
-pub use object::{SampleMode, SampledObject, Sampler, Tracked};
+pub use object::{SampleMode, Sampler, Tracked};
 pub use tables::axis::HermiteTable;

@@ -4,10 +4,11 @@
 
 use glam::DVec3;
 use prespline::geom::TensorSurface;
+use prespline::model::SampledObject;
+use prespline::model::exact::exact_grid;
 use prespline::model::{KindEdit, Model, PointEdit, SplineForm, SurfaceEdit, SurfaceModel};
 use prespline::sampling::curvature::principal;
-use prespline::sampling::exact::exact_grid;
-use prespline::sampling::{PartialSet, SampleMode, SampledObject};
+use prespline::sampling::{PartialSet, SampleMode};
 
 use crate::common;
 use common::Rng;

@@ -11,11 +11,12 @@ use oracle::random::{
 };
 use oracle::rng::Rng;
 use prespline::geom::point::{Point, nan_max};
+use prespline::model::SampledObject;
 use prespline::model::{
     CurveEdit, Edit, ErbsCurveEdit, ErbsSurfaceEdit, LocalEdit, ObjectEdit, PointEdit, SurfaceEdit,
     merge_edits,
 };
-use prespline::sampling::{SampleGrid, SampleMode, SampledObject};
+use prespline::sampling::{SampleGrid, SampleMode};
 use prespline::scene::{Scene, parse_edits, parse_scene};
 
 /// A random one-object scene of `kind` and `count` random edits for it, through the product's

@@ -495,7 +495,7 @@ fn takes_fast_path(object: &oracle::scene::Object) -> bool {
 /// there) or the oracle's vanishes (no normal is defined) are not compared. Returns (error, normal ratio, normals compared).
 fn render_grid_error(
     object: &oracle::scene::Object,
-    sampled: &prespline::sampling::SampledObject,
+    sampled: &prespline::model::SampledObject,
 ) -> (f64, f64, usize) {
     use oracle::compare::nan_max;
     let grid = sampled.grid();
@@ -572,7 +572,8 @@ fn render_grid_error(
 /// fast path, then again after random point moves through the fast path's delta updates.
 #[test]
 fn drawing_samples_and_the_shading_fast_path_agree_with_oracle() {
-    use prespline::sampling::{SampleMode, SampledObject};
+    use prespline::model::SampledObject;
+    use prespline::sampling::SampleMode;
     use prespline::scene::edit::parse_edits;
     let seeds = seeds(40, 7);
     let opts = Options {

@@ -3,11 +3,12 @@
 //! segment's points, derivatives from forward differences), never `prespline::geom`.
 
 use glam::DVec3;
+use prespline::model::SampledObject;
+use prespline::model::exact::exact_grid;
 use prespline::model::{
     BezierSplineEdit, CatmullRomEdit, KindEdit, Model, ModelRef, ObjectEdit, PointEdit,
 };
-use prespline::sampling::exact::exact_grid;
-use prespline::sampling::{PartialSet, SampleMode, SampledObject};
+use prespline::sampling::{PartialSet, SampleMode};
 use prespline::scene::{Scene, parse_scene};
 
 use crate::common;

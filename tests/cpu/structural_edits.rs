@@ -6,11 +6,12 @@
 
 use glam::DVec3;
 use prespline::geom::{BSplineCurve, KnotVector, TensorSurface};
+use prespline::model::SampledObject;
 use prespline::model::{
     CurveEdit, CurveModel, KindEdit, Model, ObjectEdit, PointEdit, SplineForm, SurfaceEdit,
     SurfaceModel,
 };
-use prespline::sampling::{SampleGrid, SampleMode, SampledObject};
+use prespline::sampling::{SampleGrid, SampleMode};
 
 struct Rng(u64);
 

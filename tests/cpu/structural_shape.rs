@@ -8,10 +8,11 @@
 
 use glam::DVec3;
 use prespline::geom::{BSplineCurve, TensorSurface};
+use prespline::model::SampledObject;
 use prespline::model::{
     CurveEdit, CurveModel, KindEdit, MAX_DEGREE, Model, SplineForm, SurfaceEdit, SurfaceModel,
 };
-use prespline::sampling::{SampleMode, SampledObject};
+use prespline::sampling::SampleMode;
 use proptest::prelude::*;
 use proptest::test_runner::{FileFailurePersistence, RngSeed};
 use std::process::Command;

@@ -248,9 +248,9 @@ impl<const WU: usize, const WV: usize> Pass<'_, WU, WV> {
 mod tests {
     use super::*;
     use crate::geom::{BFunctionKind, ErbsSurface, TensorSurface};
+    use crate::model::ErbsSurfaceSampler;
     use crate::model::{ErbsSurfaceEdit, ErbsSurfaceModel, LocalEdit, LocalPath};
     use crate::sampling::Sampler;
-    use crate::sampling::erbs_surface::ErbsSurfaceSampler;
     use crate::sampling::grid::PartialSet;
     use crate::sampling::kernels::testing::{Rng, difference};
     use glam::DMat4;

@@ -242,6 +242,8 @@ impl NormalStage {
 
 /// Unit normals of `data`'s samples (S, Su, Sv each) into `normals`, `LANES` at a time so that
 /// the square roots and divisions vectorise; reports the index of every degenerate sample.
+/// Inlinable into the point edits of other modules, whose row loops it finishes.
+#[inline]
 pub(crate) fn normals_of(
     data: &[[DVec3; 3]],
     normals: &mut [DVec3],

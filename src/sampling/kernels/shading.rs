@@ -346,11 +346,11 @@ mod tests {
     use crate::geom::point::{Point, nan_max};
     use crate::geom::surface::regular_normal;
     use crate::geom::{BSplineCurve, TensorSurface};
+    use crate::model::SplineCurveSampler;
+    use crate::model::SplineSurfaceSampler;
     use crate::model::{CurveEdit, CurveModel, PointEdit, SplineForm, SurfaceEdit, SurfaceModel};
     use crate::sampling::grid::PartialSet;
     use crate::sampling::kernels::testing::{Rng, difference};
-    use crate::sampling::spline_curve::SplineCurveSampler;
-    use crate::sampling::spline_surface::SplineSurfaceSampler;
     use crate::sampling::{DirtyRegion, Sampler};
 
     /// Clamped knots on [0, 1] with random interior knots, some repeated (up to the degree).

@@ -1,16 +1,16 @@
 //! Pre-evaluated tensor-product Bézier, B-spline and NURBS surfaces.
 
-use super::dirty::DirtyRegion;
-use super::fallback::{NormalSource, resolve_degenerate};
-use super::grid::{PartialSet, SampleGrid};
-use super::kernels::curvature;
-use super::kernels::shading::{self, ShadingGrid};
-use super::object::Sampler;
-use super::rational::QuotientRule;
-use super::spline_curve::PointState;
-use super::tables::axis::{HermiteTable, dot};
+use super::curve_sampler::PointState;
 use crate::geom::TensorSurface;
 use crate::model::{KindEdit, SurfaceEdit, SurfaceModel};
+use crate::sampling::dirty::DirtyRegion;
+use crate::sampling::fallback::{NormalSource, resolve_degenerate};
+use crate::sampling::grid::{PartialSet, SampleGrid};
+use crate::sampling::kernels::curvature;
+use crate::sampling::kernels::shading::{self, ShadingGrid};
+use crate::sampling::object::Sampler;
+use crate::sampling::rational::QuotientRule;
+use crate::sampling::tables::axis::{HermiteTable, dot};
 use glam::{DVec3, DVec4};
 use std::ops::Range;
 
@@ -242,11 +242,12 @@ impl SplineSurfaceSampler {
 
     fn update_normals(&mut self, rows: Range<usize>, cols: Range<usize>) {
         let params = params(&self.tables);
-        super::normals::update(&mut self.grid, rows, cols, params, self.model.surface());
+        crate::sampling::normals::update(&mut self.grid, rows, cols, params, self.model.surface());
     }
 }
 
 impl Sampler for SplineSurfaceSampler {
+    type Model = SurfaceModel;
     type Edit = SurfaceEdit;
 
     fn model(&self) -> &SurfaceModel {

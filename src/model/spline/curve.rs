@@ -1,10 +1,13 @@
 //! Bézier, B-spline and NURBS curves: the model and its edits.
 
-use super::edit::{EditError, KindEdit, ObjectEdit, Target, check_shape_kept};
-use super::points::PointEdit;
-use super::{MAX_CURVE_SAMPLES, MAX_DEGREE, SplineForm, check_samples};
+use super::curve_sampler::SplineCurveSampler;
 use crate::geom::shape::{insertion_window, shape_change, span_probes};
 use crate::geom::{BSplineCurve, GeomError, KnotVector};
+use crate::model::Kind;
+use crate::model::edit::{EditError, KindEdit, Target, check_shape_kept};
+use crate::model::points::PointEdit;
+use crate::model::{MAX_CURVE_SAMPLES, MAX_DEGREE, SplineForm, check_samples};
+use crate::sampling::SampleMode;
 
 /// A Bézier or B-spline (NURBS with weights) curve with its sample count.
 #[derive(Debug, Clone, PartialEq)]
@@ -43,6 +46,32 @@ impl CurveModel {
 
     pub fn samples(&self) -> usize {
         self.samples
+    }
+}
+
+impl Kind for CurveModel {
+    type Edit = CurveEdit;
+    type Sampler = SplineCurveSampler;
+    const SURFACE: bool = false;
+    const LABEL: &'static str = "curve";
+
+    fn type_name(&self) -> &'static str {
+        match self.form {
+            SplineForm::Bezier => "bezier_curve",
+            SplineForm::BSpline => "bspline_curve",
+        }
+    }
+
+    fn sample_dims(&self) -> [usize; 2] {
+        [self.samples, 1]
+    }
+
+    fn domain(&self) -> Vec<(f64, f64)> {
+        vec![self.curve.domain()]
+    }
+
+    fn sampler(&self, mode: SampleMode) -> SplineCurveSampler {
+        SplineCurveSampler::new(self.clone(), mode.layout().0)
     }
 }
 
@@ -128,17 +157,6 @@ impl KindEdit for CurveEdit {
     fn merge(&self, next: &Self) -> Option<Self> {
         match (self, next) {
             (CurveEdit::Point(a), CurveEdit::Point(b)) => a.merge(b).map(CurveEdit::Point),
-            _ => None,
-        }
-    }
-
-    fn into_object(self) -> ObjectEdit {
-        ObjectEdit::Curve(self)
-    }
-
-    fn from_object(e: &ObjectEdit) -> Option<&Self> {
-        match e {
-            ObjectEdit::Curve(e) => Some(e),
             _ => None,
         }
     }

@@ -6,19 +6,19 @@
 //! that level's samples over the edited patch's support, and each parent blends it in by the
 //! Leibniz rule over the same samples.
 
-use super::dirty::DirtyRegion;
-use super::fallback::{NormalSource, resolve_degenerate};
-use super::grid::{PartialSet, SampleGrid};
-use super::kernels::dense::{self, Target};
-use super::object::Sampler;
-use super::tables::erbs_axis::ErbsAxis;
-use super::tables::erbs_patch::{
-    self, BlendTerm, DENSE, DenseRow, Out, SplinePatch, add_share, clip,
-};
 use crate::geom::erbs::{ErbsKnots, ErbsSurface, LocalPatch};
 use crate::geom::knots::uniform_params;
 use crate::geom::point::binomial;
 use crate::model::{ErbsEdit, ErbsSurfaceEdit, ErbsSurfaceModel, KindEdit, LocalEdit};
+use crate::sampling::dirty::DirtyRegion;
+use crate::sampling::fallback::{NormalSource, resolve_degenerate};
+use crate::sampling::grid::{PartialSet, SampleGrid};
+use crate::sampling::kernels::dense::{self, Target};
+use crate::sampling::object::Sampler;
+use crate::sampling::tables::erbs_axis::ErbsAxis;
+use crate::sampling::tables::erbs_patch::{
+    self, BlendTerm, DENSE, DenseRow, Out, SplinePatch, add_share, clip,
+};
 use glam::{DMat4, DVec3};
 use std::ops::Range;
 
@@ -859,7 +859,7 @@ impl ErbsSurfaceSampler {
             self.level.axes[0].params.as_slice(),
             self.level.axes[1].params.as_slice(),
         ];
-        super::normals::update(
+        crate::sampling::normals::update(
             &mut self.level.grid,
             rows,
             cols,
@@ -882,6 +882,7 @@ impl ErbsSurfaceSampler {
 }
 
 impl Sampler for ErbsSurfaceSampler {
+    type Model = ErbsSurfaceModel;
     type Edit = ErbsSurfaceEdit;
 
     fn model(&self) -> &ErbsSurfaceModel {

@@ -1,11 +1,11 @@
 //! Pre-evaluated Catmull–Rom and Bézier splines: the B-spline of their Bézier chain (knots of
 //! multiplicity d at the junctions) in a [`SplineCurveSampler`], fed one control point at a time.
 
-use super::dirty::DirtyRegion;
-use super::grid::SampleGrid;
-use super::object::Sampler;
-use super::spline_curve::SplineCurveSampler;
+use crate::model::spline::curve_sampler::SplineCurveSampler;
 use crate::model::{ChainEdit, ChainModel, CurveEdit, PointEdit};
+use crate::sampling::dirty::DirtyRegion;
+use crate::sampling::grid::SampleGrid;
+use crate::sampling::object::Sampler;
 
 /// A chain kind's model and the pre-evaluation of its B-spline form. The B-spline's control
 /// points are always the model's chain points, bit for bit.
@@ -23,6 +23,7 @@ impl<E: ChainEdit> ChainCurveSampler<E> {
 }
 
 impl<E: ChainEdit> Sampler for ChainCurveSampler<E> {
+    type Model = E::Model;
     type Edit = E;
 
     fn model(&self) -> &E::Model {

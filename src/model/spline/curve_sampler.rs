@@ -1,14 +1,14 @@
 //! Pre-evaluated Bézier, B-spline and NURBS curves.
 
-use super::dirty::DirtyRegion;
-use super::grid::{PartialSet, SampleGrid};
-use super::kernels::shading;
-use super::object::Sampler;
-use super::rational::QuotientRule;
-use super::tables::axis::{HermiteTable, dot};
 use crate::geom::BSplineCurve;
 use crate::geom::point::to_homogeneous;
 use crate::model::{CurveEdit, CurveModel, KindEdit, PointNet};
+use crate::sampling::dirty::DirtyRegion;
+use crate::sampling::grid::{PartialSet, SampleGrid};
+use crate::sampling::kernels::shading;
+use crate::sampling::object::Sampler;
+use crate::sampling::rational::QuotientRule;
+use crate::sampling::tables::axis::{HermiteTable, dot};
 use glam::{DVec3, DVec4};
 use std::ops::Range;
 
@@ -156,6 +156,7 @@ impl SplineCurveSampler {
 }
 
 impl Sampler for SplineCurveSampler {
+    type Model = CurveModel;
     type Edit = CurveEdit;
 
     fn model(&self) -> &CurveModel {

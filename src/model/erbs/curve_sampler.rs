@@ -4,14 +4,14 @@
 //! of that level's samples over the edited local's support; each parent blends it in over the
 //! same samples, so the cost at every level is what the edit touches.
 
-use super::dirty::DirtyRegion;
-use super::grid::{PartialSet, SampleGrid};
-use super::object::Sampler;
-use super::tables::axis::{HermiteTable, dot};
-use super::tables::erbs_axis::{ErbsAxis, leibniz_terms};
 use crate::geom::erbs::{ErbsCurve, LocalCurve};
 use crate::geom::knots::uniform_params;
 use crate::model::{ErbsCurveEdit, ErbsCurveModel, ErbsEdit, KindEdit, LocalEdit};
+use crate::sampling::dirty::DirtyRegion;
+use crate::sampling::grid::{PartialSet, SampleGrid};
+use crate::sampling::object::Sampler;
+use crate::sampling::tables::axis::{HermiteTable, dot};
+use crate::sampling::tables::erbs_axis::{ErbsAxis, leibniz_terms};
 use glam::{DMat4, DVec3};
 use std::ops::Range;
 
@@ -315,6 +315,7 @@ impl ErbsCurveSampler {
 }
 
 impl Sampler for ErbsCurveSampler {
+    type Model = ErbsCurveModel;
     type Edit = ErbsCurveEdit;
 
     fn model(&self) -> &ErbsCurveModel {

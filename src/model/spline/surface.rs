@@ -1,11 +1,14 @@
 //! Tensor-product Bézier, B-spline and NURBS surfaces: the model and its edits.
 
 use super::curve::{check_elevation, check_insertion, check_restore, replace};
-use super::edit::{EditError, KindEdit, ObjectEdit, Target, check_shape_kept};
-use super::points::PointEdit;
-use super::{SplineForm, check_surface_samples};
+use super::surface_sampler::SplineSurfaceSampler;
 use crate::geom::shape::{greville, insertion_window, shape_change, span_probes};
 use crate::geom::{KnotVector, TensorSurface};
+use crate::model::Kind;
+use crate::model::edit::{EditError, KindEdit, Target, check_shape_kept};
+use crate::model::points::PointEdit;
+use crate::model::{SplineForm, check_surface_samples};
+use crate::sampling::SampleMode;
 use glam::DVec3;
 
 /// A Bézier or B-spline (NURBS with weights) surface with its sample counts [mu, mv].
@@ -56,6 +59,33 @@ impl SurfaceModel {
     }
 }
 
+impl Kind for SurfaceModel {
+    type Edit = SurfaceEdit;
+    type Sampler = SplineSurfaceSampler;
+    const SURFACE: bool = true;
+    const LABEL: &'static str = "surface";
+
+    fn type_name(&self) -> &'static str {
+        match self.form {
+            SplineForm::Bezier => "bezier_surface",
+            SplineForm::BSpline => "bspline_surface",
+        }
+    }
+
+    fn sample_dims(&self) -> [usize; 2] {
+        self.samples
+    }
+
+    fn domain(&self) -> Vec<(f64, f64)> {
+        self.surface.domain().to_vec()
+    }
+
+    fn sampler(&self, mode: SampleMode) -> SplineSurfaceSampler {
+        let (_, set, normals) = mode.layout();
+        SplineSurfaceSampler::new(self.clone(), set, normals)
+    }
+}
+
 fn is_bezier(s: &TensorSurface) -> bool {
     (0..2).all(|dir| s.knots()[dir] == KnotVector::bezier(s.degree()[dir], 0.0, 1.0))
 }
@@ -74,7 +104,7 @@ pub enum SurfaceEdit {
     ElevateDegree {
         by: [usize; 2],
     },
-    /// Put back a whole earlier model (see [`super::CurveEdit::Restore`]).
+    /// Put back a whole earlier model (see [`super::curve::CurveEdit::Restore`]).
     Restore {
         model: Box<SurfaceModel>,
         shape_kept: bool,
@@ -170,17 +200,6 @@ impl KindEdit for SurfaceEdit {
     fn merge(&self, next: &Self) -> Option<Self> {
         match (self, next) {
             (SurfaceEdit::Point(a), SurfaceEdit::Point(b)) => a.merge(b).map(SurfaceEdit::Point),
-            _ => None,
-        }
-    }
-
-    fn into_object(self) -> ObjectEdit {
-        ObjectEdit::Surface(self)
-    }
-
-    fn from_object(e: &ObjectEdit) -> Option<&Self> {
-        match e {
-            ObjectEdit::Surface(e) => Some(e),
             _ => None,
         }
     }

@@ -1,9 +1,9 @@
 //! Reference sampling by direct evaluation of the geometry at every parameter (no
 //! pre-evaluation). Slow; used to check the engine.
 
-use super::grid::{PartialSet, SampleGrid};
 use crate::geom::knots::uniform_params;
 use crate::model::{ChainModel, ModelRef};
+use crate::sampling::{PartialSet, SampleGrid};
 
 /// Samples `model` point by point through the geometry layer's own evaluators.
 pub fn exact_grid(model: ModelRef<'_>, set: &PartialSet) -> SampleGrid {

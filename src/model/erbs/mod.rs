@@ -3,15 +3,23 @@
 //! into the object or into an ERBS local, a polynomial local turned into an ERBS local of its own.
 //! One generic edit type serves both kinds through [`ErbsNet`].
 
-use super::edit::{EditError, KindEdit, ObjectEdit, Target, check_shape_kept};
-use super::points::check_vector;
-use super::{Index2, MAX_CURVE_SAMPLES, MAX_DEGREE, check_samples, check_surface_samples};
+pub mod curve_sampler;
+pub mod surface_sampler;
+
 use crate::geom::erbs::{ErbsCurve, ErbsSurface, LocalCurve, LocalPatch, MAX_NESTING};
 use crate::geom::shape::{ShapeChange, erbs_knot_probes, erbs_probes, shape_change};
 use crate::geom::{BFunctionKind, GeomError};
+use crate::model::Kind;
+use crate::model::edit::{EditError, KindEdit, Target, check_shape_kept};
+use crate::model::points::check_vector;
+use crate::model::registry::IntoObject;
+use crate::model::{Index2, MAX_CURVE_SAMPLES, MAX_DEGREE, check_samples, check_surface_samples};
+use crate::sampling::SampleMode;
+use curve_sampler::ErbsCurveSampler;
 use glam::{DMat4, DVec3, DVec4};
 use std::fmt::Debug;
 use std::hash::Hash;
+use surface_sampler::ErbsSurfaceSampler;
 
 /// An ERBS curve with its sample count.
 #[derive(Debug, Clone, PartialEq)]
@@ -54,6 +62,53 @@ impl ErbsSurfaceModel {
 
     pub fn samples(&self) -> [usize; 2] {
         self.samples
+    }
+}
+
+impl Kind for ErbsCurveModel {
+    type Edit = ErbsCurveEdit;
+    type Sampler = ErbsCurveSampler;
+    const SURFACE: bool = false;
+    const LABEL: &'static str = "ERBS curve";
+
+    fn type_name(&self) -> &'static str {
+        "erbs_curve"
+    }
+
+    fn sample_dims(&self) -> [usize; 2] {
+        [self.samples, 1]
+    }
+
+    fn domain(&self) -> Vec<(f64, f64)> {
+        vec![self.curve.domain()]
+    }
+
+    fn sampler(&self, mode: SampleMode) -> ErbsCurveSampler {
+        ErbsCurveSampler::new(self.clone(), mode.layout().0)
+    }
+}
+
+impl Kind for ErbsSurfaceModel {
+    type Edit = ErbsSurfaceEdit;
+    type Sampler = ErbsSurfaceSampler;
+    const SURFACE: bool = true;
+    const LABEL: &'static str = "ERBS surface";
+
+    fn type_name(&self) -> &'static str {
+        "erbs_surface"
+    }
+
+    fn sample_dims(&self) -> [usize; 2] {
+        self.samples
+    }
+
+    fn domain(&self) -> Vec<(f64, f64)> {
+        self.surface.domain().to_vec()
+    }
+
+    fn sampler(&self, mode: SampleMode) -> ErbsSurfaceSampler {
+        let (_, set, normals) = mode.layout();
+        ErbsSurfaceSampler::new(self.clone(), set, normals)
     }
 }
 
@@ -214,9 +269,6 @@ pub trait ErbsNet: Clone + PartialEq + Debug + Sized {
     /// How far `built` (an ERBS local built from `local`) lies from `local` at its knots, where
     /// it interpolates it.
     fn build_change(local: &Self::Local, built: &Self) -> ShapeChange;
-
-    fn into_object(e: ErbsEdit<Self>) -> ObjectEdit;
-    fn from_object(e: &ObjectEdit) -> Option<&ErbsEdit<Self>>;
 }
 
 /// An edit of one local curve or patch.
@@ -507,7 +559,10 @@ impl<N: ErbsNet> ErbsEdit<N> {
     }
 }
 
-impl<N: ErbsNet> KindEdit for ErbsEdit<N> {
+impl<N: ErbsNet> KindEdit for ErbsEdit<N>
+where
+    ErbsEdit<N>: IntoObject,
+{
     type Model = N::Model;
 
     fn validate(&self, m: &N::Model) -> Result<(), EditError> {
@@ -534,14 +589,6 @@ impl<N: ErbsNet> KindEdit for ErbsEdit<N> {
             (ErbsEdit::Local(a), ErbsEdit::Local(b)) => a.merge(b).map(ErbsEdit::Local),
             _ => None,
         }
-    }
-
-    fn into_object(self) -> ObjectEdit {
-        N::into_object(self)
-    }
-
-    fn from_object(e: &ObjectEdit) -> Option<&Self> {
-        N::from_object(e)
     }
 }
 
@@ -700,17 +747,6 @@ impl ErbsNet for ErbsCurve {
         let at = erbs_knot_probes(built.knots());
         shape_change(local, &Self::wrap(built.clone()), &at)
     }
-
-    fn into_object(e: ErbsEdit<Self>) -> ObjectEdit {
-        ObjectEdit::ErbsCurve(e)
-    }
-
-    fn from_object(e: &ObjectEdit) -> Option<&ErbsEdit<Self>> {
-        match e {
-            ObjectEdit::ErbsCurve(e) => Some(e),
-            _ => None,
-        }
-    }
 }
 
 impl ErbsNet for ErbsSurface {
@@ -839,17 +875,6 @@ impl ErbsNet for ErbsSurface {
     fn build_change(local: &LocalPatch, built: &Self) -> ShapeChange {
         let at = built.knots().each_ref().map(erbs_knot_probes);
         shape_change(local, &Self::wrap(built.clone()), &at)
-    }
-
-    fn into_object(e: ErbsEdit<Self>) -> ObjectEdit {
-        ObjectEdit::ErbsSurface(e)
-    }
-
-    fn from_object(e: &ObjectEdit) -> Option<&ErbsEdit<Self>> {
-        match e {
-            ObjectEdit::ErbsSurface(e) => Some(e),
-            _ => None,
-        }
     }
 }
 

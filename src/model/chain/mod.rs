@@ -4,11 +4,17 @@
 //! multiplicity d at the junctions); an edit of a user point becomes moves of the few chain
 //! points it changes ([`ChainEdit::chain_points`]), each touching only its segments' samples.
 
-use super::edit::{EditError, KindEdit, ObjectEdit, Target};
-use super::points::{PointEdit, check_index, check_vector};
-use super::{CurveModel, Index2, MAX_CURVE_SAMPLES, SplineForm, check_samples};
+pub mod sampler;
+
 use crate::geom::{BezierSpline, CatmullRom, GeomError};
+use crate::model::Kind;
+use crate::model::edit::{EditError, KindEdit, Target};
+use crate::model::points::{PointEdit, check_index, check_vector};
+use crate::model::registry::Model;
+use crate::model::{CurveModel, Index2, MAX_CURVE_SAMPLES, SplineForm, check_samples};
+use crate::sampling::SampleMode;
 use glam::DVec3;
+use sampler::ChainCurveSampler;
 
 /// A curve kind pre-evaluated as the B-spline of its Bézier chain.
 pub trait ChainModel: Clone + std::fmt::Debug {
@@ -125,17 +131,6 @@ impl KindEdit for CatmullRomEdit {
     fn merge(&self, next: &Self) -> Option<Self> {
         let (CatmullRomEdit::Point(a), CatmullRomEdit::Point(b)) = (self, next);
         a.merge(b).map(CatmullRomEdit::Point)
-    }
-
-    fn into_object(self) -> ObjectEdit {
-        ObjectEdit::CatmullRom(self)
-    }
-
-    fn from_object(e: &ObjectEdit) -> Option<&Self> {
-        match e {
-            ObjectEdit::CatmullRom(e) => Some(e),
-            _ => None,
-        }
     }
 }
 
@@ -269,17 +264,6 @@ impl KindEdit for BezierSplineEdit {
             _ => None,
         }
     }
-
-    fn into_object(self) -> ObjectEdit {
-        ObjectEdit::BezierSpline(self)
-    }
-
-    fn from_object(e: &ObjectEdit) -> Option<&Self> {
-        match e {
-            ObjectEdit::BezierSpline(e) => Some(e),
-            _ => None,
-        }
-    }
 }
 
 impl ChainEdit for BezierSplineEdit {
@@ -292,6 +276,60 @@ impl ChainEdit for BezierSplineEdit {
                 .unwrap_or_default(),
             BezierSplineEdit::Set { values, .. } => values.iter().map(|&(i, _)| i).collect(),
         }
+    }
+}
+
+impl Kind for CatmullRomModel {
+    type Edit = CatmullRomEdit;
+    type Sampler = ChainCurveSampler<CatmullRomEdit>;
+    const SURFACE: bool = false;
+    const LABEL: &'static str = "Catmull–Rom";
+
+    fn type_name(&self) -> &'static str {
+        "catmull_rom"
+    }
+
+    fn sample_dims(&self) -> [usize; 2] {
+        [self.samples, 1]
+    }
+
+    fn domain(&self) -> Vec<(f64, f64)> {
+        vec![self.spline.domain()]
+    }
+
+    fn sampler(&self, mode: SampleMode) -> Self::Sampler {
+        ChainCurveSampler::new(self.clone(), mode.layout().0)
+    }
+
+    fn to_bspline_curve(&self) -> Option<Model> {
+        Some(Model::Curve(self.chain_form()))
+    }
+}
+
+impl Kind for BezierSplineModel {
+    type Edit = BezierSplineEdit;
+    type Sampler = ChainCurveSampler<BezierSplineEdit>;
+    const SURFACE: bool = false;
+    const LABEL: &'static str = "Bézier spline";
+
+    fn type_name(&self) -> &'static str {
+        "bezier_spline"
+    }
+
+    fn sample_dims(&self) -> [usize; 2] {
+        [self.samples, 1]
+    }
+
+    fn domain(&self) -> Vec<(f64, f64)> {
+        vec![self.spline.domain()]
+    }
+
+    fn sampler(&self, mode: SampleMode) -> Self::Sampler {
+        ChainCurveSampler::new(self.clone(), mode.layout().0)
+    }
+
+    fn to_bspline_curve(&self) -> Option<Model> {
+        Some(Model::Curve(self.chain_form()))
     }
 }
 

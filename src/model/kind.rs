@@ -1,0 +1,210 @@
+//! What an object kind is: one trait, implemented once per kind in the kind's own module, and
+//! the object-safe views of it ([`DynKind`], [`DynEdit`], [`DynSampler`]) through which the
+//! registered kinds ([`super::registry`]) are reached without a `match` in every layer.
+
+use super::edit::{EditError, KindEdit, Target};
+use super::registry::{Model, ModelRef, ObjectEdit, SampledObject};
+use crate::sampling::{DirtyRegion, PartialSet, SampleGrid, SampleMode, Sampler, Tracked};
+use std::fmt::Debug;
+
+/// An object kind: its model type (this trait's implementor), its edits and its sampler.
+pub trait Kind: Clone + Debug + PartialEq + Sized + 'static {
+    type Edit: KindEdit<Model = Self>;
+    type Sampler: Sampler<Model = Self, Edit = Self::Edit> + Clone + Debug;
+
+    /// Whether the samples form a surface grid (else a curve).
+    const SURFACE: bool;
+
+    /// The kind's name in messages ("curve", "ERBS surface", …).
+    const LABEL: &'static str;
+
+    /// The scene-file `type` of this model.
+    fn type_name(&self) -> &'static str;
+
+    /// Sample grid dimensions: [m, 1] for curves, [mu, mv] for surfaces.
+    fn sample_dims(&self) -> [usize; 2];
+
+    /// Parameter domain per direction (one entry for curves).
+    fn domain(&self) -> Vec<(f64, f64)>;
+
+    /// Pre-evaluates and fully samples the model.
+    fn sampler(&self, mode: SampleMode) -> Self::Sampler;
+
+    /// The equivalent `bspline_curve` of a kind that is a chain of Bézier segments.
+    fn to_bspline_curve(&self) -> Option<Model> {
+        None
+    }
+}
+
+/// A [`Kind`] behind a reference, for code that holds a model of any kind.
+pub trait DynKind {
+    fn type_name(&self) -> &'static str;
+    fn is_surface(&self) -> bool;
+    fn sample_dims(&self) -> [usize; 2];
+    fn domain(&self) -> Vec<(f64, f64)>;
+    fn to_model(&self) -> Model;
+    fn sampled(&self, mode: SampleMode) -> SampledObject;
+    fn to_bspline_curve(&self) -> Option<Model>;
+    /// Applies an edit of this kind to the model (another kind's is an error).
+    fn apply(&mut self, edit: &ObjectEdit) -> Result<(), EditError>;
+    fn validate(&self, edit: &ObjectEdit) -> Result<(), EditError>;
+    fn inverse(&self, edit: &ObjectEdit) -> Result<ObjectEdit, EditError>;
+}
+
+/// The error for an edit paired with a model of another kind.
+pub fn edit_kind_mismatch(e: &ObjectEdit, model_type: &str) -> EditError {
+    EditError::new(
+        "object",
+        format!("a {} edit does not apply to a {model_type}", e.kind_name()),
+    )
+}
+
+impl<K> DynKind for K
+where
+    K: Kind,
+    Model: From<K>,
+    SampledObject: From<Tracked<K::Sampler>>,
+{
+    fn type_name(&self) -> &'static str {
+        Kind::type_name(self)
+    }
+
+    fn is_surface(&self) -> bool {
+        K::SURFACE
+    }
+
+    fn sample_dims(&self) -> [usize; 2] {
+        Kind::sample_dims(self)
+    }
+
+    fn domain(&self) -> Vec<(f64, f64)> {
+        Kind::domain(self)
+    }
+
+    fn to_model(&self) -> Model {
+        Model::from(self.clone())
+    }
+
+    fn sampled(&self, mode: SampleMode) -> SampledObject {
+        SampledObject::from(Tracked::new(self.sampler(mode)))
+    }
+
+    fn to_bspline_curve(&self) -> Option<Model> {
+        Kind::to_bspline_curve(self)
+    }
+
+    fn apply(&mut self, edit: &ObjectEdit) -> Result<(), EditError> {
+        let e = K::Edit::from_object(edit)
+            .ok_or_else(|| edit_kind_mismatch(edit, Kind::type_name(self)))?;
+        e.apply(self);
+        Ok(())
+    }
+
+    fn validate(&self, edit: &ObjectEdit) -> Result<(), EditError> {
+        K::Edit::from_object(edit)
+            .ok_or_else(|| edit_kind_mismatch(edit, Kind::type_name(self)))?
+            .validate(self)
+    }
+
+    fn inverse(&self, edit: &ObjectEdit) -> Result<ObjectEdit, EditError> {
+        let e = K::Edit::from_object(edit)
+            .ok_or_else(|| edit_kind_mismatch(edit, Kind::type_name(self)))?;
+        Ok(e.inverse(self).into_object())
+    }
+}
+
+/// A [`KindEdit`] behind a reference.
+pub trait DynEdit {
+    /// The kind's name in messages.
+    fn kind_label(&self) -> &'static str;
+    fn target(&self) -> Target;
+    /// This edit followed by `next` as one, when both act on one target and combine.
+    fn merge(&self, next: &ObjectEdit) -> Option<ObjectEdit>;
+}
+
+impl<E> DynEdit for E
+where
+    E: KindEdit,
+    E::Model: Kind,
+{
+    fn kind_label(&self) -> &'static str {
+        <E::Model as Kind>::LABEL
+    }
+
+    fn target(&self) -> Target {
+        KindEdit::target(self)
+    }
+
+    fn merge(&self, next: &ObjectEdit) -> Option<ObjectEdit> {
+        let next = E::from_object(next)?;
+        KindEdit::merge(self, next).map(KindEdit::into_object)
+    }
+}
+
+/// A kind's tracked sampler behind a reference.
+pub trait DynSampler {
+    fn model(&self) -> ModelRef<'_>;
+    fn grid(&self) -> &SampleGrid;
+    fn params(&self) -> Vec<&[f64]>;
+    fn interval(&self) -> Option<usize>;
+    fn set_interval(&mut self, every: Option<usize>);
+    /// Applies an edit of the sampler's kind through the delta path. Edits arrive validated;
+    /// checking again costs a few comparisons and keeps a stale index (say, after an undone
+    /// refinement) from ever reaching the kernels.
+    fn apply(&mut self, edit: &ObjectEdit) -> Result<DirtyRegion, EditError>;
+    fn rebuild_touched(&mut self) -> DirtyRegion;
+    fn full(&mut self) -> DirtyRegion;
+}
+
+impl<S> DynSampler for Tracked<S>
+where
+    S: Sampler,
+    S::Edit: KindEdit<Model = S::Model>,
+    S::Model: Kind<Edit = S::Edit>,
+    for<'a> ModelRef<'a>: From<&'a S::Model>,
+{
+    fn model(&self) -> ModelRef<'_> {
+        ModelRef::from(Sampler::model(self))
+    }
+
+    fn grid(&self) -> &SampleGrid {
+        Sampler::grid(self)
+    }
+
+    fn params(&self) -> Vec<&[f64]> {
+        Sampler::params(self)
+    }
+
+    fn interval(&self) -> Option<usize> {
+        self.interval
+    }
+
+    fn set_interval(&mut self, every: Option<usize>) {
+        self.interval = every;
+    }
+
+    fn apply(&mut self, edit: &ObjectEdit) -> Result<DirtyRegion, EditError> {
+        let model = Sampler::model(self);
+        let e = <S::Edit as KindEdit>::from_object(edit)
+            .ok_or_else(|| edit_kind_mismatch(edit, Kind::type_name(model)))?;
+        e.validate(model)?;
+        Ok(Sampler::apply(self, e))
+    }
+
+    fn rebuild_touched(&mut self) -> DirtyRegion {
+        Tracked::rebuild_touched(self)
+    }
+
+    fn full(&mut self) -> DirtyRegion {
+        Sampler::full(self)
+    }
+}
+
+/// What a sampler keeps per sample, read back from its grid.
+pub(super) fn mode_of(grid: &SampleGrid) -> SampleMode {
+    match (&grid.partials, grid.normals.is_some()) {
+        (PartialSet::Curve(1), _) | (PartialSet::Shading, true) => SampleMode::Render,
+        (PartialSet::Curvature, true) => SampleMode::Analysis,
+        (p, _) => SampleMode::Derivatives(p.max_order()),
+    }
+}

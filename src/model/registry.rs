@@ -1,0 +1,426 @@
+//! The closed sums over the registered kinds: [`Model`], [`ModelRef`], [`ObjectEdit`] and
+//! [`SampledObject`], generated from the one list in `model/mod.rs` by [`kinds!`]. Everything
+//! they do goes through the [`Kind`](super::kind::Kind) implementation of the kind inside, via
+//! the object-safe views of `model::kind`: nothing here names a kind.
+
+use super::edit::{EditError, Target};
+use super::kind::mode_of;
+use crate::sampling::{DirtyRegion, SampleGrid, SampleMode};
+
+/// A kind's edit as an [`ObjectEdit`] and back (implemented for each registered kind's edit;
+/// used through [`KindEdit::into_object`](super::KindEdit::into_object) and
+/// [`KindEdit::from_object`](super::KindEdit::from_object)).
+pub trait IntoObject: Sized {
+    #[must_use]
+    fn wrap(self) -> ObjectEdit;
+
+    fn unwrap(e: &ObjectEdit) -> Option<&Self>;
+}
+
+/// Declares the kinds: `Variant(ModelType)` each, once. Generates the four sums over them and
+/// the conversions into them; the rest of this module is written against the sums.
+macro_rules! kinds {
+    ($($v:ident($m:ty)),+ $(,)?) => {
+        /// Every object kind with its geometry and sample counts.
+        #[derive(Debug, Clone, PartialEq)]
+        pub enum Model {
+            $($v($m),)+
+        }
+
+        /// A borrowed [`Model`] (samplers own their kind's model; this is how others read it).
+        #[derive(Debug, Clone, Copy, PartialEq)]
+        pub enum ModelRef<'a> {
+            $($v(&'a $m),)+
+        }
+
+        /// An edit of any kind.
+        #[derive(Debug, Clone, PartialEq)]
+        pub enum ObjectEdit {
+            $($v(<$m as $crate::model::Kind>::Edit),)+
+            /// Replace the whole model, possibly by one of another kind with the same sample
+            /// counts (conversion of a Catmull–Rom or Bézier spline to its `bspline_curve`, and
+            /// its undo).
+            Replace(Box<Model>),
+        }
+
+        /// A scene object with pre-evaluation data and its canonical sample grid.
+        #[derive(Debug, Clone)]
+        pub enum SampledObject {
+            $($v($crate::sampling::Tracked<<$m as $crate::model::Kind>::Sampler>),)+
+        }
+
+        $(
+            impl IntoObject for <$m as $crate::model::Kind>::Edit {
+                fn wrap(self) -> ObjectEdit {
+                    ObjectEdit::$v(self)
+                }
+
+                fn unwrap(e: &ObjectEdit) -> Option<&Self> {
+                    match e {
+                        ObjectEdit::$v(x) => Some(x),
+                        _ => None,
+                    }
+                }
+            }
+
+            impl From<$m> for Model {
+                fn from(m: $m) -> Self {
+                    Model::$v(m)
+                }
+            }
+
+            impl<'a> From<&'a $m> for ModelRef<'a> {
+                fn from(m: &'a $m) -> Self {
+                    ModelRef::$v(m)
+                }
+            }
+
+            impl From<$crate::sampling::Tracked<<$m as $crate::model::Kind>::Sampler>>
+                for SampledObject
+            {
+                fn from(s: $crate::sampling::Tracked<<$m as $crate::model::Kind>::Sampler>) -> Self {
+                    SampledObject::$v(s)
+                }
+            }
+        )+
+
+        impl Model {
+            /// The model's kind.
+            #[must_use]
+            pub fn kind(&self) -> &dyn $crate::model::kind::DynKind {
+                match self {
+                    $(Model::$v(m) => m,)+
+                }
+            }
+
+            fn kind_mut(&mut self) -> &mut dyn $crate::model::kind::DynKind {
+                match self {
+                    $(Model::$v(m) => m,)+
+                }
+            }
+
+            #[must_use]
+            pub fn as_ref(&self) -> ModelRef<'_> {
+                match self {
+                    $(Model::$v(m) => ModelRef::$v(m),)+
+                }
+            }
+        }
+
+        impl<'a> ModelRef<'a> {
+            /// The model's kind.
+            #[must_use]
+            pub fn kind(&self) -> &'a dyn $crate::model::kind::DynKind {
+                match *self {
+                    $(ModelRef::$v(m) => m,)+
+                }
+            }
+        }
+
+        impl ObjectEdit {
+            /// The kind's edit inside (`None` for a replacement).
+            fn as_dyn(&self) -> Option<&dyn $crate::model::kind::DynEdit> {
+                match self {
+                    $(ObjectEdit::$v(e) => Some(e),)+
+                    ObjectEdit::Replace(_) => None,
+                }
+            }
+        }
+
+        impl SampledObject {
+            fn sampler(&self) -> &dyn $crate::model::kind::DynSampler {
+                match self {
+                    $(SampledObject::$v(s) => s,)+
+                }
+            }
+
+            fn sampler_mut(&mut self) -> &mut dyn $crate::model::kind::DynSampler {
+                match self {
+                    $(SampledObject::$v(s) => s,)+
+                }
+            }
+        }
+    };
+}
+
+registered_kinds!(kinds);
+
+impl Model {
+    /// The scene-file `type` string.
+    #[must_use]
+    pub fn type_name(&self) -> &'static str {
+        self.kind().type_name()
+    }
+
+    #[must_use]
+    pub fn is_surface(&self) -> bool {
+        self.kind().is_surface()
+    }
+
+    /// Sample grid dimensions: [m, 1] for curves, [mu, mv] for surfaces.
+    #[must_use]
+    pub fn sample_dims(&self) -> [usize; 2] {
+        self.kind().sample_dims()
+    }
+
+    /// Parameter domain per direction (one entry for curves).
+    #[must_use]
+    pub fn domain(&self) -> Vec<(f64, f64)> {
+        self.kind().domain()
+    }
+
+    /// Applies a validated edit of this object's kind (a kind mismatch is an error).
+    pub fn apply(&mut self, edit: &ObjectEdit) -> Result<(), EditError> {
+        match edit {
+            ObjectEdit::Replace(new) => {
+                *self = (**new).clone();
+                Ok(())
+            }
+            e => self.kind_mut().apply(e),
+        }
+    }
+}
+
+impl<'a> ModelRef<'a> {
+    #[must_use]
+    pub fn type_name(&self) -> &'static str {
+        self.kind().type_name()
+    }
+
+    #[must_use]
+    pub fn is_surface(&self) -> bool {
+        self.kind().is_surface()
+    }
+
+    #[must_use]
+    pub fn sample_dims(&self) -> [usize; 2] {
+        self.kind().sample_dims()
+    }
+
+    #[must_use]
+    pub fn domain(&self) -> Vec<(f64, f64)> {
+        self.kind().domain()
+    }
+
+    /// The equivalent B-spline curve (Catmull–Rom and Bézier splines: their Bézier chain), or
+    /// `None` for kinds that are not such a chain.
+    #[must_use]
+    pub fn to_bspline_curve(&self) -> Option<Model> {
+        self.kind().to_bspline_curve()
+    }
+
+    /// An owned copy.
+    #[must_use]
+    pub fn to_model(&self) -> Model {
+        self.kind().to_model()
+    }
+}
+
+impl ObjectEdit {
+    #[must_use]
+    pub fn target(&self) -> Target {
+        self.as_dyn().map_or(Target::Structure, |e| e.target())
+    }
+
+    /// Whether the edit changes the object's structure (knots, degree, control counts).
+    #[must_use]
+    pub fn is_structural(&self) -> bool {
+        self.target() == Target::Structure
+    }
+
+    /// The two as one edit, when they act on one target and combine.
+    #[must_use]
+    pub fn merge(&self, next: &ObjectEdit) -> Option<ObjectEdit> {
+        self.as_dyn()?.merge(next)
+    }
+
+    /// Checks the edit against a model (of its own kind).
+    pub fn validate(&self, model: ModelRef<'_>) -> Result<(), EditError> {
+        match self {
+            ObjectEdit::Replace(new) => check_replacement(new.as_ref().as_ref(), model),
+            e => model.kind().validate(e),
+        }
+    }
+
+    /// The edit restoring `model` as it is before this edit, or an error on a kind mismatch.
+    pub fn inverse(&self, model: ModelRef<'_>) -> Result<ObjectEdit, EditError> {
+        match self {
+            ObjectEdit::Replace(_) => Ok(ObjectEdit::Replace(Box::new(model.to_model()))),
+            e => model.kind().inverse(e),
+        }
+    }
+
+    /// The kind's name for messages: "curve", "ERBS surface", "replacement"…
+    #[must_use]
+    pub fn kind_name(&self) -> &'static str {
+        self.as_dyn().map_or("replacement", |e| e.kind_label())
+    }
+}
+
+/// A replacement keeps the sample grid (curve or surface, and its counts), so samplers and GPU
+/// mirrors keep their size.
+fn check_replacement(new: ModelRef<'_>, old: ModelRef<'_>) -> Result<(), EditError> {
+    if new.is_surface() == old.is_surface() && new.sample_dims() == old.sample_dims() {
+        Ok(())
+    } else {
+        Err(EditError::new(
+            "object",
+            format!(
+                "a {} with samples {:?} cannot replace a {} with samples {:?}",
+                new.type_name(),
+                new.sample_dims(),
+                old.type_name(),
+                old.sample_dims()
+            ),
+        ))
+    }
+}
+
+impl SampledObject {
+    /// Pre-evaluates and fully samples `model`.
+    #[must_use]
+    pub fn new(model: &Model, mode: SampleMode) -> Self {
+        model.kind().sampled(mode)
+    }
+
+    /// The sample mode this object was built with.
+    #[must_use]
+    pub fn mode(&self) -> SampleMode {
+        mode_of(self.grid())
+    }
+
+    /// `None` disables the periodic exact rebuild (to measure raw drift in tests).
+    pub fn set_rebuild_interval(&mut self, every: Option<usize>) {
+        self.sampler_mut().set_interval(every);
+    }
+
+    /// The current model by reference (no copy).
+    #[must_use]
+    pub fn model(&self) -> ModelRef<'_> {
+        self.sampler().model()
+    }
+
+    #[must_use]
+    pub fn type_name(&self) -> &'static str {
+        self.model().type_name()
+    }
+
+    #[must_use]
+    pub fn grid(&self) -> &SampleGrid {
+        self.sampler().grid()
+    }
+
+    /// Sample parameters per direction.
+    #[must_use]
+    pub fn params(&self) -> Vec<&[f64]> {
+        self.sampler().params()
+    }
+
+    /// Applies an edit through the delta path; returns the samples it touched (including any
+    /// periodic rebuild's). An edit of another kind, or one that does not fit the model, is an
+    /// error and changes nothing.
+    pub fn apply(&mut self, edit: &ObjectEdit) -> Result<DirtyRegion, EditError> {
+        if let ObjectEdit::Replace(model) = edit {
+            edit.validate(self.model())?;
+            let interval = self.sampler().interval();
+            *self = SampledObject::new(model, self.mode());
+            self.set_rebuild_interval(interval);
+            let [rows, cols] = self.grid().dims;
+            return Ok(DirtyRegion::surface(0..rows, 0..cols));
+        }
+        self.sampler_mut().apply(edit)
+    }
+
+    /// Exact re-evaluation of everything touched since the last rebuild (drift reset).
+    pub fn rebuild_touched(&mut self) -> DirtyRegion {
+        self.sampler_mut().rebuild_touched()
+    }
+
+    /// Full sampling from the pre-evaluated data, as the constructor does.
+    pub fn rebuild_all(&mut self) -> DirtyRegion {
+        self.sampler_mut().full()
+    }
+
+    /// Samples in the grid (rows × cols).
+    #[must_use]
+    pub fn sample_count(&self) -> usize {
+        let [a, b] = self.grid().dims;
+        a * b
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::{BSplineCurve, KnotVector, TensorSurface};
+    use crate::model::{
+        CurveEdit, CurveModel, KindEdit, PointEdit, SplineForm, SurfaceEdit, SurfaceModel,
+    };
+    use glam::DVec3;
+
+    /// A mirror that copies exactly the rows each edit reports, as the GPU mirrors do, must equal
+    /// the grid after every edit.
+    fn mirror_follows(obj: &mut SampledObject, edits: &[ObjectEdit]) {
+        let stride = obj.grid().stride();
+        let cols = obj.grid().dims[1];
+        let mut mirror = obj.grid().data.clone();
+        let bits = |v: &[DVec3]| -> Vec<[u64; 3]> {
+            v.iter().map(|p| p.to_array().map(f64::to_bits)).collect()
+        };
+        for (k, e) in edits.iter().enumerate() {
+            let region = obj.apply(e).unwrap();
+            let rows = region.rows.start * cols * stride..region.rows.end * cols * stride;
+            mirror[rows.clone()].copy_from_slice(&obj.grid().data[rows]);
+            assert!(
+                bits(&mirror) == bits(&obj.grid().data),
+                "after edit {k}, a mirror fed the reported regions differs from the grid"
+            );
+        }
+    }
+
+    fn wiggle(k: usize) -> DVec3 {
+        let x = k as f64;
+        DVec3::new((x * 0.7).sin(), (x * 1.3).cos(), (x * 0.37).sin()) * 0.123_456_7
+    }
+
+    #[test]
+    fn apply_reports_what_the_periodic_rebuild_rewrote() {
+        // Edits at both ends of a curve and a surface; every 3rd edit rebuilds everything touched
+        // since the last rebuild, which rewrites the other end's samples with exact values.
+        let n = 12;
+        let pts = (0..n).map(|i| DVec3::new(i as f64, 0.0, 0.0)).collect();
+        let knots = KnotVector::clamped_uniform(3, n, 0.0, 1.0).into_vec();
+        let c = BSplineCurve::new(3, knots.clone(), pts, None).unwrap();
+        let m = CurveModel::new(SplineForm::BSpline, c, 200).unwrap();
+        for mode in [SampleMode::Render, SampleMode::Derivatives(2)] {
+            let mut obj = SampledObject::new(&Model::Curve(m.clone()), mode);
+            obj.set_rebuild_interval(Some(3));
+            let edits: Vec<ObjectEdit> = (0..40)
+                .map(|k| {
+                    let point = if k % 2 == 0 { 1 } else { n - 2 };
+                    let delta = wiggle(k);
+                    CurveEdit::Point(PointEdit::Move { point, delta }).into_object()
+                })
+                .collect();
+            mirror_follows(&mut obj, &edits);
+        }
+        let pts = (0..n * n)
+            .map(|k| DVec3::new((k / n) as f64, (k % n) as f64, 0.0))
+            .collect();
+        let knots2 = KnotVector::clamped_uniform(2, n, 0.0, 1.0).into_vec();
+        let s = TensorSurface::bspline([3, 2], [knots, knots2], [n, n], pts, None).unwrap();
+        let m = SurfaceModel::new(SplineForm::BSpline, s, [40, 30]).unwrap();
+        for mode in [SampleMode::Render, SampleMode::Derivatives(1)] {
+            let mut obj = SampledObject::new(&Model::Surface(m.clone()), mode);
+            obj.set_rebuild_interval(Some(3));
+            let edits: Vec<ObjectEdit> = (0..40)
+                .map(|k| {
+                    let point = if k % 2 == 0 { [1, 1] } else { [n - 2, n - 2] };
+                    let delta = wiggle(k);
+                    SurfaceEdit::Point(PointEdit::Move { point, delta }).into_object()
+                })
+                .collect();
+            mirror_follows(&mut obj, &edits);
+        }
+    }
+}
