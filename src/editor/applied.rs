@@ -1,32 +1,8 @@
 //! The one report an apply gives back: what changed, so that whoever mirrors the document (the
 //! GPU scene, a test's reference copy) copies exactly that and never looks at the edits.
 
+pub use crate::model::controls::ControlsChange;
 use crate::sampling::{DirtyRegion, DirtySet};
-
-/// What happened to one object's control display.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub enum ControlsChange {
-    #[default]
-    Unchanged,
-    /// These display vertices were rewritten in place (the layout is the same).
-    Vertices(DirtySet),
-    /// The layout changed (a refinement, an undone one, a conversion): take it all again.
-    Resized,
-}
-
-impl ControlsChange {
-    /// Both changes as one.
-    fn join(&mut self, other: ControlsChange) {
-        *self = match (std::mem::take(self), other) {
-            (ControlsChange::Resized, _) | (_, ControlsChange::Resized) => ControlsChange::Resized,
-            (ControlsChange::Unchanged, x) | (x, ControlsChange::Unchanged) => x,
-            (ControlsChange::Vertices(mut a), ControlsChange::Vertices(b)) => {
-                b.ranges().iter().for_each(|r| a.insert(r.clone()));
-                ControlsChange::Vertices(a)
-            }
-        };
-    }
-}
 
 /// What an apply changed in one object.
 #[derive(Debug, Clone, Default, PartialEq)]

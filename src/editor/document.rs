@@ -2,14 +2,11 @@
 //! ([`SampledObject`]) and control display, and what can be read and built from it (handles,
 //! bounds, the edits a gesture stands for).
 
-use super::controls::{
-    ControlDisplay, each_curve_leaf, each_curve_leaf_of, each_patch_leaf, each_patch_leaf_of,
-};
 use crate::geom::Bounds;
 use crate::model::SampledObject;
 use crate::model::{
-    BezierSplineEdit, CatmullRomEdit, CurveEdit, Edit, ErbsCurveEdit, ErbsSurfaceEdit, Index2,
-    KindEdit, LocalEdit, LocalPath, Model, ModelRef, ObjectEdit, PointEdit, SurfaceEdit,
+    ControlDisplay, Edit, ErbsCurveEdit, ErbsSurfaceEdit, Grip, Index2, KindEdit, LocalEdit,
+    LocalPath, Model, ModelRef, ObjectEdit, each_curve_leaf_of, each_patch_leaf_of,
 };
 use crate::sampling::SampleMode;
 use crate::scene::{Scene, SceneObject};
@@ -81,6 +78,28 @@ impl Handle {
             Handle::Point { object, .. } | Handle::LocalPoint { object, .. } => object,
         }
     }
+
+    /// The grip within its object.
+    #[must_use]
+    pub fn grip(&self) -> Grip {
+        match *self {
+            Handle::Point { point, .. } => Grip::Point(point),
+            Handle::LocalPoint { local, point, .. } => Grip::LocalPoint { local, point },
+        }
+    }
+
+    /// The handle of `grip` on object `object`.
+    #[must_use]
+    pub fn of(object: usize, grip: Grip) -> Self {
+        match grip {
+            Grip::Point(point) => Handle::Point { object, point },
+            Grip::LocalPoint { local, point } => Handle::LocalPoint {
+                object,
+                local,
+                point,
+            },
+        }
+    }
 }
 
 impl Document {
@@ -130,64 +149,14 @@ impl Document {
     /// have no weight (ERBS local points, Catmull–Rom and Bézier spline handles).
     pub fn weight_of(&self, handle: Handle) -> Option<f64> {
         let model = self.objects.get(handle.object())?.sampled.model();
-        match (handle, model) {
-            (
-                Handle::Point {
-                    point: Index2::One(k),
-                    ..
-                },
-                ModelRef::Curve(c),
-            ) => Some(c.curve().weights().map_or(1.0, |w| w[k])),
-            (
-                Handle::Point {
-                    point: Index2::Two(i, j),
-                    ..
-                },
-                ModelRef::Surface(s),
-            ) => {
-                let s = s.surface();
-                Some(s.weights().map_or(1.0, |w| w[i * s.count()[1] + j]))
-            }
-            _ => None,
-        }
+        model.kind().weight(handle.grip())
     }
 
     /// The edit setting a control point's weight (a polynomial object becomes rational), or
     /// why it cannot be set.
     pub fn set_weight(&self, handle: Handle, weight: f64) -> Result<Edit, String> {
         let model = self.objects[handle.object()].sampled.model();
-        let edit: ObjectEdit = match (handle, model) {
-            (
-                Handle::Point {
-                    point: Index2::One(point),
-                    ..
-                },
-                ModelRef::Curve(_),
-            ) => CurveEdit::Point(PointEdit::Weight { point, weight }).into_object(),
-            (
-                Handle::Point {
-                    point: Index2::Two(i, j),
-                    ..
-                },
-                ModelRef::Surface(_),
-            ) => SurfaceEdit::Point(PointEdit::Weight {
-                point: [i, j],
-                weight,
-            })
-            .into_object(),
-            (_, ModelRef::CatmullRom(_) | ModelRef::BezierSpline(_)) => {
-                return Err(format!(
-                    "a {} has no weights: B converts it to a bspline_curve first",
-                    model.type_name()
-                ));
-            }
-            _ => {
-                return Err(format!(
-                    "the points of an {} have no weights",
-                    model.type_name()
-                ));
-            }
-        };
+        let edit = model.kind().weight_edit(handle.grip(), weight)?;
         edit.validate(model).map_err(|e| e.to_string())?;
         Ok(Edit {
             object: handle.object(),
@@ -225,85 +194,15 @@ impl Document {
         b
     }
 
-    /// Every pickable control point of object `i` with its position (no sampling: cheap).
+    /// Every pickable control point of object `i` with its position: the points its control
+    /// display draws (no sampling: cheap).
     pub fn handles(&self, i: usize) -> Vec<(Handle, DVec3)> {
-        let object = i;
-        let polygon = |points: Vec<DVec3>| {
-            points
-                .into_iter()
-                .enumerate()
-                .map(|(k, q)| {
-                    let point = Index2::One(k);
-                    (Handle::Point { object, point }, q)
-                })
-                .collect()
-        };
-        let local_points = |path: LocalPath<Index2>, pts: &[DVec3], cols: usize| {
-            pts.iter()
-                .enumerate()
-                .map(|(q, &p)| {
-                    let point = match q.checked_div(cols) {
-                        None => Index2::One(q),
-                        Some(a) => Index2::Two(a, q % cols),
-                    };
-                    (
-                        Handle::LocalPoint {
-                            object,
-                            local: path,
-                            point,
-                        },
-                        p,
-                    )
-                })
-                .collect::<Vec<_>>()
-        };
-        match self.objects[i].sampled.model() {
-            ModelRef::CatmullRom(c) => polygon(c.spline().points().to_vec()),
-            ModelRef::BezierSpline(c) => polygon(c.spline().handles()),
-            ModelRef::Curve(c) => c
-                .curve()
-                .points()
-                .iter()
-                .enumerate()
-                .map(|(k, &q)| {
-                    (
-                        Handle::Point {
-                            object,
-                            point: Index2::One(k),
-                        },
-                        q,
-                    )
-                })
-                .collect(),
-            ModelRef::Surface(s) => {
-                let s = s.surface();
-                let cols = s.count()[1];
-                s.points()
-                    .iter()
-                    .enumerate()
-                    .map(|(k, &q)| {
-                        (
-                            Handle::Point {
-                                object,
-                                point: Index2::Two(k / cols, k % cols),
-                            },
-                            q,
-                        )
-                    })
-                    .collect()
-            }
-            ModelRef::ErbsCurve(c) => each_curve_leaf(c.curve(), None)
-                .into_iter()
-                .flat_map(|(path, l)| local_points(path, l.points().unwrap_or(&[]), 0))
-                .collect(),
-            ModelRef::ErbsSurface(s) => each_patch_leaf(s.surface(), None)
-                .into_iter()
-                .flat_map(|(path, p)| match p.net() {
-                    Some(([_, nc], pts)) => local_points(path, pts, nc),
-                    None => Vec::new(),
-                })
-                .collect(),
-        }
+        self.objects[i]
+            .controls
+            .grips()
+            .into_iter()
+            .map(|(grip, p)| (Handle::of(i, grip), p))
+            .collect()
     }
 
     /// Every pickable control point of the document.
@@ -316,67 +215,7 @@ impl Document {
     /// The edit that moves a handle by `delta` (`None` if the handle does not fit its object).
     pub fn move_handle(&self, handle: Handle, delta: DVec3) -> Option<Edit> {
         let model = self.objects.get(handle.object())?.sampled.model();
-        let edit = match (handle, model) {
-            (
-                Handle::Point {
-                    point: Index2::One(point),
-                    ..
-                },
-                ModelRef::Curve(_),
-            ) => CurveEdit::Point(PointEdit::Move { point, delta }).into_object(),
-            (
-                Handle::Point {
-                    point: Index2::One(point),
-                    ..
-                },
-                ModelRef::CatmullRom(_),
-            ) => CatmullRomEdit::Point(PointEdit::Move { point, delta }).into_object(),
-            (
-                Handle::Point {
-                    point: Index2::One(point),
-                    ..
-                },
-                ModelRef::BezierSpline(_),
-            ) => BezierSplineEdit::Move { point, delta }.into_object(),
-            (
-                Handle::Point {
-                    point: Index2::Two(i, j),
-                    ..
-                },
-                ModelRef::Surface(_),
-            ) => SurfaceEdit::Point(PointEdit::Move {
-                point: [i, j],
-                delta,
-            })
-            .into_object(),
-            (
-                Handle::LocalPoint {
-                    local,
-                    point: Index2::One(point),
-                    ..
-                },
-                ModelRef::ErbsCurve(_),
-            ) => ErbsCurveEdit::Local(LocalEdit::MovePoint {
-                local: local.to_curve()?,
-                point,
-                delta,
-            })
-            .into_object(),
-            (
-                Handle::LocalPoint {
-                    local,
-                    point: Index2::Two(a, b),
-                    ..
-                },
-                ModelRef::ErbsSurface(_),
-            ) => ErbsSurfaceEdit::Local(LocalEdit::MovePoint {
-                local: local.to_surface()?,
-                point: [a, b],
-                delta,
-            })
-            .into_object(),
-            _ => return None,
-        };
+        let edit = model.kind().move_edit(handle.grip(), delta)?;
         Some(Edit {
             object: handle.object(),
             edit,

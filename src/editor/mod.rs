@@ -9,14 +9,13 @@
 //! editor looks at an edit again.
 
 pub mod applied;
-pub mod controls;
 pub mod document;
 pub mod pipeline;
 pub mod undo;
 
-pub use applied::{Applied, ControlsChange, ObjectChange};
-pub use controls::{
-    ControlDisplay, ControlLayout, LOCAL_CURVE_SAMPLES, LOCAL_PATCH_SAMPLES, LocalEntry,
+pub use crate::model::controls::{
+    ControlDisplay, ControlLayout, Grip, LOCAL_CURVE_SAMPLES, LOCAL_PATCH_SAMPLES, LocalEntry,
 };
+pub use applied::{Applied, ControlsChange, ObjectChange};
 pub use document::{DocObject, Document, Handle};
 pub use pipeline::{Editor, EditorOptions, ListRefused, Refused};

@@ -2,7 +2,7 @@
 //! pre-evaluation). Slow; used to check the engine.
 
 use crate::geom::knots::uniform_params;
-use crate::model::{ChainModel, ModelRef};
+use crate::model::ModelRef;
 use crate::sampling::{PartialSet, SampleGrid};
 
 /// Samples `model` point by point through the geometry layer's own evaluators.
@@ -28,29 +28,7 @@ pub fn exact_grid(model: ModelRef<'_>, set: &PartialSet) -> SampleGrid {
     for (i, &u) in pu.iter().enumerate() {
         for (j, &v) in pv.iter().enumerate() {
             let out = grid.sample_mut(i, j);
-            match model {
-                ModelRef::Curve(m) => out.copy_from_slice(&m.curve().derivatives(u, g)),
-                ModelRef::ErbsCurve(m) => out.copy_from_slice(&m.curve().derivatives(u, g)),
-                ModelRef::Surface(m) => {
-                    let p = m.surface().derivatives(u, v, g);
-                    for (slot, &(a, b)) in list.iter().enumerate() {
-                        out[slot] = p.get(a, b);
-                    }
-                }
-                ModelRef::ErbsSurface(m) => {
-                    let p = m.surface().derivatives(u, v, g);
-                    for (slot, &(a, b)) in list.iter().enumerate() {
-                        out[slot] = p.get(a, b);
-                    }
-                }
-                // Converted above; this is the same evaluation, only slower.
-                ModelRef::CatmullRom(m) => {
-                    out.copy_from_slice(&m.chain_form().curve().derivatives(u, g))
-                }
-                ModelRef::BezierSpline(m) => {
-                    out.copy_from_slice(&m.chain_form().curve().derivatives(u, g))
-                }
-            }
+            model.kind().derivatives_at([u, v], g, &list, out);
         }
     }
     grid

@@ -2,9 +2,12 @@
 //! the object-safe views of it ([`DynKind`], [`DynEdit`], [`DynSampler`]) through which the
 //! registered kinds ([`super::registry`]) are reached without a `match` in every layer.
 
+use super::controls::{ControlDisplay, Grip};
 use super::edit::{EditError, KindEdit, Target};
 use super::registry::{Model, ModelRef, ObjectEdit, SampledObject};
+use super::{Index2, LocalPath};
 use crate::sampling::{DirtyRegion, PartialSet, SampleGrid, SampleMode, Sampler, Tracked};
+use glam::DVec3;
 use std::fmt::Debug;
 
 /// An object kind: its model type (this trait's implementor), its edits and its sampler.
@@ -34,6 +37,54 @@ pub trait Kind: Clone + Debug + PartialEq + Sized + 'static {
     fn to_bspline_curve(&self) -> Option<Model> {
         None
     }
+
+    /// Exact evaluation by the geometry layer's own evaluators (no pre-evaluation), for the
+    /// reference path: at `uv` ([u, 0] on curves) the derivatives up to `order` — curves write
+    /// C, C', …; surfaces write the partials `list` names, (a, b) = ∂^(a+b)/∂u^a∂v^b.
+    fn derivatives_at(
+        &self,
+        uv: [f64; 2],
+        order: usize,
+        list: &[(usize, usize)],
+        out: &mut [DVec3],
+    );
+
+    /// The parameters where a chain's Bézier segments meet (kinds built of segments).
+    fn junctions(&self) -> Option<Vec<f64>> {
+        None
+    }
+
+    /// What is drawn and picked besides the samples: the control polygon or net, or the
+    /// polynomial locals of an ERBS object.
+    fn controls(&self) -> ControlDisplay;
+
+    /// One point of the control polygon or net, so a drag rewrites one display vertex; `None`
+    /// where the kind's display is rebuilt instead.
+    fn control_point(&self, _point: Index2) -> Option<DVec3> {
+        None
+    }
+
+    /// The display of the polynomial locals at or below `local` (kinds with locals).
+    fn local_controls(&self, _local: LocalPath<Index2>) -> Option<ControlDisplay> {
+        None
+    }
+
+    /// The edit that moves a grip by `delta` (`None` for a grip the model does not have).
+    fn move_edit(&self, grip: Grip, delta: DVec3) -> Option<Self::Edit>;
+
+    /// The weight of a control point (1 for a polynomial object of a rational kind), `None`
+    /// for grips without one.
+    fn weight(&self, _grip: Grip) -> Option<f64> {
+        None
+    }
+
+    /// The edit setting a grip's weight, or why the kind has none.
+    fn weight_edit(&self, _grip: Grip, _weight: f64) -> Result<Self::Edit, String> {
+        Err(format!(
+            "the points of an {} have no weights",
+            self.type_name()
+        ))
+    }
 }
 
 /// A [`Kind`] behind a reference, for code that holds a model of any kind.
@@ -49,6 +100,20 @@ pub trait DynKind {
     fn apply(&mut self, edit: &ObjectEdit) -> Result<(), EditError>;
     fn validate(&self, edit: &ObjectEdit) -> Result<(), EditError>;
     fn inverse(&self, edit: &ObjectEdit) -> Result<ObjectEdit, EditError>;
+    fn controls(&self) -> ControlDisplay;
+    fn derivatives_at(
+        &self,
+        uv: [f64; 2],
+        order: usize,
+        list: &[(usize, usize)],
+        out: &mut [DVec3],
+    );
+    fn junctions(&self) -> Option<Vec<f64>>;
+    fn control_point(&self, point: Index2) -> Option<DVec3>;
+    fn local_controls(&self, local: LocalPath<Index2>) -> Option<ControlDisplay>;
+    fn move_edit(&self, grip: Grip, delta: DVec3) -> Option<ObjectEdit>;
+    fn weight(&self, grip: Grip) -> Option<f64>;
+    fn weight_edit(&self, grip: Grip, weight: f64) -> Result<ObjectEdit, String>;
 }
 
 /// The error for an edit paired with a model of another kind.
@@ -110,6 +175,44 @@ where
         let e = K::Edit::from_object(edit)
             .ok_or_else(|| edit_kind_mismatch(edit, Kind::type_name(self)))?;
         Ok(e.inverse(self).into_object())
+    }
+
+    fn controls(&self) -> ControlDisplay {
+        Kind::controls(self)
+    }
+
+    fn derivatives_at(
+        &self,
+        uv: [f64; 2],
+        order: usize,
+        list: &[(usize, usize)],
+        out: &mut [DVec3],
+    ) {
+        Kind::derivatives_at(self, uv, order, list, out);
+    }
+
+    fn junctions(&self) -> Option<Vec<f64>> {
+        Kind::junctions(self)
+    }
+
+    fn control_point(&self, point: Index2) -> Option<DVec3> {
+        Kind::control_point(self, point)
+    }
+
+    fn local_controls(&self, local: LocalPath<Index2>) -> Option<ControlDisplay> {
+        Kind::local_controls(self, local)
+    }
+
+    fn move_edit(&self, grip: Grip, delta: DVec3) -> Option<ObjectEdit> {
+        Kind::move_edit(self, grip, delta).map(KindEdit::into_object)
+    }
+
+    fn weight(&self, grip: Grip) -> Option<f64> {
+        Kind::weight(self, grip)
+    }
+
+    fn weight_edit(&self, grip: Grip, weight: f64) -> Result<ObjectEdit, String> {
+        Kind::weight_edit(self, grip, weight).map(KindEdit::into_object)
     }
 }
 

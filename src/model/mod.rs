@@ -24,6 +24,7 @@ macro_rules! registered_kinds {
 }
 
 mod chain;
+pub mod controls;
 mod edit;
 mod erbs;
 pub mod exact;
@@ -36,7 +37,9 @@ pub use chain::sampler::ChainCurveSampler;
 pub use chain::{
     BezierSplineEdit, BezierSplineModel, CatmullRomEdit, CatmullRomModel, ChainEdit, ChainModel,
 };
+pub use controls::{ControlDisplay, ControlLayout, ControlsChange, Grip};
 pub use edit::{Edit, EditError, KindEdit, Target, merge_edits};
+pub use erbs::controls::{each_curve_leaf_of, each_patch_leaf_of};
 pub use erbs::curve_sampler::ErbsCurveSampler;
 pub use erbs::surface_sampler::ErbsSurfaceSampler;
 pub use erbs::{

@@ -33,21 +33,17 @@ impl<'a> CurveEval<'a> {
                 junctions: None,
             },
             ModelRef::ErbsCurve(c) => CurveEval::Erbs(c.curve()),
-            ModelRef::CatmullRom(_) | ModelRef::BezierSpline(_) => {
-                let junctions = match model {
-                    ModelRef::CatmullRom(c) => c.spline().breakpoints(),
-                    ModelRef::BezierSpline(c) => c.spline().knots().to_vec(),
-                    _ => Vec::new(),
-                };
-                let Some(Model::Curve(chain)) = model.to_bspline_curve() else {
+            _ if model.is_surface() => return None,
+            // Chains of Bézier segments: the de Boor form of the chain, with its junctions.
+            other => {
+                let Some(Model::Curve(chain)) = other.to_bspline_curve() else {
                     return None;
                 };
                 CurveEval::BSpline {
                     curve: Cow::Owned(chain.curve().clone()),
-                    junctions: Some(junctions),
+                    junctions: other.kind().junctions(),
                 }
             }
-            ModelRef::Surface(_) | ModelRef::ErbsSurface(_) => return None,
         })
     }
 

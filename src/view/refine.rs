@@ -105,11 +105,15 @@ impl Refine {
     pub fn supported(&self, doc: &Document) -> Result<(), String> {
         let model = doc.objects[self.object].sampled.model();
         match model {
-            ModelRef::CatmullRom(_) | ModelRef::BezierSpline(_) => Err(format!(
+            ModelRef::Curve(_)
+            | ModelRef::Surface(_)
+            | ModelRef::ErbsCurve(_)
+            | ModelRef::ErbsSurface(_) => Ok(()),
+            _ if model.to_bspline_curve().is_some() => Err(format!(
                 "a {} keeps its segments: B converts it to a bspline_curve first",
                 model.type_name()
             )),
-            _ => Ok(()),
+            _ => Err(format!("a {} takes no knots", model.type_name())),
         }
     }
 
@@ -127,9 +131,6 @@ impl Refine {
                 times: 1,
             }
             .into_object(),
-            ModelRef::CatmullRom(_) | ModelRef::BezierSpline(_) => {
-                return Err(self.supported(doc).err().unwrap_or_default());
-            }
             ModelRef::ErbsCurve(_) => ErbsCurveEdit::InsertKnot {
                 local: self.level.and_then(|p| p.to_curve()),
                 at: self.level_parameter(doc, t)?,
@@ -142,6 +143,7 @@ impl Refine {
                 degree: None,
             }
             .into_object(),
+            _ => return Err(self.supported(doc).err().unwrap_or_default()),
         };
         edit.validate(model).map_err(|e| e.to_string())?;
         Ok(Edit {

@@ -8,6 +8,7 @@ pub mod sampler;
 
 use crate::geom::{BezierSpline, CatmullRom, GeomError};
 use crate::model::Kind;
+use crate::model::controls::{ControlDisplay, Grip};
 use crate::model::edit::{EditError, KindEdit, Target};
 use crate::model::points::{PointEdit, check_index, check_vector};
 use crate::model::registry::Model;
@@ -304,6 +305,39 @@ impl Kind for CatmullRomModel {
     fn to_bspline_curve(&self) -> Option<Model> {
         Some(Model::Curve(self.chain_form()))
     }
+
+    fn derivatives_at(
+        &self,
+        [u, _]: [f64; 2],
+        order: usize,
+        _: &[(usize, usize)],
+        out: &mut [DVec3],
+    ) {
+        out.copy_from_slice(&self.chain_form().curve().derivatives(u, order));
+    }
+
+    fn junctions(&self) -> Option<Vec<f64>> {
+        Some(self.spline.breakpoints())
+    }
+
+    /// The interpolated points.
+    fn controls(&self) -> ControlDisplay {
+        ControlDisplay::polygon(self.spline.points().to_vec())
+    }
+
+    fn move_edit(&self, grip: Grip, delta: DVec3) -> Option<CatmullRomEdit> {
+        let Grip::Point(Index2::One(point)) = grip else {
+            return None;
+        };
+        Some(CatmullRomEdit::Point(PointEdit::Move { point, delta }))
+    }
+
+    fn weight_edit(&self, _grip: Grip, _weight: f64) -> Result<Self::Edit, String> {
+        Err(format!(
+            "a {} has no weights: B converts it to a bspline_curve first",
+            self.type_name()
+        ))
+    }
 }
 
 impl Kind for BezierSplineModel {
@@ -330,6 +364,40 @@ impl Kind for BezierSplineModel {
 
     fn to_bspline_curve(&self) -> Option<Model> {
         Some(Model::Curve(self.chain_form()))
+    }
+
+    fn derivatives_at(
+        &self,
+        [u, _]: [f64; 2],
+        order: usize,
+        _: &[(usize, usize)],
+        out: &mut [DVec3],
+    ) {
+        out.copy_from_slice(&self.chain_form().curve().derivatives(u, order));
+    }
+
+    fn junctions(&self) -> Option<Vec<f64>> {
+        Some(self.spline.knots().to_vec())
+    }
+
+    /// Bézier points, or the de Boor polygon of splines edited through it (their Bézier points
+    /// are drawn as an overlay).
+    fn controls(&self) -> ControlDisplay {
+        ControlDisplay::polygon(self.spline.handles())
+    }
+
+    fn move_edit(&self, grip: Grip, delta: DVec3) -> Option<BezierSplineEdit> {
+        let Grip::Point(Index2::One(point)) = grip else {
+            return None;
+        };
+        Some(BezierSplineEdit::Move { point, delta })
+    }
+
+    fn weight_edit(&self, _grip: Grip, _weight: f64) -> Result<Self::Edit, String> {
+        Err(format!(
+            "a {} has no weights: B converts it to a bspline_curve first",
+            self.type_name()
+        ))
     }
 }
 

@@ -3,11 +3,14 @@
 use super::curve_sampler::SplineCurveSampler;
 use crate::geom::shape::{insertion_window, shape_change, span_probes};
 use crate::geom::{BSplineCurve, GeomError, KnotVector};
+use crate::model::Index2;
 use crate::model::Kind;
+use crate::model::controls::{ControlDisplay, Grip};
 use crate::model::edit::{EditError, KindEdit, Target, check_shape_kept};
 use crate::model::points::PointEdit;
 use crate::model::{MAX_CURVE_SAMPLES, MAX_DEGREE, SplineForm, check_samples};
 use crate::sampling::SampleMode;
+use glam::DVec3;
 
 /// A Bézier or B-spline (NURBS with weights) curve with its sample count.
 #[derive(Debug, Clone, PartialEq)]
@@ -72,6 +75,49 @@ impl Kind for CurveModel {
 
     fn sampler(&self, mode: SampleMode) -> SplineCurveSampler {
         SplineCurveSampler::new(self.clone(), mode.layout().0)
+    }
+
+    fn derivatives_at(
+        &self,
+        [u, _]: [f64; 2],
+        order: usize,
+        _: &[(usize, usize)],
+        out: &mut [DVec3],
+    ) {
+        out.copy_from_slice(&self.curve.derivatives(u, order));
+    }
+
+    fn controls(&self) -> ControlDisplay {
+        ControlDisplay::polygon(self.curve.points().to_vec())
+    }
+
+    fn control_point(&self, point: Index2) -> Option<DVec3> {
+        let Index2::One(k) = point else { return None };
+        self.curve.points().get(k).copied()
+    }
+
+    fn move_edit(&self, grip: Grip, delta: DVec3) -> Option<CurveEdit> {
+        let Grip::Point(Index2::One(point)) = grip else {
+            return None;
+        };
+        Some(CurveEdit::Point(PointEdit::Move { point, delta }))
+    }
+
+    fn weight(&self, grip: Grip) -> Option<f64> {
+        let Grip::Point(Index2::One(k)) = grip else {
+            return None;
+        };
+        self.curve.points().get(k)?;
+        Some(self.curve.weights().map_or(1.0, |w| w[k]))
+    }
+
+    fn weight_edit(&self, grip: Grip, weight: f64) -> Result<CurveEdit, String> {
+        match grip {
+            Grip::Point(Index2::One(point)) => {
+                Ok(CurveEdit::Point(PointEdit::Weight { point, weight }))
+            }
+            _ => Err(format!("a {} has no such control point", self.type_name())),
+        }
     }
 }
 

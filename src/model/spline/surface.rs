@@ -4,7 +4,9 @@ use super::curve::{check_elevation, check_insertion, check_restore, replace};
 use super::surface_sampler::SplineSurfaceSampler;
 use crate::geom::shape::{greville, insertion_window, shape_change, span_probes};
 use crate::geom::{KnotVector, TensorSurface};
+use crate::model::Index2;
 use crate::model::Kind;
+use crate::model::controls::{ControlDisplay, Grip};
 use crate::model::edit::{EditError, KindEdit, Target, check_shape_kept};
 use crate::model::points::PointEdit;
 use crate::model::{SplineForm, check_surface_samples};
@@ -83,6 +85,59 @@ impl Kind for SurfaceModel {
     fn sampler(&self, mode: SampleMode) -> SplineSurfaceSampler {
         let (_, set, normals) = mode.layout();
         SplineSurfaceSampler::new(self.clone(), set, normals)
+    }
+
+    fn derivatives_at(
+        &self,
+        [u, v]: [f64; 2],
+        order: usize,
+        list: &[(usize, usize)],
+        out: &mut [DVec3],
+    ) {
+        let p = self.surface.derivatives(u, v, order);
+        for (slot, &(a, b)) in list.iter().enumerate() {
+            out[slot] = p.get(a, b);
+        }
+    }
+
+    fn controls(&self) -> ControlDisplay {
+        ControlDisplay::net(self.surface.count(), self.surface.points().to_vec())
+    }
+
+    fn control_point(&self, point: Index2) -> Option<DVec3> {
+        let Index2::Two(i, j) = point else {
+            return None;
+        };
+        let [rows, cols] = self.surface.count();
+        (i < rows && j < cols).then(|| self.surface.point(i, j))
+    }
+
+    fn move_edit(&self, grip: Grip, delta: DVec3) -> Option<SurfaceEdit> {
+        let Grip::Point(Index2::Two(i, j)) = grip else {
+            return None;
+        };
+        Some(SurfaceEdit::Point(PointEdit::Move {
+            point: [i, j],
+            delta,
+        }))
+    }
+
+    fn weight(&self, grip: Grip) -> Option<f64> {
+        let Grip::Point(Index2::Two(i, j)) = grip else {
+            return None;
+        };
+        let [rows, cols] = self.surface.count();
+        (i < rows && j < cols).then(|| self.surface.weights().map_or(1.0, |w| w[i * cols + j]))
+    }
+
+    fn weight_edit(&self, grip: Grip, weight: f64) -> Result<SurfaceEdit, String> {
+        match grip {
+            Grip::Point(Index2::Two(i, j)) => Ok(SurfaceEdit::Point(PointEdit::Weight {
+                point: [i, j],
+                weight,
+            })),
+            _ => Err(format!("a {} has no such control point", self.type_name())),
+        }
     }
 }
 

@@ -78,13 +78,12 @@ pub fn object_to_element(o: &SceneObject) -> Result<FreeForm, SceneError> {
             &erbs::surface_to_bspline(m.surface()).map_err(at)?,
             Basis::BSpline,
         ),
-        // Catmull–Rom and Bézier splines as the B-spline of their Bézier chain.
-        chain @ (ModelRef::CatmullRom(_) | ModelRef::BezierSpline(_)) => {
-            match chain.to_bspline_curve() {
-                Some(crate::model::Model::Curve(c)) => curve_element(c.curve(), Basis::BSpline),
-                _ => return Err(at("has no B-spline form".into())),
-            }
-        }
+        // Catmull–Rom and Bézier splines as the B-spline of their Bézier chain; any other
+        // kind through its B-spline form where it has one.
+        other => match other.to_bspline_curve() {
+            Some(crate::model::Model::Curve(c)) => curve_element(c.curve(), Basis::BSpline),
+            _ => return Err(at(format!("a {} has no OBJ form", other.type_name()))),
+        },
     };
     let dims = o.model.sample_dims();
     e.name = Some(o.name.clone());

@@ -1,0 +1,209 @@
+//! The ERBS curve kind: its model and what its edits need of it.
+
+use super::controls::curve_controls;
+use super::curve_sampler::ErbsCurveSampler;
+use super::*;
+use crate::geom::erbs::{ErbsCurve, LocalCurve};
+use crate::geom::shape::{ShapeChange, erbs_knot_probes, erbs_probes, shape_change};
+use crate::geom::{BFunctionKind, GeomError};
+use crate::model::Index2;
+use crate::model::Kind;
+use crate::model::controls::{ControlDisplay, Grip};
+use crate::model::edit::EditError;
+use crate::model::{MAX_CURVE_SAMPLES, check_samples};
+use crate::sampling::SampleMode;
+use glam::{DMat4, DVec3};
+use std::fmt::Debug;
+
+/// An ERBS curve with its sample count.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ErbsCurveModel {
+    curve: ErbsCurve,
+    samples: usize,
+}
+
+impl ErbsCurveModel {
+    pub fn new(curve: ErbsCurve, samples: usize) -> Result<Self, EditError> {
+        check_samples(samples, MAX_CURVE_SAMPLES)?;
+        Ok(Self { curve, samples })
+    }
+
+    pub fn curve(&self) -> &ErbsCurve {
+        &self.curve
+    }
+
+    pub fn samples(&self) -> usize {
+        self.samples
+    }
+}
+
+impl Kind for ErbsCurveModel {
+    type Edit = ErbsCurveEdit;
+    type Sampler = ErbsCurveSampler;
+    const SURFACE: bool = false;
+    const LABEL: &'static str = "ERBS curve";
+
+    fn type_name(&self) -> &'static str {
+        "erbs_curve"
+    }
+
+    fn sample_dims(&self) -> [usize; 2] {
+        [self.samples, 1]
+    }
+
+    fn domain(&self) -> Vec<(f64, f64)> {
+        vec![self.curve.domain()]
+    }
+
+    fn sampler(&self, mode: SampleMode) -> ErbsCurveSampler {
+        ErbsCurveSampler::new(self.clone(), mode.layout().0)
+    }
+
+    fn derivatives_at(
+        &self,
+        [u, _]: [f64; 2],
+        order: usize,
+        _: &[(usize, usize)],
+        out: &mut [DVec3],
+    ) {
+        out.copy_from_slice(&self.curve.derivatives(u, order));
+    }
+
+    fn controls(&self) -> ControlDisplay {
+        curve_controls(&self.curve, None)
+    }
+
+    fn local_controls(&self, local: LocalPath<Index2>) -> Option<ControlDisplay> {
+        Some(curve_controls(&self.curve, Some(local)))
+    }
+
+    fn move_edit(&self, grip: Grip, delta: DVec3) -> Option<ErbsCurveEdit> {
+        let Grip::LocalPoint {
+            local,
+            point: Index2::One(point),
+        } = grip
+        else {
+            return None;
+        };
+        Some(ErbsCurveEdit::Local(LocalEdit::MovePoint {
+            local: local.to_curve()?,
+            point,
+            delta,
+        }))
+    }
+}
+
+impl ErbsNet for ErbsCurve {
+    type Index = usize;
+    type Local = LocalCurve;
+    type Knot = f64;
+    type Degree = usize;
+    type Count = usize;
+    type Model = ErbsCurveModel;
+
+    fn of(m: &ErbsCurveModel) -> &Self {
+        &m.curve
+    }
+
+    fn of_mut(m: &mut ErbsCurveModel) -> &mut Self {
+        &mut m.curve
+    }
+
+    fn local_at(&self, path: &[usize]) -> Option<&LocalCurve> {
+        ErbsCurve::local_at(self, path)
+    }
+
+    fn check_path(&self, path: &[usize]) -> Result<(), EditError> {
+        let mut level = self;
+        for (depth, &l) in path.iter().enumerate() {
+            check_count("local", l, level.local_curves().len())
+                .map_err(|e| step_error(depth, e))?;
+            match (&level.local_curves()[l], depth + 1 < path.len()) {
+                (LocalCurve::Erbs(e), true) => level = e,
+                (LocalCurve::Spline { .. }, true) => {
+                    return Err(EditError::new(
+                        "local",
+                        format!("step {depth} of the path is a polynomial local: it has no locals"),
+                    ));
+                }
+                _ => {}
+            }
+        }
+        Ok(())
+    }
+
+    fn points(local: &LocalCurve) -> Option<&[DVec3]> {
+        local.points()
+    }
+
+    fn check_point(local: &LocalCurve, p: usize) -> Result<(), EditError> {
+        check_count("point", p, local.points().map_or(0, <[DVec3]>::len))
+    }
+
+    fn as_erbs(local: &LocalCurve) -> Option<&Self> {
+        match local {
+            LocalCurve::Erbs(e) => Some(e),
+            LocalCurve::Spline { .. } => None,
+        }
+    }
+
+    fn wrap(e: Self) -> LocalCurve {
+        LocalCurve::Erbs(Box::new(e))
+    }
+
+    fn transform_local(&mut self, path: &[usize], a: &DMat4) {
+        ErbsCurve::transform_local(self, path, a);
+    }
+
+    fn translate_local_point(&mut self, path: &[usize], p: usize, d: DVec3) {
+        ErbsCurve::translate_local_point(self, path, p, d);
+    }
+
+    fn set_local_points(&mut self, path: &[usize], points: &[DVec3]) {
+        ErbsCurve::set_local_points(self, path, points);
+    }
+
+    fn set_local(&mut self, path: &[usize], local: LocalCurve) {
+        ErbsCurve::set_local(self, path, local);
+    }
+
+    fn refine(&self, t: f64, degree: Option<usize>) -> Result<Self, GeomError> {
+        self.insert_knot(t, degree).map(|(c, _)| c)
+    }
+
+    fn build(
+        local: &LocalCurve,
+        n: usize,
+        degree: usize,
+        bf: BFunctionKind,
+    ) -> Result<Self, GeomError> {
+        match local {
+            LocalCurve::Spline { curve, .. } => ErbsCurve::from_curve(curve, n, degree, bf, false),
+            LocalCurve::Erbs(_) => Err(GeomError::new("to_erbs", "already an ERBS local")),
+        }
+    }
+
+    fn bfunction(&self) -> BFunctionKind {
+        ErbsCurve::bfunction(self)
+    }
+
+    fn check_degree(d: usize) -> Result<(), EditError> {
+        check_max_degree("degree", d)
+    }
+
+    const NOUN: &'static str = "curve";
+    const LOCAL_NOUN: &'static str = "local curve";
+
+    fn refinement_change(&self, refined: &Self, t: f64) -> ShapeChange {
+        let degree = self.local_curves().iter().map(LocalCurve::degree).max();
+        let per = degree.unwrap_or(0) + 1;
+        let mut at = erbs_probes(self.knots(), per, Some(self.knots().locate(t)));
+        at.push(t);
+        shape_change(self, refined, &at)
+    }
+
+    fn build_change(local: &LocalCurve, built: &Self) -> ShapeChange {
+        let at = erbs_knot_probes(built.knots());
+        shape_change(local, &Self::wrap(built.clone()), &at)
+    }
+}
