@@ -7,6 +7,7 @@
 #![warn(clippy::undocumented_unsafe_blocks)]
 pub mod cli;
 pub mod editor;
+pub mod format;
 pub mod geom;
 #[allow(unsafe_code)]
 pub mod gpu;

@@ -6,8 +6,10 @@ use super::controls::{ControlDisplay, Grip};
 use super::edit::{EditError, KindEdit, Target};
 use super::registry::{Model, ModelRef, ObjectEdit, SampledObject};
 use super::{Index2, LocalPath};
+use crate::format::{At, SceneError};
 use crate::sampling::{DirtyRegion, PartialSet, SampleGrid, SampleMode, Sampler, Tracked};
 use glam::DVec3;
+use serde_json::{Map, Value};
 use std::fmt::Debug;
 
 /// An object kind: its model type (this trait's implementor), its edits and its sampler.
@@ -21,8 +23,27 @@ pub trait Kind: Clone + Debug + PartialEq + Sized + 'static {
     /// The kind's name in messages ("curve", "ERBS surface", …).
     const LABEL: &'static str;
 
+    /// The scene-file `type` names this kind reads (docs/scene-format.md).
+    const TYPES: &'static [&'static str];
+
     /// The scene-file `type` of this model.
     fn type_name(&self) -> &'static str;
+
+    /// Reads an object of type `ty` (one of [`Kind::TYPES`]) from its fields; `common` names
+    /// the fields every object has, which the scene reads.
+    fn read(
+        ty: &str,
+        at: &At,
+        obj: &Map<String, Value>,
+        common: &[&'static str],
+    ) -> Result<Self, SceneError>;
+
+    /// Writes the kind's own fields, each as `, "name": value` (the scene writes the name,
+    /// type, samples and colour).
+    fn write(&self, out: &mut String);
+
+    /// Reads an edit of this object (docs/scene-format.md, edits files).
+    fn read_edit(&self, at: &At, obj: &Map<String, Value>) -> Result<Self::Edit, SceneError>;
 
     /// Sample grid dimensions: [m, 1] for curves, [mu, mv] for surfaces.
     fn sample_dims(&self) -> [usize; 2];
@@ -101,6 +122,8 @@ pub trait DynKind {
     fn validate(&self, edit: &ObjectEdit) -> Result<(), EditError>;
     fn inverse(&self, edit: &ObjectEdit) -> Result<ObjectEdit, EditError>;
     fn controls(&self) -> ControlDisplay;
+    fn write(&self, out: &mut String);
+    fn read_edit(&self, at: &At, obj: &Map<String, Value>) -> Result<ObjectEdit, SceneError>;
     fn derivatives_at(
         &self,
         uv: [f64; 2],
@@ -179,6 +202,14 @@ where
 
     fn controls(&self) -> ControlDisplay {
         Kind::controls(self)
+    }
+
+    fn write(&self, out: &mut String) {
+        Kind::write(self, out);
+    }
+
+    fn read_edit(&self, at: &At, obj: &Map<String, Value>) -> Result<ObjectEdit, SceneError> {
+        Kind::read_edit(self, at, obj).map(KindEdit::into_object)
     }
 
     fn derivatives_at(

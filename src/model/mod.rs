@@ -28,6 +28,7 @@ pub mod controls;
 mod edit;
 mod erbs;
 pub mod exact;
+pub mod file;
 pub mod kind;
 mod points;
 pub mod registry;

@@ -85,6 +85,40 @@ macro_rules! kinds {
         )+
 
         impl Model {
+            /// Reads an object of scene-file type `ty` through the kind that declares it;
+            /// `None` for a type no kind declares.
+            pub fn read(
+                ty: &str,
+                at: &$crate::format::At,
+                obj: &serde_json::Map<String, serde_json::Value>,
+                common: &[&'static str],
+            ) -> Option<Result<Model, $crate::format::SceneError>> {
+                use $crate::model::Kind;
+                $(
+                    if <$m>::TYPES.contains(&ty) {
+                        return Some(<$m>::read(ty, at, obj, common).map(Model::$v));
+                    }
+                )+
+                None
+            }
+
+            /// Every scene-file type, curves first, in registration order.
+            #[must_use]
+            pub fn types() -> Vec<&'static str> {
+                use $crate::model::Kind;
+                let mut curves = Vec::new();
+                let mut surfaces = Vec::new();
+                $(
+                    if <$m>::SURFACE {
+                        surfaces.extend_from_slice(<$m>::TYPES);
+                    } else {
+                        curves.extend_from_slice(<$m>::TYPES);
+                    }
+                )+
+                curves.extend(surfaces);
+                curves
+            }
+
             /// The model's kind.
             #[must_use]
             pub fn kind(&self) -> &dyn $crate::model::kind::DynKind {

@@ -3,15 +3,13 @@
 
 pub mod demo;
 pub mod edit;
-mod json;
 pub mod obj;
 mod parse;
-mod parse_erbs;
 mod write;
 
+pub use crate::format::json::{self, At, SceneError};
 pub use crate::model::{Index2, MAX_CURVE_SAMPLES, MAX_DEGREE, MAX_SURFACE_SAMPLES, Model};
 pub use edit::{EditList, parse_edits};
-pub use json::At;
 pub use parse::parse_scene;
 pub use write::scene_to_json;
 
@@ -37,11 +35,6 @@ pub fn escape_controls(s: &str) -> Cow<'_, str> {
     }
     Cow::Owned(out)
 }
-
-/// Anything wrong with a scene or edit file, as one line naming the object, field and index.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("{0}")]
-pub struct SceneError(pub String);
 
 /// A whole scene: objects in file order.
 #[derive(Debug, Clone, PartialEq, Default)]

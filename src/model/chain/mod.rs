@@ -4,8 +4,10 @@
 //! multiplicity d at the junctions); an edit of a user point becomes moves of the few chain
 //! points it changes ([`ChainEdit::chain_points`]), each touching only its segments' samples.
 
+pub mod file;
 pub mod sampler;
 
+use crate::format::{At, SceneError};
 use crate::geom::{BezierSpline, CatmullRom, GeomError};
 use crate::model::Kind;
 use crate::model::controls::{ControlDisplay, Grip};
@@ -16,6 +18,7 @@ use crate::model::{CurveModel, Index2, MAX_CURVE_SAMPLES, SplineForm, check_samp
 use crate::sampling::SampleMode;
 use glam::DVec3;
 use sampler::ChainCurveSampler;
+use serde_json::{Map, Value};
 
 /// A curve kind pre-evaluated as the B-spline of its Bézier chain.
 pub trait ChainModel: Clone + std::fmt::Debug {
@@ -286,6 +289,25 @@ impl Kind for CatmullRomModel {
     const SURFACE: bool = false;
     const LABEL: &'static str = "Catmull–Rom";
 
+    const TYPES: &'static [&'static str] = &["catmull_rom"];
+
+    fn read(
+        _: &str,
+        at: &At,
+        obj: &Map<String, Value>,
+        common: &[&'static str],
+    ) -> Result<Self, SceneError> {
+        file::read_catmull_rom(at, obj, common)
+    }
+
+    fn write(&self, out: &mut String) {
+        file::write_catmull_rom(self, out);
+    }
+
+    fn read_edit(&self, at: &At, obj: &Map<String, Value>) -> Result<CatmullRomEdit, SceneError> {
+        file::read_catmull_rom_edit(at, obj)
+    }
+
     fn type_name(&self) -> &'static str {
         "catmull_rom"
     }
@@ -345,6 +367,25 @@ impl Kind for BezierSplineModel {
     type Sampler = ChainCurveSampler<BezierSplineEdit>;
     const SURFACE: bool = false;
     const LABEL: &'static str = "Bézier spline";
+
+    const TYPES: &'static [&'static str] = &["bezier_spline"];
+
+    fn read(
+        _: &str,
+        at: &At,
+        obj: &Map<String, Value>,
+        common: &[&'static str],
+    ) -> Result<Self, SceneError> {
+        file::read_bezier_spline(at, obj, common)
+    }
+
+    fn write(&self, out: &mut String) {
+        file::write_bezier_spline(self, out);
+    }
+
+    fn read_edit(&self, at: &At, obj: &Map<String, Value>) -> Result<BezierSplineEdit, SceneError> {
+        file::read_bezier_spline_edit(at, obj)
+    }
 
     fn type_name(&self) -> &'static str {
         "bezier_spline"

@@ -3,6 +3,7 @@
 use super::controls::curve_controls;
 use super::curve_sampler::ErbsCurveSampler;
 use super::*;
+use crate::format::{At, SceneError};
 use crate::geom::erbs::{ErbsCurve, LocalCurve};
 use crate::geom::shape::{ShapeChange, erbs_knot_probes, erbs_probes, shape_change};
 use crate::geom::{BFunctionKind, GeomError};
@@ -13,6 +14,7 @@ use crate::model::edit::EditError;
 use crate::model::{MAX_CURVE_SAMPLES, check_samples};
 use crate::sampling::SampleMode;
 use glam::{DMat4, DVec3};
+use serde_json::{Map, Value};
 use std::fmt::Debug;
 
 /// An ERBS curve with its sample count.
@@ -42,6 +44,25 @@ impl Kind for ErbsCurveModel {
     type Sampler = ErbsCurveSampler;
     const SURFACE: bool = false;
     const LABEL: &'static str = "ERBS curve";
+
+    const TYPES: &'static [&'static str] = &["erbs_curve"];
+
+    fn read(
+        _: &str,
+        at: &At,
+        obj: &Map<String, Value>,
+        common: &[&'static str],
+    ) -> Result<Self, SceneError> {
+        super::file::read_curve(at, obj, common)
+    }
+
+    fn write(&self, out: &mut String) {
+        super::file::write_erbs_curve(out, &self.curve);
+    }
+
+    fn read_edit(&self, at: &At, obj: &Map<String, Value>) -> Result<ErbsCurveEdit, SceneError> {
+        super::file::read_curve_edit(at, obj)
+    }
 
     fn type_name(&self) -> &'static str {
         "erbs_curve"

@@ -5,6 +5,7 @@
 
 pub mod controls;
 pub mod curve_sampler;
+pub mod file;
 pub mod surface_sampler;
 
 mod curve;

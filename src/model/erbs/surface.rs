@@ -3,6 +3,7 @@
 use super::controls::patch_controls;
 use super::surface_sampler::ErbsSurfaceSampler;
 use super::*;
+use crate::format::{At, SceneError};
 use crate::geom::erbs::{ErbsSurface, LocalPatch};
 use crate::geom::shape::{ShapeChange, erbs_knot_probes, erbs_probes, shape_change};
 use crate::geom::{BFunctionKind, GeomError};
@@ -13,6 +14,7 @@ use crate::model::controls::{ControlDisplay, Grip};
 use crate::model::edit::EditError;
 use crate::sampling::SampleMode;
 use glam::{DMat4, DVec3};
+use serde_json::{Map, Value};
 use std::fmt::Debug;
 
 /// An ERBS surface with its sample counts [mu, mv].
@@ -42,6 +44,25 @@ impl Kind for ErbsSurfaceModel {
     type Sampler = ErbsSurfaceSampler;
     const SURFACE: bool = true;
     const LABEL: &'static str = "ERBS surface";
+
+    const TYPES: &'static [&'static str] = &["erbs_surface"];
+
+    fn read(
+        _: &str,
+        at: &At,
+        obj: &Map<String, Value>,
+        common: &[&'static str],
+    ) -> Result<Self, SceneError> {
+        super::file::read_surface(at, obj, common)
+    }
+
+    fn write(&self, out: &mut String) {
+        super::file::write_erbs_surface(out, &self.surface);
+    }
+
+    fn read_edit(&self, at: &At, obj: &Map<String, Value>) -> Result<ErbsSurfaceEdit, SceneError> {
+        super::file::read_surface_edit(at, obj)
+    }
 
     fn type_name(&self) -> &'static str {
         "erbs_surface"

@@ -1,6 +1,7 @@
 //! Bézier, B-spline and NURBS curves: the model and its edits.
 
 use super::curve_sampler::SplineCurveSampler;
+use crate::format::{At, SceneError};
 use crate::geom::shape::{insertion_window, shape_change, span_probes};
 use crate::geom::{BSplineCurve, GeomError, KnotVector};
 use crate::model::Index2;
@@ -11,6 +12,7 @@ use crate::model::points::PointEdit;
 use crate::model::{MAX_CURVE_SAMPLES, MAX_DEGREE, SplineForm, check_samples};
 use crate::sampling::SampleMode;
 use glam::DVec3;
+use serde_json::{Map, Value};
 
 /// A Bézier or B-spline (NURBS with weights) curve with its sample count.
 #[derive(Debug, Clone, PartialEq)]
@@ -57,6 +59,25 @@ impl Kind for CurveModel {
     type Sampler = SplineCurveSampler;
     const SURFACE: bool = false;
     const LABEL: &'static str = "curve";
+
+    const TYPES: &'static [&'static str] = super::file::CURVE_TYPES;
+
+    fn read(
+        ty: &str,
+        at: &At,
+        obj: &Map<String, Value>,
+        common: &[&'static str],
+    ) -> Result<Self, SceneError> {
+        super::file::read_curve(ty, at, obj, common)
+    }
+
+    fn write(&self, out: &mut String) {
+        super::file::write_curve(self, out);
+    }
+
+    fn read_edit(&self, at: &At, obj: &Map<String, Value>) -> Result<CurveEdit, SceneError> {
+        super::file::read_curve_edit(at, obj)
+    }
 
     fn type_name(&self) -> &'static str {
         match self.form {

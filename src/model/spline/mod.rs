@@ -3,5 +3,6 @@
 
 pub mod curve;
 pub mod curve_sampler;
+pub mod file;
 pub mod surface;
 pub mod surface_sampler;

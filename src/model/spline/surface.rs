@@ -2,6 +2,7 @@
 
 use super::curve::{check_elevation, check_insertion, check_restore, replace};
 use super::surface_sampler::SplineSurfaceSampler;
+use crate::format::{At, SceneError};
 use crate::geom::shape::{greville, insertion_window, shape_change, span_probes};
 use crate::geom::{KnotVector, TensorSurface};
 use crate::model::Index2;
@@ -12,6 +13,7 @@ use crate::model::points::PointEdit;
 use crate::model::{SplineForm, check_surface_samples};
 use crate::sampling::SampleMode;
 use glam::DVec3;
+use serde_json::{Map, Value};
 
 /// A Bézier or B-spline (NURBS with weights) surface with its sample counts [mu, mv].
 #[derive(Debug, Clone, PartialEq)]
@@ -66,6 +68,25 @@ impl Kind for SurfaceModel {
     type Sampler = SplineSurfaceSampler;
     const SURFACE: bool = true;
     const LABEL: &'static str = "surface";
+
+    const TYPES: &'static [&'static str] = super::file::SURFACE_TYPES;
+
+    fn read(
+        ty: &str,
+        at: &At,
+        obj: &Map<String, Value>,
+        common: &[&'static str],
+    ) -> Result<Self, SceneError> {
+        super::file::read_surface(ty, at, obj, common)
+    }
+
+    fn write(&self, out: &mut String) {
+        super::file::write_surface(self, out);
+    }
+
+    fn read_edit(&self, at: &At, obj: &Map<String, Value>) -> Result<SurfaceEdit, SceneError> {
+        super::file::read_surface_edit(at, obj)
+    }
 
     fn type_name(&self) -> &'static str {
         match self.form {

@@ -9,9 +9,9 @@
 //! Trims live in the surface's parameter space, and knot insertion, degree elevation and point
 //! moves keep the domain, so they stay valid through edits.
 
+use crate::format::write::number;
 use crate::scene::SceneError;
 use crate::scene::json::{At, as_array, as_f64, as_object, as_str, as_usize, check_fields};
-use crate::scene::write::number;
 use serde_json::{Map, Value};
 
 /// The kept data of one object; empty for objects that came from anywhere else.

@@ -6,7 +6,7 @@
 
 use super::carried::{Body, Carried, Curve2, CurveRef, Technique};
 use super::model::FreeForm;
-use crate::scene::write::number;
+use crate::format::write::number;
 use std::fmt::Write;
 
 /// Statement lines longer than this are continued with `\`.

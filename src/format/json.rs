@@ -3,9 +3,13 @@
 //! Scene and edit files are parsed in two steps (text → `Value` → model) rather than with serde
 //! derives so that every message names the object, the field and the index that is wrong.
 
-use super::SceneError;
 use glam::DVec3;
 use serde_json::{Map, Value};
+
+/// Anything wrong with a scene or edit file, as one line naming the object, field and index.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct SceneError(pub String);
 
 /// Where we are, e.g. "object 'c' (objects[2])"; prefixes every message.
 #[derive(Clone)]
