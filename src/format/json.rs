@@ -5,6 +5,7 @@
 
 use glam::DVec3;
 use serde_json::{Map, Value};
+use std::fmt::Display;
 
 /// Anything wrong with a scene or edit file, as one line naming the object, field and index.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -76,7 +77,7 @@ pub fn as_str<'a>(at: &At, field: &str, v: &'a Value) -> Result<&'a str, SceneEr
 
 /// A finite number. (JSON itself cannot spell NaN or infinity; out-of-range literals are caught
 /// by the JSON parser.)
-pub fn as_f64(at: &At, field: &str, what: &str, v: &Value) -> Result<f64, SceneError> {
+pub fn as_f64(at: &At, field: &str, what: impl Display, v: &Value) -> Result<f64, SceneError> {
     match v.as_f64() {
         Some(x) if x.is_finite() => Ok(x),
         Some(x) => Err(at.err(field, format!("{what} is {x}, not a finite number"))),
@@ -88,7 +89,7 @@ pub fn as_f64(at: &At, field: &str, what: &str, v: &Value) -> Result<f64, SceneE
 }
 
 /// A non-negative integer (1.0 is not accepted: counts and indices are integers).
-pub fn as_usize(at: &At, field: &str, what: &str, v: &Value) -> Result<usize, SceneError> {
+pub fn as_usize(at: &At, field: &str, what: impl Display, v: &Value) -> Result<usize, SceneError> {
     match v.as_u64() {
         Some(x) => {
             usize::try_from(x).map_err(|_| at.err(field, format!("{what} {x} is too large")))
@@ -100,16 +101,21 @@ pub fn as_usize(at: &At, field: &str, what: &str, v: &Value) -> Result<usize, Sc
     }
 }
 
-pub fn as_f64_list(at: &At, field: &str, what: &str, v: &Value) -> Result<Vec<f64>, SceneError> {
+pub fn as_f64_list(
+    at: &At,
+    field: &str,
+    what: impl Display,
+    v: &Value,
+) -> Result<Vec<f64>, SceneError> {
     as_array(at, field, v)?
         .iter()
         .enumerate()
-        .map(|(i, x)| as_f64(at, field, &format!("{what} {i}"), x))
+        .map(|(i, x)| as_f64(at, field, format_args!("{what} {i}"), x))
         .collect()
 }
 
 /// [x, y, z].
-pub fn as_point(at: &At, field: &str, what: &str, v: &Value) -> Result<DVec3, SceneError> {
+pub fn as_point(at: &At, field: &str, what: impl Display, v: &Value) -> Result<DVec3, SceneError> {
     let a = v.as_array().ok_or_else(|| {
         at.err(
             field,
@@ -122,7 +128,7 @@ pub fn as_point(at: &At, field: &str, what: &str, v: &Value) -> Result<DVec3, Sc
             format!("{what}: expected 3 coordinates, found {}", a.len()),
         ));
     }
-    let c = |i: usize| as_f64(at, field, &format!("{what} coordinate {i}"), &a[i]);
+    let c = |i: usize| as_f64(at, field, format_args!("{what} coordinate {i}"), &a[i]);
     Ok(DVec3::new(c(0)?, c(1)?, c(2)?))
 }
 
@@ -134,8 +140,19 @@ pub fn as_points(at: &At, field: &str, v: &Value) -> Result<Vec<DVec3>, SceneErr
     }
     a.iter()
         .enumerate()
-        .map(|(i, p)| as_point(at, field, &format!("point {i}"), p))
+        .map(|(i, p)| as_point(at, field, format_args!("point {i}"), p))
         .collect()
+}
+
+/// Where an entry of a grid is, displayed "[i][j]" only when a message needs it (formatting it
+/// for every entry of a large scene costs more than parsing the number).
+#[derive(Debug, Clone, Copy)]
+pub struct GridIndex(pub usize, pub usize);
+
+impl Display for GridIndex {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "[{}][{}]", self.0, self.1)
+    }
 }
 
 /// A rectangular [rows][cols] array, flattened row-major, with its shape.
@@ -143,7 +160,7 @@ pub fn as_grid<T>(
     at: &At,
     field: &str,
     v: &Value,
-    item: impl Fn(&str, &Value) -> Result<T, SceneError>,
+    item: impl Fn(GridIndex, &Value) -> Result<T, SceneError>,
 ) -> Result<([usize; 2], Vec<T>), SceneError> {
     let rows = as_array(at, field, v)?;
     if rows.is_empty() {
@@ -170,7 +187,7 @@ pub fn as_grid<T>(
             Some(_) => {}
         }
         for (j, x) in r.iter().enumerate() {
-            out.push(item(&format!("[{i}][{j}]"), x)?);
+            out.push(item(GridIndex(i, j), x)?);
         }
     }
     Ok(([rows.len(), cols.unwrap_or(0)], out))

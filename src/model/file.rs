@@ -12,8 +12,8 @@ use serde_json::{Map, Value};
 pub fn usize_pair(at: &At, field: &str, form: &str, v: &Value) -> Result<[usize; 2], SceneError> {
     match v.as_array() {
         Some(a) if a.len() == 2 => Ok([
-            as_usize(at, field, &format!("{field}[0]"), &a[0])?,
-            as_usize(at, field, &format!("{field}[1]"), &a[1])?,
+            as_usize(at, field, format_args!("{field}[0]"), &a[0])?,
+            as_usize(at, field, format_args!("{field}[1]"), &a[1])?,
         ]),
         Some(a) => Err(at.err(field, format!("expected {form}, found {} entries", a.len()))),
         None => Err(at.err(field, format!("expected {form}, found {v}"))),
@@ -122,7 +122,7 @@ pub fn bfunction(at: &At, obj: &Map<String, Value>) -> Result<BFunctionKind, Sce
 
 pub fn point_grid(at: &At, field: &str, v: &Value) -> Result<([usize; 2], Vec<DVec3>), SceneError> {
     as_grid(at, field, v, |idx, p| {
-        as_point(at, field, &format!("point {idx}"), p)
+        as_point(at, field, format_args!("point {idx}"), p)
     })
 }
 
@@ -135,7 +135,7 @@ pub fn weight_grid(
         return Ok(None);
     };
     let (shape, w) = as_grid(at, "weights", v, |idx, x| {
-        as_f64(at, "weights", &format!("weight {idx}"), x)
+        as_f64(at, "weights", format_args!("weight {idx}"), x)
     })?;
     if shape != count {
         return Err(at.err(

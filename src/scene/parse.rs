@@ -4,34 +4,174 @@ use super::json::*;
 use super::{Scene, SceneError, SceneObject};
 use crate::model::Model;
 use crate::model::file::opt;
+use serde::Deserialize;
 use serde_json::Value;
+use std::collections::HashMap;
 
 /// Parses and validates scene JSON text.
+///
+/// The objects are streamed: each one is read into a small `Value`, validated into its model and
+/// dropped before the next, so that a large scene never holds a `Value` tree of the whole file
+/// (which took more time to build and free than the parsing itself, and four times the memory
+/// of the models).
 pub fn parse_scene(text: &str) -> Result<Scene, SceneError> {
+    if !text.trim_start().starts_with('{') {
+        // Not an object (or not JSON): the whole-value path words the message.
+        return parse_scene_value(text);
+    }
+    let failed = std::cell::RefCell::new(None);
+    let mut de = serde_json::Deserializer::from_str(text);
+    let parsed =
+        serde::de::Deserializer::deserialize_map(&mut de, SceneVisitor { failed: &failed })
+            .and_then(|objects| de.end().map(|()| objects));
+    match (parsed, failed.into_inner()) {
+        (_, Some(e)) => Err(e),
+        (Ok(objects), None) => {
+            check_connections(&objects)?;
+            Ok(Scene { objects })
+        }
+        (Err(e), None) => Err(SceneError(format!("invalid JSON: {e}"))),
+    }
+}
+
+/// The scene text through one `Value` tree: only for text that is not a JSON object, whose
+/// message this words.
+fn parse_scene_value(text: &str) -> Result<Scene, SceneError> {
     let v: Value =
         serde_json::from_str(text).map_err(|e| SceneError(format!("invalid JSON: {e}")))?;
-    let top = v.as_object().ok_or_else(|| {
-        SceneError(format!(
-            "the scene must be a JSON object {{\"objects\": [...]}}, found {}",
-            kind(&v)
-        ))
-    })?;
-    let at = At("scene".into());
-    check_fields(&at, top, &["objects"])?;
-    let list = as_array(&at, "objects", require(&at, top, "objects")?)?;
-    let mut objects: Vec<SceneObject> = Vec::with_capacity(list.len());
-    for (i, item) in list.iter().enumerate() {
-        let obj = parse_object(i, item)?;
-        if let Some(j) = objects.iter().position(|o| o.name == obj.name) {
-            return Err(SceneError(format!(
-                "object '{}' (objects[{i}]): field 'name': duplicate name, already used by objects[{j}]",
-                obj.name
-            )));
-        }
-        objects.push(obj);
+    Err(SceneError(format!(
+        "the scene must be a JSON object {{\"objects\": [...]}}, found {}",
+        kind(&v)
+    )))
+}
+
+/// A scene error raised inside the streaming deserializer: kept here and handed to serde as an
+/// empty custom error, so that it reaches the user as it was worded, not with serde's position.
+type Failed<'a> = &'a std::cell::RefCell<Option<SceneError>>;
+
+fn fail<E: serde::de::Error>(failed: Failed<'_>, e: SceneError) -> E {
+    failed.replace(Some(e));
+    E::custom("")
+}
+
+/// The top-level `{"objects": [...]}`.
+struct SceneVisitor<'a> {
+    failed: Failed<'a>,
+}
+
+impl<'de> serde::de::Visitor<'de> for SceneVisitor<'_> {
+    type Value = Vec<SceneObject>;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("a scene object {\"objects\": [...]}")
     }
-    check_connections(&objects)?;
-    Ok(Scene { objects })
+
+    fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Self::Value, A::Error> {
+        let at = At("scene".into());
+        let mut objects = None;
+        while let Some(key) = map.next_key::<String>()? {
+            match key.as_str() {
+                "objects" if objects.is_some() => {
+                    return Err(fail(self.failed, at.err("objects", "given twice")));
+                }
+                "objects" => {
+                    objects = Some(map.next_value_seed(ObjectsSeed {
+                        failed: self.failed,
+                    })?);
+                }
+                _ => {
+                    return Err(fail(
+                        self.failed,
+                        SceneError(format!(
+                            "scene: unknown field '{key}' (expected one of: objects)"
+                        )),
+                    ));
+                }
+            }
+        }
+        objects.ok_or_else(|| fail(self.failed, at.err("objects", "missing")))
+    }
+}
+
+/// The `objects` array, parsed one object at a time.
+struct ObjectsSeed<'a> {
+    failed: Failed<'a>,
+}
+
+impl<'de> serde::de::DeserializeSeed<'de> for ObjectsSeed<'_> {
+    type Value = Vec<SceneObject>;
+
+    fn deserialize<D: serde::Deserializer<'de>>(self, d: D) -> Result<Self::Value, D::Error> {
+        // Any JSON value: an array is streamed, anything else is refused with its kind.
+        let v = d.deserialize_any(self)?;
+        Ok(v)
+    }
+}
+
+impl<'de> serde::de::Visitor<'de> for ObjectsSeed<'_> {
+    type Value = Vec<SceneObject>;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("an array of objects")
+    }
+
+    fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
+        let mut objects: Vec<SceneObject> = Vec::with_capacity(seq.size_hint().unwrap_or(0));
+        // Name → index, so that uniqueness costs one hash per object, not a scan of all before
+        // it.
+        let mut names: HashMap<String, usize> = HashMap::new();
+        while let Some(item) = seq.next_element::<Value>()? {
+            let i = objects.len();
+            let obj = parse_object(i, &item).map_err(|e| fail(self.failed, e))?;
+            if let Some(j) = names.insert(obj.name.clone(), i) {
+                return Err(fail(
+                    self.failed,
+                    SceneError(format!(
+                        "object '{}' (objects[{i}]): field 'name': duplicate name, already used by objects[{j}]",
+                        obj.name
+                    )),
+                ));
+            }
+            objects.push(obj);
+        }
+        Ok(objects)
+    }
+
+    fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> Result<Self::Value, A::Error> {
+        let v = Value::deserialize(serde::de::value::MapAccessDeserializer::new(map))?;
+        Err(self.wrong_kind(&v))
+    }
+
+    fn visit_bool<E: serde::de::Error>(self, b: bool) -> Result<Self::Value, E> {
+        Err(self.wrong_kind(&Value::Bool(b)))
+    }
+
+    fn visit_i64<E: serde::de::Error>(self, x: i64) -> Result<Self::Value, E> {
+        Err(self.wrong_kind(&Value::from(x)))
+    }
+
+    fn visit_u64<E: serde::de::Error>(self, x: u64) -> Result<Self::Value, E> {
+        Err(self.wrong_kind(&Value::from(x)))
+    }
+
+    fn visit_f64<E: serde::de::Error>(self, x: f64) -> Result<Self::Value, E> {
+        Err(self.wrong_kind(&Value::from(x)))
+    }
+
+    fn visit_str<E: serde::de::Error>(self, x: &str) -> Result<Self::Value, E> {
+        Err(self.wrong_kind(&Value::from(x)))
+    }
+
+    fn visit_unit<E: serde::de::Error>(self) -> Result<Self::Value, E> {
+        Err(self.wrong_kind(&Value::Null))
+    }
+}
+
+impl ObjectsSeed<'_> {
+    fn wrong_kind<E: serde::de::Error>(&self, v: &Value) -> E {
+        let at = At("scene".into());
+        fail(self.failed, as_array(&at, "objects", v).unwrap_err())
+    }
 }
 
 /// Every kept OBJ `con` joins two surfaces of the scene along curves they keep.

@@ -214,7 +214,7 @@ pub fn erbs_surface(
     })?;
     let mut knots = Vec::with_capacity(2);
     for (dir, name) in ["u", "v"].into_iter().enumerate() {
-        let k = as_f64_list(at, "knots", &format!("{name} knot"), &kv[dir])?;
+        let k = as_f64_list(at, "knots", format!("{name} knot"), &kv[dir])?;
         let k = if closed[dir] {
             ErbsKnots::closed(k, count[dir])
         } else {
@@ -633,7 +633,7 @@ fn affine(at: &At, v: &Value) -> Result<DMat4, SceneError> {
     }
     let mut m = [[0.0; 4]; 4];
     for (r, row) in rows.iter().enumerate() {
-        let vals = as_f64_list(at, "transform", &format!("row {r} entry"), row)?;
+        let vals = as_f64_list(at, "transform", format!("row {r} entry"), row)?;
         if vals.len() != 4 {
             return Err(at.err(
                 "transform",
