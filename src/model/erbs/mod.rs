@@ -6,6 +6,8 @@
 pub mod controls;
 pub mod curve_sampler;
 pub mod file;
+#[cfg(test)]
+mod kernel_tests;
 pub mod surface_sampler;
 
 mod curve;

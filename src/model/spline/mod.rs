@@ -4,5 +4,7 @@
 pub mod curve;
 pub mod curve_sampler;
 pub mod file;
+#[cfg(test)]
+mod kernel_tests;
 pub mod surface;
 pub mod surface_sampler;
