@@ -19,6 +19,8 @@ pub enum CurveEval<'a> {
     BSpline {
         curve: std::borrow::Cow<'a, BSplineCurve>,
         junctions: Option<Vec<f64>>,
+        /// A closed chain (closed Catmull–Rom): its end meets its start, one more junction.
+        closed: bool,
     },
     Erbs(&'a ErbsCurve),
 }
@@ -31,13 +33,14 @@ impl<'a> CurveEval<'a> {
             ModelRef::Curve(c) => CurveEval::BSpline {
                 curve: Cow::Borrowed(c.curve()),
                 junctions: None,
+                closed: false,
             },
             ModelRef::ErbsCurve(c) => CurveEval::Erbs(c.curve()),
             ModelRef::CatmullRom(_) | ModelRef::BezierSpline(_) => {
-                let junctions = match model {
-                    ModelRef::CatmullRom(c) => c.spline().breakpoints(),
-                    ModelRef::BezierSpline(c) => c.spline().knots().to_vec(),
-                    _ => Vec::new(),
+                let (junctions, closed) = match model {
+                    ModelRef::CatmullRom(c) => (c.spline().breakpoints(), c.spline().closed()),
+                    ModelRef::BezierSpline(c) => (c.spline().knots().to_vec(), false),
+                    _ => (Vec::new(), false),
                 };
                 let Some(Model::Curve(chain)) = model.to_bspline_curve() else {
                     return None;
@@ -45,6 +48,7 @@ impl<'a> CurveEval<'a> {
                 CurveEval::BSpline {
                     curve: Cow::Owned(chain.curve().clone()),
                     junctions: Some(junctions),
+                    closed,
                 }
             }
             ModelRef::Surface(_) | ModelRef::ErbsSurface(_) => return None,
@@ -67,13 +71,19 @@ impl<'a> CurveEval<'a> {
     }
 
     /// The parameters a badge goes to: the segment junctions of Catmull–Rom and Bézier
-    /// splines, the interior knots of multiplicity > 1 of B-spline curves (where their
-    /// guaranteed continuity drops below C^(d−1)); none for ERBS curves (C^∞ blends).
+    /// splines (a closed chain's seam too, as the domain's start), the interior knots of
+    /// multiplicity > 1 of B-spline curves (where their guaranteed continuity drops below
+    /// C^(d−1)); none for ERBS curves (C^∞ blends).
     pub fn join_params(&self) -> Vec<f64> {
         match self {
             CurveEval::BSpline {
-                junctions: Some(j), ..
-            } => j[1..j.len() - 1].to_vec(),
+                junctions: Some(j),
+                closed,
+                ..
+            } => {
+                let seam = if *closed { &j[..1] } else { &[] };
+                seam.iter().chain(&j[1..j.len() - 1]).copied().collect()
+            }
             CurveEval::BSpline { curve, .. } => {
                 let (a, b) = curve.domain();
                 curve
@@ -87,14 +97,17 @@ impl<'a> CurveEval<'a> {
         }
     }
 
-    /// Left and right limits of c, c', c'' at t.
+    /// Left and right limits of c, c', c'' at t. At a closed chain's seam (the domain's start)
+    /// the left limit is the one at the domain's end.
     pub fn limits(&self, t: f64) -> Option<([DVec3; 3], [DVec3; 3])> {
-        let CurveEval::BSpline { curve, .. } = self else {
+        let CurveEval::BSpline { curve, closed, .. } = self else {
             return None;
         };
+        let (a, b) = curve.domain();
+        let left_at = if *closed && t == a { b } else { t };
         let arr = |v: Vec<DVec3>| [v[0], v[1], v[2]];
         Some((
-            arr(curve.one_sided_derivatives(t, 2, true)),
+            arr(curve.one_sided_derivatives(left_at, 2, true)),
             arr(curve.one_sided_derivatives(t, 2, false)),
         ))
     }
