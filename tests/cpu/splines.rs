@@ -644,7 +644,10 @@ fn closed_curves_have_a_badge_at_their_seam() {
     let pw = lecture_closed_catmull_rom(&p);
     let (l, r) = (pw.limit(5, 6.0, 2), pw.limit(0, 0.0, 2));
     let size = p.iter().fold(0.0f64, |m, q| m.max(q.abs().max_element()));
-    assert_eq!(classify([l[0], l[1], l[2]], [r[0], r[1], r[2]], size), joins[0].class);
+    assert_eq!(
+        classify([l[0], l[1], l[2]], [r[0], r[1], r[2]], size),
+        joins[0].class
+    );
     assert!(close(l[0], joins[0].position, size, 1e-15));
 
     // examples/catmull_rom.json: the closed centripetal ring has 8 points, so 8 badges; the
@@ -673,7 +676,12 @@ fn closed_curves_have_a_badge_at_their_seam() {
     // Centripetal knots: one tangent direction at every junction, the seam included (G1, or
     // C1 where neighbouring chords happen to be equal).
     for j in &ring {
-        assert!(matches!(j.class.label(), "G1" | "C1"), "ring at {}: {}", j.t, j.class.label());
+        assert!(
+            matches!(j.class.label(), "G1" | "C1"),
+            "ring at {}: {}",
+            j.t,
+            j.class.label()
+        );
     }
 
     // ERBS curves get no badges, closed ones neither: the blend is C^∞ across the seam too.
