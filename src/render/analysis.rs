@@ -144,6 +144,40 @@ pub fn curve_joins(model: ModelRef<'_>) -> Vec<Join> {
         .collect()
 }
 
+/// The runs of sample indices a curve is drawn as: one run, or for a B-spline curve whose
+/// interior knot of multiplicity ≥ degree + 1 leaves a gap (C⁻¹, the "gap" badge), one run per
+/// connected piece, so no line bridges the gap. `params` are the curve's sample parameters;
+/// a sample at the gap's knot belongs to the piece on its right (the evaluator's right limit).
+#[must_use]
+pub fn curve_pieces(model: ModelRef<'_>, params: &[f64]) -> Vec<std::ops::Range<usize>> {
+    let whole = vec![0..params.len()];
+    // Only B-spline, Bézier and NURBS curves can tear: chains share their junction points and
+    // ERBS curves blend smoothly.
+    let ModelRef::Curve(c) = model else {
+        return whole;
+    };
+    let curve = c.curve();
+    let d = curve.degree();
+    let (a, b) = curve.domain();
+    let may_tear = |t: f64| t > a && t < b && curve.knots().multiplicity(t) > d;
+    if !curve.knots().breakpoints(a, b).into_iter().any(may_tear) {
+        return whole;
+    }
+    let mut cuts: Vec<usize> = curve_joins(model)
+        .iter()
+        .filter(|j| !j.class.connected)
+        .map(|j| params.partition_point(|&p| p < j.t))
+        .collect();
+    cuts.dedup();
+    let mut start = 0;
+    let mut pieces = Vec::with_capacity(cuts.len() + 1);
+    for cut in cuts.into_iter().chain([params.len()]) {
+        pieces.push(start..cut);
+        start = cut;
+    }
+    pieces
+}
+
 /// A length scale of the curve: the largest coordinate magnitude of a coarse sampling.
 fn extent(curve: &CurveEval<'_>) -> f64 {
     let (a, b) = curve.domain();

@@ -2,6 +2,7 @@
 //! structures, with per-frame-slot dirty tracking so each slot receives exactly the rows changed
 //! since it was last written.
 
+use super::analysis::curve_pieces;
 use super::lod::{GridMetrics, Lod};
 use super::map_mirror::{MapScalars, MapView, SurfaceSlot};
 use super::style::{NetMode, Palette, ViewOptions, Wire};
@@ -372,12 +373,15 @@ impl GpuScene {
                     width: opts.curve_width,
                     depth_test: true,
                 };
-                let run = PointRun {
-                    offset: o.samples.offset,
-                    stride: 3,
-                    count: grid.dims[0],
-                };
-                frame.draw_polyline(&self.arenas[o.samples.arena], run, &style)?;
+                let sampled = &doc.objects[i].sampled;
+                for piece in curve_pieces(sampled.model(), sampled.params()[0]) {
+                    let run = PointRun {
+                        offset: o.samples.offset + 3 * piece.start,
+                        stride: 3,
+                        count: piece.len(),
+                    };
+                    polyline(frame, &self.arenas[o.samples.arena], run, &style)?;
+                }
             }
             let layout = &doc.objects[i].controls.layout;
             self.draw_controls(frame, i, o, layout, opts, hl, &palette)?;

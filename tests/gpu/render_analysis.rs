@@ -449,3 +449,76 @@ fn the_osculating_readout_is_not_overlapped_by_badges() {
     assert!(only_readout(&bad, rect).is_err());
     common::teardown(renderer, sink);
 }
+
+/// A B-spline curve whose interior knot has multiplicity degree + 1 is two pieces (C⁻¹, the
+/// "gap" badge): no line may bridge them. Degree 1 over (−3,0) (−1,0) | (1,2) (3,2), seen from
+/// straight above: the pieces are drawn, the diagonal between (−1,0) and (1,2) stays empty. The
+/// negative control is the same points with a simple interior knot, one polyline through all
+/// four, whose diagonal the same probes must see.
+#[test]
+fn curves_with_a_gap_are_drawn_apart() {
+    use prespline::render::analysis::curve_pieces;
+    use prespline::render::camera::OrbitCamera;
+    let scene = |knots: &str| {
+        prespline::scene::parse_scene(&format!(
+            r#"{{"objects": [{{"name": "c", "type": "bspline_curve", "degree": 1, "knots": {knots},
+            "points": [[-3, 0, 0], [-1, 0, 0], [1, 2, 0], [3, 2, 0]], "samples": 41, "color": [1, 1, 1]}}]}}"#
+        ))
+        .unwrap()
+    };
+    let (torn, whole) = (scene("[0, 0, 1, 1, 2, 2]"), scene("[0, 0, 1, 2, 3, 3]"));
+    let camera = OrbitCamera::parse("0,1,20,0,1,0").unwrap();
+    let ink = |scene: &Scene| {
+        let doc = common::editor(scene, None).into_document();
+        let sampled = &doc.objects[0].sampled;
+        let pieces = curve_pieces(sampled.model(), sampled.params()[0]);
+        let (w, h) = (400u32, 400u32);
+        let (mut renderer, sink) = common::renderer();
+        let shot = Shot {
+            width: w,
+            height: h,
+            camera: Some(camera),
+            options: ViewOptions::default(),
+            msaa: 1,
+        };
+        let px = render_document(&mut renderer, &doc, &shot).unwrap();
+        common::teardown(renderer, sink);
+        let background = px.get(0, 0);
+        // Pixels in a 9×9 window around the projection of `p` that differ from the background.
+        let lit = |p: DVec3| {
+            let (x, y, _) = camera
+                .project(p, w as f64, h as f64, &doc.bounds())
+                .unwrap();
+            let (x, y) = (x.round() as i64, y.round() as i64);
+            let mut n = 0;
+            for yy in y - 4..=y + 4 {
+                for xx in x - 4..=x + 4 {
+                    let c = px.get(xx as u32, yy as u32);
+                    n += usize::from((0..3).any(|k| c[k].abs_diff(background[k]) > 40));
+                }
+            }
+            n
+        };
+        let pieces_lit = [DVec3::new(-2.0, 0.0, 0.0), DVec3::new(2.0, 2.0, 0.0)].map(lit);
+        let bridge_lit = [0.3, 0.5, 0.7].map(|s| lit(DVec3::new(-1.0 + 2.0 * s, 2.0 * s, 0.0)));
+        (pieces, pieces_lit, bridge_lit)
+    };
+    let (pieces, pieces_lit, bridge_lit) = ink(&torn);
+    assert_eq!(
+        pieces,
+        [0..20, 20..41],
+        "the sample at the gap starts the right piece"
+    );
+    assert!(
+        pieces_lit.iter().all(|&n| n > 0),
+        "both pieces drawn: {pieces_lit:?}"
+    );
+    assert_eq!(bridge_lit, [0, 0, 0], "nothing bridges the gap");
+    let (pieces, pieces_lit, bridge_lit) = ink(&whole);
+    assert_eq!(pieces, [0..41]);
+    assert!(pieces_lit.iter().all(|&n| n > 0), "{pieces_lit:?}");
+    assert!(
+        bridge_lit.iter().all(|&n| n > 0),
+        "negative control: the probes see a drawn diagonal: {bridge_lit:?}"
+    );
+}
