@@ -16,7 +16,7 @@ use prespline::model::{Edit, KindEdit, PointEdit, SurfaceEdit};
 use prespline::render::analysis::{
     CurveEval, Osculating, PANEL, badge_overlay, osculating_panel_origin, osculating_text,
 };
-use prespline::render::maps::SurfaceMap;
+use prespline::render::maps::{MapScale, SurfaceMap};
 use prespline::render::offscreen::{Shot, render_document, shot_camera};
 use prespline::render::{GpuScene, Highlight, Lod, MapView, ViewOptions};
 use prespline::scene::Scene;
@@ -237,7 +237,10 @@ fn frame(
 }
 
 fn view(map: SurfaceMap) -> Option<MapView> {
-    Some(MapView { map, range: 0.5 })
+    Some(MapView {
+        map,
+        scales: vec![MapScale::symmetric(0.5); 2],
+    })
 }
 
 fn offscreen(renderer: &mut Renderer, shot: &Shot) -> OffscreenTarget {
@@ -520,5 +523,114 @@ fn curves_with_a_gap_are_drawn_apart() {
     assert!(
         bridge_lit.iter().all(|&n| n > 0),
         "negative control: the probes see a drawn diagonal: {bridge_lit:?}"
+    );
+}
+
+/// The bumpy B-spline surface (moved to the left) next to the 32 teapot patches, Gaussian map.
+fn bumps_beside_the_teapot() -> Scene {
+    let read = |p: &str| -> serde_json::Value {
+        let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(p));
+        serde_json::from_str(&text.unwrap()).unwrap()
+    };
+    let mut scene = read("examples/teapot.json");
+    let mut bumps = read("examples/bspline_surface.json")["objects"][0].clone();
+    for row in bumps["points"].as_array_mut().unwrap() {
+        for p in row.as_array_mut().unwrap() {
+            p[0] = serde_json::json!(p[0].as_f64().unwrap() - 9.0);
+        }
+    }
+    scene["objects"].as_array_mut().unwrap().push(bumps);
+    prespline::scene::parse_scene(&scene.to_string()).unwrap()
+}
+
+/// The fraction of object `i`'s samples whose pixel is clearly coloured (not white or grey),
+/// leaving out those under the legends (bottom right, at most two stacked).
+fn coloured_fraction(doc: &Document, shot: &Shot, px: &Pixels, i: usize) -> f64 {
+    let camera = shot_camera(doc, shot);
+    let (w, h) = (shot.width as f64, shot.height as f64);
+    let grid = doc.objects[i].sampled.grid();
+    let stride = grid.stride();
+    let (mut seen, mut coloured) = (0usize, 0usize);
+    for k in 0..grid.dims[0] * grid.dims[1] {
+        let Some((x, y, _)) = camera.project(grid.data[k * stride], w, h, &doc.bounds()) else {
+            continue;
+        };
+        let legends = x >= w - 340.0 && y >= h - 64.0 - 2.0 * 96.0;
+        if x < 0.0 || y < 0.0 || x >= w || y >= h || legends {
+            continue;
+        }
+        let c = px.get(x as u32, y as u32);
+        let (hi, lo) = (c[..3].iter().max().unwrap(), c[..3].iter().min().unwrap());
+        seen += 1;
+        coloured += usize::from(hi - lo > 40);
+    }
+    assert!(seen > 100, "object {i} is in the picture");
+    coloured as f64 / seen as f64
+}
+
+/// In a mixed scene each surface gets its own colour scale by default: the gently curved bumps
+/// (|K| ≲ 0.7) beside the teapot (|K| up to ~60) still show red and blue. The negative control
+/// is the shared scale, which the teapot sets, so the bumps go almost white.
+#[test]
+fn per_object_ranges_colour_every_surface_in_a_mixed_scene() {
+    use prespline::render::maps::{MapRange, map_scales};
+    let scene = bumps_beside_the_teapot();
+    let doc = common::editor(&scene, Some(SurfaceMap::Gaussian)).into_document();
+    let bumps = doc.objects.len() - 1;
+    let render = |range: MapRange| {
+        let shot = Shot {
+            width: 960,
+            height: 540,
+            camera: None,
+            options: ViewOptions {
+                analysis: Some(SurfaceMap::Gaussian),
+                map_range: range,
+                ..ViewOptions::default()
+            },
+            msaa: 1,
+        };
+        let (mut renderer, sink) = common::renderer();
+        let px = render_document(&mut renderer, &doc, &shot).unwrap();
+        common::teardown(renderer, sink);
+        let fractions = [0, bumps].map(|i| coloured_fraction(&doc, &shot, &px, i));
+        (fractions, px)
+    };
+    // The scales themselves: the bumps' own range is the one it gets alone, the teapot's
+    // patches (teapot_00 … teapot_31) share one.
+    let own = map_scales(&doc, SurfaceMap::Gaussian, MapRange::PerObject);
+    let alone = common::editor(
+        &load("examples/bspline_surface.json"),
+        Some(SurfaceMap::Gaussian),
+    )
+    .into_document();
+    let alone = map_scales(&alone, SurfaceMap::Gaussian, MapRange::PerObject)[0];
+    // Equal up to the rounding of the curvature after the move by −9 in x.
+    assert!((own[bumps].high - alone.high).abs() <= 1e-12 * alone.high);
+    assert_eq!(own[bumps].low, -own[bumps].high);
+    assert!(
+        own[..bumps].iter().all(|s| *s == own[0]),
+        "one scale for the teapot"
+    );
+    let shared = map_scales(&doc, SurfaceMap::Gaussian, MapRange::Shared);
+    assert!(
+        shared[bumps].high > 20.0 * own[bumps].high,
+        "{shared:?} vs {own:?}"
+    );
+
+    let ([teapot, bumpy], px) = render(MapRange::PerObject);
+    if std::env::var_os("PRESPLINE_KEEP").is_some() {
+        px.write_png(Path::new("/tmp/mixed-per-object.png"))
+            .unwrap();
+    }
+    assert!(teapot > 0.05, "teapot coloured: {teapot}");
+    assert!(bumpy > 0.3, "per-object: the bumps show colour: {bumpy}");
+    let ([teapot, bumpy], px) = render(MapRange::Shared);
+    if std::env::var_os("PRESPLINE_KEEP").is_some() {
+        px.write_png(Path::new("/tmp/mixed-shared.png")).unwrap();
+    }
+    assert!(teapot > 0.05, "teapot coloured: {teapot}");
+    assert!(
+        bumpy < 0.05,
+        "negative control, shared scale: the bumps wash out: {bumpy}"
     );
 }
