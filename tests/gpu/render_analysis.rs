@@ -370,9 +370,9 @@ fn only_readout(px: &Pixels, rect: [u32; 4]) -> Result<(), String> {
 /// The readout's text colour (sRGB).
 const READOUT: [u8; 4] = [240, 150, 240, 255];
 
-/// `prespline render examples/catmull_rom.json --badges --osculating centripetal@3.3`: the
-/// readout lies over a G1 badge there, and is drawn above it on its opaque panel (it used to
-/// read "cur C2 ture").
+/// `prespline render examples/catmull_rom.json --badges --osculating centripetal@T`, T the
+/// first parameter (in steps of 0.05) whose readout lies over a badge: the readout is drawn
+/// above it on its opaque panel (it used to read "cur C2 ture").
 #[test]
 fn the_osculating_readout_is_not_overlapped_by_badges() {
     let scene = load("examples/catmull_rom.json");
@@ -381,53 +381,57 @@ fn the_osculating_readout_is_not_overlapped_by_badges() {
         .iter()
         .position(|o| o.name == "centripetal")
         .unwrap();
-    let options = ViewOptions {
-        badges: true,
-        osculating_at: Some((i, 3.3)),
-        ..ViewOptions::default()
-    };
     let (mut renderer, sink) = common::renderer();
     let doc = Document::new(&scene);
     let shot = Shot {
         width: 1280,
         height: 720,
         camera: None,
-        options,
+        options: ViewOptions::default(),
         msaa: 0,
     };
-    let px = render_document(&mut renderer, &doc, &shot).unwrap();
-    // Where the readout goes, as the renderer places it.
     let font = renderer.font();
-    let o = Osculating::at(&CurveEval::of(doc.objects[i].sampled.model()).unwrap(), 3.3).unwrap();
     let (w, h) = (shot.width as f64, shot.height as f64);
-    let (x, y, _) = shot_camera(&doc, &shot)
-        .project(o.point, w, h, &doc.bounds())
-        .unwrap();
-    let [tw, th] = font.text_size(&osculating_text("centripetal", &o), TextSize::Normal);
-    let [px0, py0] = osculating_panel_origin([tw, th], (x, y), [w as f32, h as f32]);
-    let rect = [
-        px0 as u32,
-        py0 as u32,
-        (px0 + tw + 10.0) as u32,
-        (py0 + th + 8.0) as u32,
-    ];
-    // A badge lies under the readout here (a join of a curve inside its panel).
+    let camera = shot_camera(&doc, &shot);
     let badges = badge_overlay(&doc, font, |p| {
-        shot_camera(&doc, &shot)
+        camera
             .project(p, w, h, &doc.bounds())
             .map(|(x, y, _)| (x, y))
     });
-    let covered = badges.chunks_exact(6).any(|q| {
-        let (a, b) = (q[0].pos, q[2].pos);
-        a[0] < rect[2] as f32
-            && b[0] > rect[0] as f32
-            && a[1] < rect[3] as f32
-            && b[1] > rect[1] as f32
-    });
-    assert!(
-        covered,
-        "no badge under the readout: the test shows nothing"
-    );
+    // Where the readout at t goes, as the renderer places it.
+    let readout_rect = |t: f64| {
+        let curve = CurveEval::of(doc.objects[i].sampled.model()).unwrap();
+        let o = Osculating::at(&curve, t)?;
+        let (x, y, _) = camera.project(o.point, w, h, &doc.bounds())?;
+        let [tw, th] = font.text_size(&osculating_text("centripetal", &o), TextSize::Normal);
+        let [px0, py0] = osculating_panel_origin([tw, th], (x, y), [w as f32, h as f32]);
+        Some([
+            px0 as u32,
+            py0 as u32,
+            (px0 + tw + 10.0) as u32,
+            (py0 + th + 8.0) as u32,
+        ])
+    };
+    // A badge under the readout (a join of a curve inside its panel).
+    let covered = |rect: [u32; 4]| {
+        badges.chunks_exact(6).any(|q| {
+            let (a, b) = (q[0].pos, q[2].pos);
+            a[0] < rect[2] as f32
+                && b[0] > rect[0] as f32
+                && a[1] < rect[3] as f32
+                && b[1] > rect[1] as f32
+        })
+    };
+    let (t, rect) = (1..120)
+        .map(|k| k as f64 * 0.05)
+        .find_map(|t| readout_rect(t).filter(|&r| covered(r)).map(|r| (t, r)))
+        .expect("no badge under any readout: the test shows nothing");
+    let options = ViewOptions {
+        badges: true,
+        osculating_at: Some((i, t)),
+        ..ViewOptions::default()
+    };
+    let px = render_document(&mut renderer, &doc, &Shot { options, ..shot }).unwrap();
     let magenta = (rect[1]..rect[3])
         .flat_map(|y| (rect[0]..rect[2]).map(move |x| (x, y)))
         .filter(|&(x, y)| px.get(x, y)[..3] == READOUT[..3])
