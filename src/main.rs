@@ -4,7 +4,7 @@
 use clap::{Args, Parser, Subcommand};
 use prespline::cli::files::{SampleOverride, SamplesArg};
 use prespline::cli::{self, CliError};
-use prespline::render::maps::SurfaceMap;
+use prespline::render::maps::{MapRange, SurfaceMap};
 use prespline::render::{NetMode, OrbitCamera, ViewOptions, Wire};
 use prespline::sampling::budget::{self, MemoryBudget};
 use prespline::scene::escape_controls;
@@ -39,6 +39,8 @@ enum Command {
         /// Apply the edits to the model and re-sample from scratch instead of the delta path.
         #[arg(long)]
         full: bool,
+        #[command(flatten)]
+        samples: SamplesArgs,
         #[command(flatten)]
         memory: MemoryArgs,
     },
@@ -83,6 +85,8 @@ enum Command {
         /// Open with a surface analysis map on: gaussian, mean, kmax, kmin or zebra (M cycles).
         #[arg(long, value_name = "MAP", value_parser = SurfaceMap::parse)]
         analysis: Option<SurfaceMap>,
+        #[command(flatten)]
+        map_range: MapRangeArgs,
     },
     /// Run a scripted, reproducible editing session and report where every millisecond goes.
     Bench {
@@ -116,6 +120,8 @@ enum Command {
         #[arg(long, default_value_t = 0)]
         msaa: u32,
         #[command(flatten)]
+        samples: SamplesArgs,
+        #[command(flatten)]
         memory: MemoryArgs,
         /// Draw every sample of every surface (no display level of detail), for comparison.
         #[arg(long)]
@@ -123,6 +129,8 @@ enum Command {
         /// Show a surface analysis map throughout: gaussian, mean, kmax, kmin or zebra.
         #[arg(long, value_name = "MAP", value_parser = SurfaceMap::parse)]
         analysis: Option<SurfaceMap>,
+        #[command(flatten)]
+        map_range: MapRangeArgs,
     },
     /// Render a scene headless (no display needed) into a PNG image.
     Render {
@@ -200,6 +208,16 @@ impl MemoryArgs {
     }
 }
 
+/// The colour scale of curvature maps.
+#[derive(Args, Clone, Copy)]
+struct MapRangeArgs {
+    /// Colour scale of curvature maps: per-object (each surface its own symmetric range from
+    /// the 90th percentile of |value|; patches named NAME_0, NAME_1, … share one), shared (one
+    /// range over every surface) or MIN,MAX (fixed: MIN blue, MAX red, white halfway).
+    #[arg(long, value_name = "shared|per-object|MIN,MAX", default_value = "per-object", value_parser = MapRange::parse, allow_hyphen_values = true)]
+    map_range: MapRange,
+}
+
 /// What to draw besides curves and shaded surfaces.
 #[derive(Args, Clone, Copy)]
 struct DisplayArgs {
@@ -229,6 +247,8 @@ struct DisplayArgs {
     /// (principal curvatures) or zebra (reflection lines).
     #[arg(long, value_name = "MAP", value_parser = SurfaceMap::parse)]
     analysis: Option<SurfaceMap>,
+    #[command(flatten)]
+    map_range: MapRangeArgs,
     /// Draw every sample of every surface (no display level of detail).
     #[arg(long)]
     no_lod: bool,
@@ -249,6 +269,7 @@ impl DisplayArgs {
             curvature_comb: self.comb,
             badges: self.badges,
             analysis: self.analysis,
+            map_range: self.map_range.map_range,
             lod: !self.no_lod,
             ..ViewOptions::default()
         }
@@ -263,6 +284,7 @@ fn main() -> ExitCode {
             derivatives,
             edits,
             full,
+            samples,
             memory,
         } => {
             let args = cli::sample::SampleArgs {
@@ -271,6 +293,7 @@ fn main() -> ExitCode {
                 edits: edits.as_deref(),
                 full,
                 memory: memory.budget(),
+                samples: samples.counts(),
             };
             cli::sample::run(&args).and_then(|text| print(&text))
         }
@@ -285,6 +308,7 @@ fn main() -> ExitCode {
             recover,
             memory,
             analysis,
+            map_range,
         } => cli::view::run(&cli::view::ViewOptions {
             scene: scene.as_deref(),
             size,
@@ -296,6 +320,7 @@ fn main() -> ExitCode {
             memory: memory.budget(),
             recover: recover.as_ref().map(Option::as_deref),
             analysis,
+            map_range: map_range.map_range,
         }),
         Command::Bench {
             scene,
@@ -307,9 +332,11 @@ fn main() -> ExitCode {
             naive,
             out,
             msaa,
+            samples,
             memory,
             no_lod,
             analysis,
+            map_range,
         } => {
             let args = cli::bench::BenchArgs {
                 scene,
@@ -324,6 +351,8 @@ fn main() -> ExitCode {
                 memory: memory.budget(),
                 lod: !no_lod,
                 analysis,
+                map_range: map_range.map_range,
+                samples: samples.counts(),
             };
             cli::bench::run(&args).map(|line| eprintln!("{}", escape_controls(&line)))
         }

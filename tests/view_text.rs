@@ -8,7 +8,7 @@ mod common;
 use prespline::gpu::font::{Font, TextSize};
 use prespline::gpu::{OffscreenDesc, OverlayVertex, Pixels, Renderer, ValidationSink};
 use prespline::render::analysis::PANEL;
-use prespline::render::maps::{SurfaceMap, legend};
+use prespline::render::maps::{LegendPlace, MapScale, SurfaceMap, legend};
 use prespline::scene::parse_scene;
 use prespline::view::Session;
 use prespline::view::hud::{
@@ -167,7 +167,13 @@ fn the_help_is_drawn_above_the_legend_at_800x600() {
     v.session.set_map(Some(SurfaceMap::Gaussian));
     let font = Font::new(1.0);
     let help = help_overlay(&font, W as f32, H as f32);
-    let legend = legend(SurfaceMap::Gaussian, 1.0, &font, W as f32, H as f32);
+    let place = LegendPlace {
+        name: None,
+        slot: 0,
+        width: W as f32,
+        height: H as f32,
+    };
+    let legend = legend(SurfaceMap::Gaussian, MapScale::symmetric(1.0), &font, place);
     let both = intersect(quad_rect(&help, 0), quad_rect(&legend, 0));
     assert!(
         both[0] + 50 < both[2] && both[1] + 20 < both[3],

@@ -41,6 +41,10 @@ pub struct BenchArgs {
     pub lod: bool,
     /// A surface analysis map shown throughout (`--analysis`).
     pub analysis: Option<SurfaceMap>,
+    /// `--samples` overrides for the scene (the demo's too).
+    pub samples: super::files::SampleOverride,
+    /// How the map's colour scale is chosen (`--map-range`).
+    pub map_range: crate::render::maps::MapRange,
 }
 
 /// Runs the benchmark, writes the reports and returns the closing line.
@@ -50,10 +54,14 @@ pub fn run(args: &BenchArgs) -> Result<String, CliError> {
     }
     let (scene, scene_name) = match &args.scene {
         Some(p) => (
-            super::files::load_scene(p, &Default::default())?,
+            super::files::load_scene(p, &args.samples)?,
             p.display().to_string(),
         ),
-        None => (demo_scene(), "demo".to_string()),
+        None => {
+            let mut demo = demo_scene();
+            args.samples.apply(&mut demo)?;
+            (demo, "demo".to_string())
+        }
     };
     super::render::check_drawable(&scene, Path::new(&scene_name), &args.memory)?;
     super::render::check_analysis(&scene, args.analysis, &args.memory)?;
@@ -88,6 +96,13 @@ pub fn run(args: &BenchArgs) -> Result<String, CliError> {
             ..RunInfo::default()
         };
         info = info.with("target", if args.window { "window" } else { "offscreen" });
+        // The problem size, which `--samples` sets: every object's sample count, summed.
+        let samples: usize = scene
+            .objects
+            .iter()
+            .map(|o| o.model.sample_dims().iter().product::<usize>())
+            .sum();
+        info = info.with("scene_samples", samples);
         let paths = write_all(&dir, &info, &frames).map_err(|e| CliError(e.to_string()))?;
         written.extend(paths);
         if !args.window {
@@ -177,6 +192,7 @@ fn run_headless(
     .map_err(CliError)?;
     session.set_naive(naive);
     session.options.lod = args.lod;
+    session.options.map_range = args.map_range;
     session.set_map(args.analysis);
     let total = args.warmup + args.frames;
     let result = (|| -> Result<Recorder, CliError> {
@@ -269,6 +285,7 @@ fn run_window(
         msaa: args.msaa,
         lod: args.lod,
         analysis: args.analysis,
+        map_range: args.map_range,
         memory: args.memory,
     })
     .map_err(CliError)?;

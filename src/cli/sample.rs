@@ -23,6 +23,8 @@ pub struct SampleArgs<'a> {
     pub full: bool,
     /// What pre-evaluation and the output text may take.
     pub memory: MemoryBudget,
+    /// `--samples` overrides for the loaded scene.
+    pub samples: super::files::SampleOverride,
 }
 
 /// Runs the command and returns the complete output text (nothing is printed on error, so a
@@ -34,7 +36,7 @@ pub fn run(args: &SampleArgs) -> Result<String, CliError> {
             args.derivatives
         )));
     }
-    let scene = super::files::load_scene(args.scene, &Default::default())?;
+    let scene = super::files::load_scene(args.scene, &args.samples)?;
     let edits = match args.edits {
         Some(path) => {
             let text = std::fs::read_to_string(path)

@@ -32,6 +32,8 @@ pub struct ViewOptions<'a> {
     pub recover: Option<Option<&'a Path>>,
     /// A surface analysis map shown from the start (`--analysis`; M cycles it later).
     pub analysis: Option<crate::render::maps::SurfaceMap>,
+    /// How the map's colour scale is chosen (`--map-range`).
+    pub map_range: crate::render::maps::MapRange,
 }
 
 pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
@@ -55,11 +57,11 @@ pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
             p.display().to_string(),
             p.to_path_buf(),
         ),
-        (None, None) => (
-            demo_scene(),
-            "demo".to_string(),
-            Path::new(DEMO_SAVE).to_path_buf(),
-        ),
+        (None, None) => {
+            let mut demo = demo_scene();
+            opts.samples.apply(&mut demo)?;
+            (demo, "demo".to_string(), Path::new(DEMO_SAVE).to_path_buf())
+        }
     };
     let note = places.waiting_note(recovered.as_deref());
     let mut autosave = match recovered {
@@ -101,6 +103,7 @@ pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
         msaa: 0,
         lod: true,
         analysis: opts.analysis,
+        map_range: opts.map_range,
         memory: opts.memory,
     };
     let title = args.title.clone();

@@ -70,8 +70,9 @@ pub trait Kind: Clone + Debug + PartialEq + Sized + 'static {
         out: &mut [DVec3],
     );
 
-    /// The parameters where a chain's Bézier segments meet (kinds built of segments).
-    fn junctions(&self) -> Option<Vec<f64>> {
+    /// The parameters where a chain's Bézier segments meet, and whether the chain closes on
+    /// itself (its seam is a junction too), for kinds built of segments.
+    fn junctions(&self) -> Option<(Vec<f64>, bool)> {
         None
     }
 
@@ -131,7 +132,7 @@ pub trait DynKind {
         list: &[(usize, usize)],
         out: &mut [DVec3],
     );
-    fn junctions(&self) -> Option<Vec<f64>>;
+    fn junctions(&self) -> Option<(Vec<f64>, bool)>;
     fn control_point(&self, point: Index2) -> Option<DVec3>;
     fn local_controls(&self, local: LocalPath<Index2>) -> Option<ControlDisplay>;
     fn move_edit(&self, grip: Grip, delta: DVec3) -> Option<ObjectEdit>;
@@ -222,7 +223,7 @@ where
         Kind::derivatives_at(self, uv, order, list, out);
     }
 
-    fn junctions(&self) -> Option<Vec<f64>> {
+    fn junctions(&self) -> Option<(Vec<f64>, bool)> {
         Kind::junctions(self)
     }
 

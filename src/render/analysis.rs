@@ -19,6 +19,8 @@ pub enum CurveEval<'a> {
     BSpline {
         curve: std::borrow::Cow<'a, BSplineCurve>,
         junctions: Option<Vec<f64>>,
+        /// A closed chain (closed Catmull–Rom): its end meets its start, one more junction.
+        closed: bool,
     },
     Erbs(&'a ErbsCurve),
 }
@@ -31,17 +33,20 @@ impl<'a> CurveEval<'a> {
             ModelRef::Curve(c) => CurveEval::BSpline {
                 curve: Cow::Borrowed(c.curve()),
                 junctions: None,
+                closed: false,
             },
             ModelRef::ErbsCurve(c) => CurveEval::Erbs(c.curve()),
             _ if model.is_surface() => return None,
             // Chains of Bézier segments: the de Boor form of the chain, with its junctions.
             other => {
+                let (junctions, closed) = other.kind().junctions()?;
                 let Some(Model::Curve(chain)) = other.to_bspline_curve() else {
                     return None;
                 };
                 CurveEval::BSpline {
                     curve: Cow::Owned(chain.curve().clone()),
-                    junctions: other.kind().junctions(),
+                    junctions: Some(junctions),
+                    closed,
                 }
             }
         })
@@ -63,13 +68,19 @@ impl<'a> CurveEval<'a> {
     }
 
     /// The parameters a badge goes to: the segment junctions of Catmull–Rom and Bézier
-    /// splines, the interior knots of multiplicity > 1 of B-spline curves (where their
-    /// guaranteed continuity drops below C^(d−1)); none for ERBS curves (C^∞ blends).
+    /// splines (a closed chain's seam too, as the domain's start), the interior knots of
+    /// multiplicity > 1 of B-spline curves (where their guaranteed continuity drops below
+    /// C^(d−1)); none for ERBS curves (C^∞ blends).
     pub fn join_params(&self) -> Vec<f64> {
         match self {
             CurveEval::BSpline {
-                junctions: Some(j), ..
-            } => j[1..j.len() - 1].to_vec(),
+                junctions: Some(j),
+                closed,
+                ..
+            } => {
+                let seam = if *closed { &j[..1] } else { &[] };
+                seam.iter().chain(&j[1..j.len() - 1]).copied().collect()
+            }
             CurveEval::BSpline { curve, .. } => {
                 let (a, b) = curve.domain();
                 curve
@@ -83,14 +94,17 @@ impl<'a> CurveEval<'a> {
         }
     }
 
-    /// Left and right limits of c, c', c'' at t.
+    /// Left and right limits of c, c', c'' at t. At a closed chain's seam (the domain's start)
+    /// the left limit is the one at the domain's end.
     pub fn limits(&self, t: f64) -> Option<([DVec3; 3], [DVec3; 3])> {
-        let CurveEval::BSpline { curve, .. } = self else {
+        let CurveEval::BSpline { curve, closed, .. } = self else {
             return None;
         };
+        let (a, b) = curve.domain();
+        let left_at = if *closed && t == a { b } else { t };
         let arr = |v: Vec<DVec3>| [v[0], v[1], v[2]];
         Some((
-            arr(curve.one_sided_derivatives(t, 2, true)),
+            arr(curve.one_sided_derivatives(left_at, 2, true)),
             arr(curve.one_sided_derivatives(t, 2, false)),
         ))
     }
@@ -125,6 +139,40 @@ pub fn curve_joins(model: ModelRef<'_>) -> Vec<Join> {
             })
         })
         .collect()
+}
+
+/// The runs of sample indices a curve is drawn as: one run, or for a B-spline curve whose
+/// interior knot of multiplicity ≥ degree + 1 leaves a gap (C⁻¹, the "gap" badge), one run per
+/// connected piece, so no line bridges the gap. `params` are the curve's sample parameters;
+/// a sample at the gap's knot belongs to the piece on its right (the evaluator's right limit).
+#[must_use]
+pub fn curve_pieces(model: ModelRef<'_>, params: &[f64]) -> Vec<std::ops::Range<usize>> {
+    let whole = vec![0..params.len()];
+    // Only B-spline, Bézier and NURBS curves can tear: chains share their junction points and
+    // ERBS curves blend smoothly.
+    let ModelRef::Curve(c) = model else {
+        return whole;
+    };
+    let curve = c.curve();
+    let d = curve.degree();
+    let (a, b) = curve.domain();
+    let may_tear = |t: f64| t > a && t < b && curve.knots().multiplicity(t) > d;
+    if !curve.knots().breakpoints(a, b).into_iter().any(may_tear) {
+        return whole;
+    }
+    let mut cuts: Vec<usize> = curve_joins(model)
+        .iter()
+        .filter(|j| !j.class.connected)
+        .map(|j| params.partition_point(|&p| p < j.t))
+        .collect();
+    cuts.dedup();
+    let mut start = 0;
+    let mut pieces = Vec::with_capacity(cuts.len() + 1);
+    for cut in cuts.into_iter().chain([params.len()]) {
+        pieces.push(start..cut);
+        start = cut;
+    }
+    pieces
 }
 
 /// A length scale of the curve: the largest coordinate magnitude of a coarse sampling.

@@ -70,9 +70,12 @@ impl OrbitCamera {
         }
     }
 
-    /// Places the target at the bounds' centre and picks the smallest distance at which all
-    /// eight corners of the box project inside 90 % of the image (bisection; the sphere-fit
-    /// distance is the safe upper bound).
+    /// Frames the projected bounds: from the current direction, the eight corners of the box
+    /// project centred in the image and fill 90 % of it in the tighter direction, so a flat
+    /// object seen at an angle gets equal margins above and below (centring the box's centre,
+    /// or fitting its bounding sphere, leaves the near side crowded and the far side empty).
+    /// Alternates a distance fit (bisection) with moving the target in the view plane by the
+    /// projected box's offset; perspective makes each move approximate, so a few rounds.
     pub fn frame(&mut self, bounds: &Bounds, aspect: f64) {
         self.target = bounds.centre();
         let half = 0.5 * self.fov_y;
@@ -84,41 +87,70 @@ impl OrbitCamera {
         }
         let corners: Vec<DVec3> = (0..8)
             .map(|i| {
+                let pick = |bit: usize, lo: f64, hi: f64| if i & bit == 0 { lo } else { hi };
                 DVec3::new(
-                    if i & 1 == 0 {
-                        bounds.min.x
-                    } else {
-                        bounds.max.x
-                    },
-                    if i & 2 == 0 {
-                        bounds.min.y
-                    } else {
-                        bounds.max.y
-                    },
-                    if i & 4 == 0 {
-                        bounds.min.z
-                    } else {
-                        bounds.max.z
-                    },
+                    pick(1, bounds.min.x, bounds.max.x),
+                    pick(2, bounds.min.y, bounds.max.y),
+                    pick(4, bounds.min.z, bounds.max.z),
                 )
             })
             .collect();
-        let fits = |cam: &OrbitCamera| {
-            let (near, far) = cam.clip_planes(bounds);
-            let vp = DMat4::perspective_rh(cam.fov_y, aspect, near, far) * cam.view();
-            corners.iter().all(|&p| {
-                let c = vp * p.extend(1.0);
-                c.w > 0.0 && (c.x / c.w).abs() <= 0.9 && (c.y / c.w).abs() <= 0.9
-            })
+        for _ in 0..8 {
+            self.fit_distance(&corners, bounds, aspect, safe);
+            let Some([x0, x1, y0, y1]) = self.projected_box(&corners, bounds, aspect) else {
+                break;
+            };
+            let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+            if cx.abs().max(cy.abs()) < 1e-5 {
+                break;
+            }
+            let (right, up) = self.basis();
+            let h = self.distance * half.tan();
+            self.target += right * (cx * h * aspect) + up * (cy * h);
+        }
+        self.fit_distance(&corners, bounds, aspect, safe);
+    }
+
+    /// The NDC box [x0, x1, y0, y1] of `points`; `None` when one is behind the eye.
+    fn projected_box(&self, points: &[DVec3], bounds: &Bounds, aspect: f64) -> Option<[f64; 4]> {
+        let vp = self.view_proj(aspect, bounds);
+        let mut b = [
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ];
+        for &p in points {
+            let c = vp * p.extend(1.0);
+            if c.w <= 0.0 {
+                return None;
+            }
+            let (x, y) = (c.x / c.w, c.y / c.w);
+            b = [b[0].min(x), b[1].max(x), b[2].min(y), b[3].max(y)];
+        }
+        Some(b)
+    }
+
+    /// The smallest distance (bisection) at which every point projects inside 90 % of the
+    /// image, from the current target and direction; `safe` is a first upper bound.
+    fn fit_distance(&mut self, points: &[DVec3], bounds: &Bounds, aspect: f64, safe: f64) {
+        let fits = |distance: f64| {
+            let probe = OrbitCamera { distance, ..*self };
+            probe
+                .projected_box(points, bounds, aspect)
+                .is_some_and(|[x0, x1, y0, y1]| x0 >= -0.9 && x1 <= 0.9 && y0 >= -0.9 && y1 <= 0.9)
         };
-        let (mut lo, mut hi) = (0.0, safe);
+        let mut hi = safe.max(f64::MIN_POSITIVE);
+        for _ in 0..60 {
+            if fits(hi) {
+                break;
+            }
+            hi *= 2.0;
+        }
+        let mut lo = 0.0;
         for _ in 0..40 {
             let mid = 0.5 * (lo + hi);
-            let probe = OrbitCamera {
-                distance: mid,
-                ..*self
-            };
-            if fits(&probe) { hi = mid } else { lo = mid }
+            if fits(mid) { hi = mid } else { lo = mid }
         }
         self.distance = hi;
     }
@@ -284,7 +316,8 @@ mod tests {
         let (o, d) = c.ray(x, y, 1200.0, 800.0, &b);
         let closest = o + d * (p - o).dot(d);
         assert!((closest - p).length() < 1e-9);
-        // Framing keeps every corner inside the image.
+        // Framing keeps every corner inside the image, the box centred with equal margins.
+        let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
         for i in 0..8 {
             let q = DVec3::new(
                 if i & 1 == 0 { -1.0 } else { 1.0 },
@@ -296,6 +329,19 @@ mod tests {
                 (0.0..1200.0).contains(&x) && (0.0..800.0).contains(&y),
                 "{q:?} → {x}, {y}"
             );
+            (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
         }
+        assert!(
+            (x0 - (1200.0 - x1)).abs() < 0.5,
+            "left {x0} right {}",
+            1200.0 - x1
+        );
+        assert!(
+            (y0 - (800.0 - y1)).abs() < 0.5,
+            "top {y0} bottom {}",
+            800.0 - y1
+        );
+        // The tighter direction is filled to 90 %.
+        assert!(((y1 - y0) / 800.0 - 0.9).abs() < 1e-3 || ((x1 - x0) / 1200.0 - 0.9).abs() < 1e-3);
     }
 }

@@ -2,6 +2,7 @@
 //! structures, with per-frame-slot dirty tracking so each slot receives exactly the rows changed
 //! since it was last written.
 
+use super::analysis::curve_pieces;
 use super::lod::{GridMetrics, Lod};
 use super::map_mirror::{MapScalars, MapView, SurfaceSlot};
 use super::style::{NetMode, Palette, ViewOptions, Wire};
@@ -205,28 +206,28 @@ impl GpuScene {
     }
 
     /// Colours the surfaces by `map` from the next frame on (`None`: plain shading). A new
-    /// curvature map computes its scalars at the next [`GpuScene::upload`]; a new range
-    /// costs nothing (it is a shader constant).
+    /// curvature map or new scales compute the scalars at the next [`GpuScene::upload`] (they
+    /// are stored on each surface's scale).
     pub fn set_map(&mut self, map: Option<MapView>) {
         self.map = map;
     }
 
     /// The map colouring the surfaces.
-    pub fn map(&self) -> Option<MapView> {
-        self.map
+    pub fn map(&self) -> Option<&MapView> {
+        self.map.as_ref()
     }
 
     /// Builds the scalar mirrors when the curvature map changed, drops them when none is
     /// shown; returns the bytes written.
     fn sync_scalars(&mut self, frame: &mut Frame<'_>, doc: &Document) -> GpuResult<usize> {
-        let wanted = self.map.map(|m| m.map).filter(|m| m.needs_curvature());
-        if self.scalars.as_ref().map(|s| s.map) == wanted {
+        let wanted = self.map.as_ref().filter(|m| m.map.needs_curvature());
+        if self.scalars.as_ref().map(|s| &s.view) == wanted {
             return Ok(0);
         }
         if let Some(old) = self.scalars.take() {
             old.destroy_with(|m| frame.destroy_mirror(m));
         }
-        let Some(map) = wanted else { return Ok(0) };
+        let Some(view) = wanted else { return Ok(0) };
         let slots: Vec<Option<SurfaceSlot>> = (0..self.objects.len())
             .map(|i| {
                 doc.objects[i].sampled.grid().normals.as_ref().map(|_| {
@@ -238,7 +239,7 @@ impl GpuScene {
                 })
             })
             .collect();
-        let scalars = MapScalars::build(frame, doc, &slots, self.arenas.len(), map)?;
+        let scalars = MapScalars::build(frame, doc, &slots, self.arenas.len(), view)?;
         let bytes = scalars.mirrors.iter().map(|m| m.len() * 4).sum::<usize>();
         self.scalars = Some(scalars);
         Ok(bytes * FRAMES_IN_FLIGHT)
@@ -372,12 +373,15 @@ impl GpuScene {
                     width: opts.curve_width,
                     depth_test: true,
                 };
-                let run = PointRun {
-                    offset: o.samples.offset,
-                    stride: 3,
-                    count: grid.dims[0],
-                };
-                frame.draw_polyline(&self.arenas[o.samples.arena], run, &style)?;
+                let sampled = &doc.objects[i].sampled;
+                for piece in curve_pieces(sampled.model(), sampled.params()[0]) {
+                    let run = PointRun {
+                        offset: o.samples.offset + 3 * piece.start,
+                        stride: 3,
+                        count: piece.len(),
+                    };
+                    polyline(frame, &self.arenas[o.samples.arena], run, &style)?;
+                }
             }
             let layout = &doc.objects[i].controls.layout;
             self.draw_controls(frame, i, o, layout, opts, hl, &palette)?;
@@ -395,7 +399,7 @@ impl GpuScene {
         style: &SurfaceStyle,
     ) -> GpuResult<()> {
         let mirror = &self.arenas[arena];
-        let Some(view) = self.map else {
+        let Some(view) = &self.map else {
             return frame.draw_surface_batch(mirror, batch, style);
         };
         if !view.map.needs_curvature() {
@@ -405,10 +409,9 @@ impl GpuScene {
             return frame.draw_surface_map_batch(mirror, None, batch, zebra);
         }
         match &self.scalars {
-            Some(s) if s.map == view.map => {
-                let scale = MapStyle::Scale {
-                    range: view.range as f32,
-                };
+            // The scalars are on each surface's scale already (−1 … 1).
+            Some(s) if s.view.map == view.map => {
+                let scale = MapStyle::Scale { range: 1.0 };
                 frame.draw_surface_map_batch(mirror, Some(&s.mirrors[arena]), batch, scale)
             }
             _ => frame.draw_surface_batch(mirror, batch, style),

@@ -6,17 +6,17 @@
 //! The scalars follow the samples: the sample rows an edit dirtied are the scalar rows it
 //! dirtied, so a drag copies only the touched rows of the map, like the vertex mirrors.
 
-use super::maps::SurfaceMap;
+use super::maps::{MapScale, SurfaceMap};
 use crate::editor::Document;
 use crate::gpu::{Frame, GpuResult, Mirror};
 use std::ops::Range;
 
-/// What colours the surfaces: a map and the half range R of its colour scale (±R).
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// What colours the surfaces: a map and each object's colour scale (by object index; ignored
+/// by zebra stripes).
+#[derive(Debug, Clone, PartialEq)]
 pub struct MapView {
     pub map: SurfaceMap,
-    /// Half range of the colour scale (ignored by zebra stripes).
-    pub range: f64,
+    pub scales: Vec<MapScale>,
 }
 
 /// A surface's place in its arena, for its scalars.
@@ -27,10 +27,11 @@ pub(crate) struct SurfaceSlot {
     pub offset: usize,
 }
 
-/// The scalars of one curvature map, one mirror per arena.
+/// The scalars of one curvature map, one mirror per arena: each value already placed on its
+/// surface's scale (−1 … 1), so surfaces drawn in one batch keep their own scales.
 pub(crate) struct MapScalars {
-    /// The map the values belong to.
-    pub map: SurfaceMap,
+    /// The map and scales the values belong to.
+    pub view: MapView,
     /// Per arena; arenas without surfaces hold a single unused float.
     pub mirrors: Vec<Mirror>,
 }
@@ -46,14 +47,14 @@ impl MapScalars {
         doc: &Document,
         slots: &[Option<SurfaceSlot>],
         arenas: usize,
-        map: SurfaceMap,
+        view: &MapView,
     ) -> GpuResult<Self> {
         let mut data = vec![Vec::<f32>::new(); arenas];
         let mut row = Vec::new();
         for (i, slot) in slots.iter().enumerate() {
             let Some(slot) = slot else { continue };
             let rows = doc.objects[i].sampled.grid().dims[0];
-            scalar_floats(doc, i, 0..rows, map, &mut row);
+            scalar_floats(doc, i, 0..rows, view, &mut row);
             let start = slot.offset / VERTEX_FLOATS;
             let a = &mut data[slot.arena];
             if a.len() < start + row.len() {
@@ -71,7 +72,10 @@ impl MapScalars {
                 }
             }
         }
-        Ok(Self { map, mirrors })
+        Ok(Self {
+            view: view.clone(),
+            mirrors,
+        })
     }
 
     /// Copies the scalars of sample rows `rows` of surface `i` into this frame's slot; returns
@@ -86,7 +90,7 @@ impl MapScalars {
         scratch: &mut Vec<f32>,
     ) -> GpuResult<usize> {
         let cols = doc.objects[i].sampled.grid().dims[1];
-        scalar_floats(doc, i, rows.clone(), self.map, scratch);
+        scalar_floats(doc, i, rows.clone(), &self.view, scratch);
         let at = slot.offset / VERTEX_FLOATS + rows.start * cols;
         frame
             .write_mirror(&mut self.mirrors[slot.arena])
@@ -100,21 +104,27 @@ impl MapScalars {
     }
 }
 
-/// `map`'s value at each sample of rows `rows` of surface `i`, as f32; NaN (drawn as undefined)
-/// where the object carries no curvature or the curvature is undefined.
+/// The map's value at each sample of rows `rows` of surface `i` on the surface's scale, as f32;
+/// NaN (drawn as undefined) where the object carries no curvature or the curvature is undefined.
 pub(crate) fn scalar_floats(
     doc: &Document,
     i: usize,
     rows: Range<usize>,
-    map: SurfaceMap,
+    view: &MapView,
     out: &mut Vec<f32>,
 ) {
+    let (map, scale) = (view.map, view.scales.get(i).copied());
+    let scale = scale.unwrap_or(MapScale::symmetric(1.0));
     let grid = doc.objects[i].sampled.grid();
     let cols = grid.dims[1];
     let samples = rows.start * cols..rows.end * cols;
     out.clear();
     match &grid.curvatures {
-        Some(kh) => out.extend(kh[samples].iter().map(|&kh| map.value(kh) as f32)),
+        Some(kh) => out.extend(
+            kh[samples]
+                .iter()
+                .map(|&kh| scale.unit(map.value(kh)) as f32),
+        ),
         None => out.resize(samples.len(), f32::NAN),
     }
 }

@@ -2,9 +2,11 @@
 //! curvature, or zebra stripes), its colour scale, and the legend that explains it.
 //!
 //! The scale is diverging — blue for negative, white for zero, red for positive — over a
-//! symmetric range ±R, R the 98th percentile of |value| over the analysed surfaces (so a few
-//! extreme samples near a singular point do not wash the map out). The shader applies the
-//! same scale ([`SCALE`] is its table), so the legend shows exactly what the surface does.
+//! symmetric range ±R, R the 90th percentile of |value| (so the most curved tenth — a cusp, a
+//! collapsed edge, a spout — does not wash the rest of the map out). By default each surface gets its own R, so a gently
+//! curved surface next to a strongly curved one keeps its colours ([`MapRange`]). Values are
+//! mapped onto [−1, 1] per surface on the CPU and the shader applies the scale ([`SCALE`] is
+//! its table), so the legend shows exactly what the surface does.
 
 use crate::editor::Document;
 use crate::gpu::OverlayVertex;
@@ -101,28 +103,131 @@ impl SurfaceMap {
     }
 }
 
-/// The half range of `map`'s colour scale over every surface of `doc` (see
-/// [`symmetric_range`]).
+/// Which percentile of |value| sets a colour scale's half range.
+pub const RANGE_PERCENTILE: f64 = 0.90;
+
+/// How the colour scale of a curvature map is chosen (`--map-range`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MapRange {
+    /// One symmetric range over every surface: the most curved surface sets it.
+    Shared,
+    /// Each surface its own symmetric range (the default).
+    PerObject,
+    /// `low` is the blue end and `high` the red end on every surface, white halfway.
+    Fixed { low: f64, high: f64 },
+}
+
+impl MapRange {
+    /// Parses `shared`, `per-object` or `MIN,MAX` (finite, MIN < MAX).
+    pub fn parse(s: &str) -> Result<Self, String> {
+        match s {
+            "shared" => return Ok(MapRange::Shared),
+            "per-object" => return Ok(MapRange::PerObject),
+            _ => {}
+        }
+        let bad = || format!("'{s}' is not shared, per-object or MIN,MAX (for example -0.5,0.5)");
+        let (a, b) = s.split_once(',').ok_or_else(bad)?;
+        let (low, high): (f64, f64) = (
+            a.trim().parse().map_err(|_| bad())?,
+            b.trim().parse().map_err(|_| bad())?,
+        );
+        if !(low.is_finite() && high.is_finite() && low < high) {
+            return Err(format!(
+                "'{s}': MIN and MAX must be finite numbers with MIN < MAX"
+            ));
+        }
+        Ok(MapRange::Fixed { low, high })
+    }
+}
+
+/// The values a surface's colour scale spans: `low` is the blue end, `high` the red end, the
+/// middle white.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MapScale {
+    pub low: f64,
+    pub high: f64,
+}
+
+impl MapScale {
+    /// ±r.
+    #[must_use]
+    pub fn symmetric(r: f64) -> Self {
+        Self { low: -r, high: r }
+    }
+
+    /// Where `v` falls on the scale, −1 (low) … 1 (high); NaN stays NaN.
+    #[must_use]
+    pub fn unit(&self, v: f64) -> f64 {
+        (2.0 * v - (self.low + self.high)) / (self.high - self.low)
+    }
+}
+
+/// The surfaces of `doc` in families that share a colour scale under [`MapRange::PerObject`]:
+/// surfaces whose names differ only in a trailing number (`teapot_00` … `teapot_31`, the
+/// patches of one model) are one family, named by the common stem; any other surface is a
+/// family of its own. In scene order.
 #[must_use]
-pub fn map_range(doc: &Document, map: SurfaceMap) -> f64 {
-    symmetric_range(doc.objects.iter().flat_map(|o| {
-        o.sampled
+pub fn surface_families(doc: &Document) -> Vec<(String, Vec<usize>)> {
+    let mut families: Vec<(String, Vec<usize>)> = Vec::new();
+    for (i, o) in doc.objects.iter().enumerate() {
+        if !o.sampled.model().is_surface() {
+            continue;
+        }
+        let stem = o.name.trim_end_matches(|c: char| c.is_ascii_digit());
+        let stem = stem.trim_end_matches(['_', '-', '.', ' ']);
+        let key = if stem.is_empty() || stem.len() == o.name.len() {
+            o.name.as_str()
+        } else {
+            stem
+        };
+        match families.iter_mut().find(|(k, _)| k == key) {
+            Some((_, members)) => members.push(i),
+            None => families.push((key.to_string(), vec![i])),
+        }
+    }
+    families
+}
+
+/// The colour scale of every object of `doc` for `map`, by object index (curves get one too,
+/// unused).
+#[must_use]
+pub fn map_scales(doc: &Document, map: SurfaceMap, range: MapRange) -> Vec<MapScale> {
+    let values = |i: usize| {
+        doc.objects[i]
+            .sampled
             .grid()
             .curvatures
             .iter()
             .flatten()
             .map(move |&kh| map.value(kh))
-    }))
+    };
+    let n = doc.objects.len();
+    match range {
+        MapRange::Fixed { low, high } => vec![MapScale { low, high }; n],
+        MapRange::Shared => vec![MapScale::symmetric(symmetric_range((0..n).flat_map(values))); n],
+        MapRange::PerObject => {
+            let mut scales = vec![MapScale::symmetric(1.0); n];
+            for (_, members) in surface_families(doc) {
+                let r = symmetric_range(members.iter().flat_map(|&i| values(i)));
+                for i in members {
+                    scales[i] = MapScale::symmetric(r);
+                }
+            }
+            scales
+        }
+    }
 }
 
-/// The colour scale's half range R (values map to ±R): the 98th percentile of |value| over
-/// `values` (NaN ignored); 1 when nothing is finite or everything is 0.
+/// The colour scale's half range R (values map to ±R): the 90th percentile of |value| over
+/// `values` (NaN ignored); 1 when nothing is finite or everything is 0. Curvature is heavy
+/// tailed (the teapot's |K|: median 1.5, 90th percentile 21, 98th 79), so a higher percentile
+/// leaves most of a surface white.
 pub fn symmetric_range(values: impl Iterator<Item = f64>) -> f64 {
     let mut mags: Vec<f64> = values.filter(|v| v.is_finite()).map(f64::abs).collect();
     if mags.is_empty() {
         return 1.0;
     }
-    let k = ((mags.len() - 1) as f64 * 0.98).round() as usize;
+    let k = ((mags.len() - 1) as f64 * RANGE_PERCENTILE).round() as usize;
     let (_, r, _) = mags.select_nth_unstable_by(k, f64::total_cmp);
     let r = *r;
     if r > 0.0 { r } else { 1.0 }
@@ -171,13 +276,35 @@ fn srgb(c: [f32; 3]) -> [u8; 4] {
 const PANEL: [u8; 4] = super::analysis::PANEL;
 const TEXT: [u8; 4] = [230, 232, 238, 255];
 
-/// The legend of `map` with half range `r`, bottom right of a `width × height` image: the title,
-/// a colour bar from −R to +R with its end and middle values (zebra: a note instead).
-pub fn legend(map: SurfaceMap, r: f64, font: &Font, width: f32, height: f32) -> Vec<OverlayVertex> {
+/// The height of a legend slot: a colour-scale legend and the gap above it.
+pub const LEGEND_STEP: f32 = 96.0;
+
+/// Where a legend goes and what it names: `slot` 0 is the lowest, bottom right of a
+/// `width × height` image, each further slot stacked above it; `name` (a surface's) is added to
+/// the title when the scales differ per surface.
+#[derive(Debug, Clone, Copy)]
+pub struct LegendPlace<'a> {
+    pub name: Option<&'a str>,
+    pub slot: usize,
+    pub width: f32,
+    pub height: f32,
+}
+
+/// The legend of `map` with colour scale `scale`: the title, a colour bar from its low to its
+/// high end with the end and middle values (zebra: a note instead).
+pub fn legend(
+    map: SurfaceMap,
+    scale: MapScale,
+    font: &Font,
+    place: LegendPlace<'_>,
+) -> Vec<OverlayVertex> {
     let mut v = Vec::new();
     let size = TextSize::Normal;
-    let title = map.title();
-    let [tw, th] = font.text_size(title, size);
+    let title = match place.name {
+        Some(name) if map != SurfaceMap::Zebra => format!("{}: {name}", map.title()),
+        _ => map.title().to_string(),
+    };
+    let [tw, th] = font.text_size(&title, size);
     let (bar_w, bar_h) = (280.0f32, 16.0f32);
     let panel_w = tw.max(bar_w) + 24.0;
     let panel_h = if map == SurfaceMap::Zebra {
@@ -185,9 +312,10 @@ pub fn legend(map: SurfaceMap, r: f64, font: &Font, width: f32, height: f32) -> 
     } else {
         th + bar_h + th + 28.0
     };
-    let (x, y) = (width - panel_w - 12.0, height - panel_h - 64.0);
+    let x = place.width - panel_w - 12.0;
+    let y = place.height - panel_h - 64.0 - place.slot as f32 * LEGEND_STEP;
     push_rect(&mut v, x, y, panel_w, panel_h, PANEL);
-    font.push_text(&mut v, title, x + 12.0, y + 8.0, size, TEXT);
+    font.push_text(&mut v, &title, x + 12.0, y + 8.0, size, TEXT);
     if map == SurfaceMap::Zebra {
         return v;
     }
@@ -206,11 +334,16 @@ pub fn legend(map: SurfaceMap, r: f64, font: &Font, width: f32, height: f32) -> 
         );
     }
     let ly = by + bar_h + 4.0;
-    let lo = format!("-{}", super::style::short(r));
-    let hi = super::style::short(r);
+    let number = |x: f64| {
+        let t = super::style::short(x.abs());
+        if x < 0.0 { format!("-{t}") } else { t }
+    };
+    let lo = number(scale.low);
+    let mid = number(0.5 * (scale.low + scale.high));
+    let hi = number(scale.high);
     font.push_text(&mut v, &lo, bx, ly, size, TEXT);
-    let [zw, _] = font.text_size("0", size);
-    font.push_text(&mut v, "0", bx + 0.5 * (bar_w - zw), ly, size, TEXT);
+    let [zw, _] = font.text_size(&mid, size);
+    font.push_text(&mut v, &mid, bx + 0.5 * (bar_w - zw), ly, size, TEXT);
     let [hw, _] = font.text_size(&hi, size);
     font.push_text(&mut v, &hi, bx + bar_w - hw, ly, size, TEXT);
     v
@@ -235,14 +368,37 @@ mod tests {
     }
 
     #[test]
-    fn range_ignores_the_worst_two_percent_and_nan() {
+    fn range_ignores_the_worst_tenth_and_nan() {
         let mut v: Vec<f64> = (0..100).map(|i| i as f64 / 100.0).collect();
         v.push(f64::NAN);
-        v.push(1e9);
+        v.extend([1e9; 10]);
         let r = symmetric_range(v.into_iter());
         assert!((0.97..=1.0).contains(&r), "{r}");
         assert_eq!(symmetric_range([0.0, 0.0].into_iter()), 1.0);
         assert_eq!(symmetric_range([f64::NAN].into_iter()), 1.0);
+    }
+
+    #[test]
+    fn map_ranges_parse_and_scales_map_to_the_unit_range() {
+        assert_eq!(MapRange::parse("shared"), Ok(MapRange::Shared));
+        assert_eq!(MapRange::parse("per-object"), Ok(MapRange::PerObject));
+        assert_eq!(
+            MapRange::parse("-0.5, 2"),
+            Ok(MapRange::Fixed {
+                low: -0.5,
+                high: 2.0
+            })
+        );
+        for bad in ["", "own", "1", "2,1", "0,0", "nan,1", "0,inf", "a,b"] {
+            assert!(MapRange::parse(bad).is_err(), "{bad}");
+        }
+        let s = MapScale {
+            low: -0.5,
+            high: 2.0,
+        };
+        assert_eq!([s.unit(-0.5), s.unit(0.75), s.unit(2.0)], [-1.0, 0.0, 1.0]);
+        assert!(s.unit(f64::NAN).is_nan());
+        assert_eq!(MapScale::symmetric(4.0).unit(-1.0), -0.25);
     }
 
     #[test]

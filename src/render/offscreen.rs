@@ -5,7 +5,9 @@ use super::camera::OrbitCamera;
 use super::gpu_scene::{GpuScene, Highlight};
 use super::lod::Lod;
 use super::map_mirror::MapView;
-use super::maps::legend;
+use super::maps::{
+    LEGEND_STEP, LegendPlace, MapRange, MapScale, legend, map_scales, surface_families,
+};
 use super::overlays::overlay_lines;
 use super::style::{Palette, ViewOptions};
 use crate::editor::Document;
@@ -67,9 +69,9 @@ fn record(
     let mut frame = renderer.begin_offscreen(target)?;
     let map = shot.options.analysis.map(|map| MapView {
         map,
-        range: super::maps::map_range(doc, map),
+        scales: map_scales(doc, map, shot.options.map_range),
     });
-    scene.set_map(map);
+    scene.set_map(map.clone());
     scene.upload(&mut frame, doc)?;
     frame.set_clear_color(Palette::default().background);
     frame.set_camera(camera.gpu(aspect, &bounds));
@@ -101,8 +103,8 @@ fn record(
     if shot.options.badges {
         overlay.extend(badge_overlay(doc, font, project));
     }
-    if let Some(m) = map {
-        overlay.extend(legend(m.map, m.range, font, size[0], size[1]));
+    if let Some(m) = &map {
+        overlay.extend(legends(doc, m, shot.options.map_range, font, size));
     }
     overlay.extend(readout);
     if !overlay.is_empty() {
@@ -111,4 +113,39 @@ fn record(
     frame.capture();
     frame.finish()?;
     Ok(())
+}
+
+/// The legends of a still image: one per surface family ([`surface_families`]), named, when
+/// each has its own scale (as many as fit, top to bottom in scene order); one for all of them
+/// otherwise.
+fn legends(
+    doc: &Document,
+    view: &MapView,
+    range: MapRange,
+    font: &crate::gpu::font::Font,
+    [width, height]: [f32; 2],
+) -> Vec<crate::gpu::OverlayVertex> {
+    let families = surface_families(doc);
+    let place = |name, slot| LegendPlace {
+        name,
+        slot,
+        width,
+        height,
+    };
+    let own = range == MapRange::PerObject && view.map.needs_curvature() && families.len() > 1;
+    if !own {
+        let first = families.first().map_or(0, |(_, m)| m[0]);
+        let scale = view.scales.get(first).copied();
+        let scale = scale.unwrap_or(MapScale::symmetric(1.0));
+        return legend(view.map, scale, font, place(None, 0));
+    }
+    let fit = (((height - 64.0) / LEGEND_STEP).floor().max(1.0) as usize).min(families.len());
+    families[..fit]
+        .iter()
+        .enumerate()
+        .flat_map(|(k, (name, members))| {
+            let scale = view.scales[members[0]];
+            legend(view.map, scale, font, place(Some(name), fit - 1 - k))
+        })
+        .collect()
 }

@@ -48,6 +48,8 @@ pub struct ViewOptions {
     pub badges: bool,
     /// A colour map (or zebra stripes) on surfaces, with its legend.
     pub analysis: Option<super::maps::SurfaceMap>,
+    /// How the map's colour scale is chosen: per surface (the default), shared or fixed.
+    pub map_range: super::maps::MapRange,
     /// The osculating circle of curve object `.0` at parameter `.1` (`render --osculating`;
     /// the viewer follows the cursor instead).
     pub osculating_at: Option<(usize, f64)>,
@@ -71,6 +73,7 @@ impl Default for ViewOptions {
             curvature_comb: false,
             badges: false,
             analysis: None,
+            map_range: super::maps::MapRange::PerObject,
             osculating_at: None,
             curve_width: 2.5,
             point_size: 8.0,

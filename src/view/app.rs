@@ -57,6 +57,8 @@ pub struct ViewArgs {
     pub lod: bool,
     /// A surface analysis map shown from the start.
     pub analysis: Option<crate::render::maps::SurfaceMap>,
+    /// How the map's colour scale is chosen.
+    pub map_range: crate::render::maps::MapRange,
     /// What pre-evaluation may take; structural edits and curvature maps that would need
     /// more are refused on the status line.
     pub memory: crate::sampling::budget::MemoryBudget,
@@ -238,6 +240,7 @@ impl App {
         session.set_autosave(self.args.autosave.clone());
         session.set_naive(self.args.naive);
         session.options.lod = self.args.lod;
+        session.options.map_range = self.args.map_range;
         if self.args.analysis.is_some() {
             session.set_map(self.args.analysis);
         }

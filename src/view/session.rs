@@ -20,7 +20,9 @@ use crate::render::analysis::{
 };
 use crate::render::lod::Lod;
 use crate::render::map_mirror::MapView;
-use crate::render::maps::{SurfaceMap, legend, map_range};
+use crate::render::maps::{
+    LegendPlace, MapRange, MapScale, SurfaceMap, legend, map_scales, surface_families,
+};
 use crate::render::overlays::overlay_lines;
 use crate::render::{
     Bounds, GpuScene, Highlight, NetMode, OrbitCamera, Palette, UploadStats, ViewOptions, Wire,
@@ -55,9 +57,9 @@ pub struct Session {
     autosave: Option<Autosave>,
     /// Osculating circle, curvature and torsion of the curve under the cursor (O).
     pub osculating: bool,
-    /// Half range of the analysis map's colour scale (refitted when a map is chosen and after
+    /// Each object's colour scale of the analysis map (refitted when a map is chosen and after
     /// each gesture that changed samples).
-    map_range: f64,
+    map_scales: Vec<MapScale>,
     /// A scripted action that could not run (see [`Session::take_script_error`]).
     script_error: Option<String>,
 }
@@ -106,7 +108,7 @@ impl Session {
             quit: false,
             autosave: None,
             osculating: false,
-            map_range: 1.0,
+            map_scales: Vec::new(),
             script_error: None,
         })
     }
@@ -392,7 +394,7 @@ impl Session {
             overlay.extend(badge_overlay(s.doc(), font, |p| view.project(p)));
         }
         if let Some(map) = self.options.analysis {
-            overlay.extend(legend(map, self.map_range, font, width, height));
+            overlay.extend(self.map_legend(map, font, width, height));
         }
         overlay.extend(readout);
         if hud {
@@ -582,12 +584,48 @@ impl Session {
     fn refit_map(&mut self) {
         if let Some(map) = self.options.analysis.filter(|m| m.needs_curvature()) {
             self.stage.editor.apply_queued();
-            self.map_range = map_range(self.stage.doc(), map);
+            self.map_scales = map_scales(self.stage.doc(), map, self.options.map_range);
         }
         self.gpu.set_map(self.options.analysis.map(|map| MapView {
             map,
-            range: self.map_range,
+            scales: self.map_scales.clone(),
         }));
+    }
+
+    /// How the analysis map's colour scale is chosen (`--map-range`); refits it.
+    pub fn set_map_range(&mut self, range: MapRange) {
+        self.options.map_range = range;
+        self.refit_map();
+    }
+
+    /// The legend of the map: the selected surface's scale under per-object ranges (the first
+    /// surface's while no surface is selected), named by its family; the one scale otherwise.
+    fn map_legend(
+        &self,
+        map: SurfaceMap,
+        font: &crate::gpu::font::Font,
+        width: f32,
+        height: f32,
+    ) -> Vec<crate::gpu::OverlayVertex> {
+        let families = surface_families(self.stage.doc());
+        let selected = self.selected().map(|h| h.object());
+        let family = families
+            .iter()
+            .find(|(_, m)| selected.is_some_and(|i| m.contains(&i)))
+            .or(families.first());
+        let own = self.options.map_range == MapRange::PerObject && families.len() > 1;
+        let name = family.filter(|_| own).map(|(name, _)| name.as_str());
+        let scale = family
+            .and_then(|(_, m)| self.map_scales.get(m[0]))
+            .copied()
+            .unwrap_or(MapScale::symmetric(1.0));
+        let place = LegendPlace {
+            name,
+            slot: 0,
+            width,
+            height,
+        };
+        legend(map, scale, font, place)
     }
 
     /// The curve sample nearest the cursor (within 40 pixels) and its osculating circle.

@@ -695,3 +695,58 @@ fn bench_on_a_malformed_scene_prints_one_line() {
         "nothing written for a failed run"
     );
 }
+
+/// `sample` takes `--samples` like every command that loads a scene: `N` for every curve,
+/// `NxM` for every surface, JSON and OBJ alike (the file's counts without it); a bad count is
+/// refused in one line.
+#[test]
+fn sample_takes_the_samples_override() {
+    let dir = Scratch::new("cli-samples");
+    let json = dir.file("scene.json", &scene(&[CURVE, SURF]));
+    let counts = |args: &[&str], path: &std::path::Path| -> Vec<Vec<usize>> {
+        let out = Command::new(env!("CARGO_BIN_EXE_prespline"))
+            .arg("sample")
+            .arg(path)
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        v["objects"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|o| match o["params"][0].as_array() {
+                Some(u) => vec![u.len(), o["params"][1].as_array().unwrap().len()],
+                None => vec![o["params"].as_array().unwrap().len()],
+            })
+            .collect()
+    };
+    assert_eq!(counts(&[], &json), [vec![10], vec![3, 3]]);
+    assert_eq!(
+        counts(&["--samples", "7", "--samples", "4x6"], &json),
+        [vec![7], vec![4, 6]]
+    );
+    assert_eq!(counts(&["--samples", "5x5"], &json), [vec![10], vec![5, 5]]);
+    // The case: an OBJ file.
+    let vase = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/vase.obj");
+    let with = counts(&["--samples", "5", "--samples", "6x7"], &vase);
+    assert!(!with.is_empty());
+    for c in with {
+        assert!(c == [5] || c == [6, 7], "{c:?}");
+    }
+    let out = Command::new(env!("CARGO_BIN_EXE_prespline"))
+        .arg("sample")
+        .arg(&json)
+        .args(["--samples", "1"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(out.stdout.is_empty());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("1 samples: expected 2..="), "{err}");
+}

@@ -600,3 +600,95 @@ fn badges_name_each_constructed_junction() {
         }
     }
 }
+
+/// The lecture's construction for a closed point list: T_j = (P_{j+1} − P_{j−1})/2 with indices
+/// taken cyclically, one segment per pair including the closing one (P_{n−1}, P_0).
+fn lecture_closed_catmull_rom(p: &[DVec3]) -> Piecewise {
+    let n = p.len();
+    let at = |j: usize| p[j % n];
+    let t = |j: usize| (at(j + 1) - at(j + n - 1)) / 2.0;
+    let mut pts = vec![p[0]];
+    for j in 0..n {
+        pts.push(at(j) + t(j) / 3.0);
+        pts.push(at(j + 1) - t(j + 1) / 3.0);
+        pts.push(at(j + 1));
+    }
+    Piecewise {
+        degree: 3,
+        breaks: (0..=n).map(|j| j as f64).collect(),
+        pts,
+    }
+}
+
+#[test]
+fn closed_curves_have_a_badge_at_their_seam() {
+    use prespline::geom::continuity::classify;
+    use prespline::render::analysis::curve_joins;
+    // A closed uniform Catmull–Rom through n points has n junctions: 1 … n−1 and the seam,
+    // where segment n−1 ends (t = n) and segment 0 starts (t = 0). It is C1 there like
+    // everywhere (the cyclic tangent), not C2: the seam's left limit comes from the end.
+    let mut rng = Rng::new(5);
+    let p = random_points(&mut rng, 6);
+    let m = one(&format!(
+        r#"{{"objects": [{{"name": "ring", "type": "catmull_rom", "points": {}, "closed": true, "samples": 60}}]}}"#,
+        points_json(&p)
+    ));
+    let joins = curve_joins(m.as_ref());
+    let ts: Vec<f64> = joins.iter().map(|j| j.t).collect();
+    assert_eq!(ts, [0.0, 1.0, 2.0, 3.0, 4.0, 5.0]);
+    assert_eq!(joins[0].position, p[0]);
+    for j in &joins {
+        assert_eq!(j.class.label(), "C1", "closed uniform at {}", j.t);
+    }
+    // The independent evaluator's limits across the seam classify the same.
+    let pw = lecture_closed_catmull_rom(&p);
+    let (l, r) = (pw.limit(5, 6.0, 2), pw.limit(0, 0.0, 2));
+    let size = p.iter().fold(0.0f64, |m, q| m.max(q.abs().max_element()));
+    assert_eq!(
+        classify([l[0], l[1], l[2]], [r[0], r[1], r[2]], size),
+        joins[0].class
+    );
+    assert!(close(l[0], joins[0].position, size, 1e-15));
+
+    // examples/catmull_rom.json: the closed centripetal ring has 8 points, so 8 badges; the
+    // open curves of 7 points have 5 each.
+    let text = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/catmull_rom.json"),
+    )
+    .unwrap();
+    let scene = parse_scene(&text).unwrap();
+    let counts: Vec<(&str, usize)> = scene
+        .objects
+        .iter()
+        .map(|o| (o.name.as_str(), curve_joins(o.model.as_ref()).len()))
+        .collect();
+    assert_eq!(
+        counts,
+        [
+            ("uniform", 5),
+            ("centripetal", 5),
+            ("chordal", 5),
+            ("closed_ring", 8)
+        ]
+    );
+    let ring = curve_joins(scene.objects[3].model.as_ref());
+    assert_eq!(ring[0].t, 0.0);
+    // Centripetal knots: one tangent direction at every junction, the seam included (G1, or
+    // C1 where neighbouring chords happen to be equal).
+    for j in &ring {
+        assert!(
+            matches!(j.class.label(), "G1" | "C1"),
+            "ring at {}: {}",
+            j.t,
+            j.class.label()
+        );
+    }
+
+    // ERBS curves get no badges, closed ones neither: the blend is C^∞ across the seam too.
+    let erbs = one(
+        r#"{"objects": [{"name": "e", "type": "erbs_curve", "closed": true, "knots": [0, 1, 2, 3],
+        "local": [{"points": [[1,0,0],[1,1,0]]}, {"points": [[0,1,0],[-1,0,0]]}, {"points": [[-1,-1,0],[1,-1,0]]}],
+        "samples": 30}]}"#,
+    );
+    assert!(curve_joins(erbs.as_ref()).is_empty());
+}

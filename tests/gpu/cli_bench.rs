@@ -207,3 +207,49 @@ fn failing_bench_prints_one_line() {
     assert!(err.lines().count() > 1, "{err}");
     assert!(err.starts_with("bench: drag on "), "{err}");
 }
+
+/// `bench` takes `--samples` (the scene's counts are replaced, the demo's too) and reports the
+/// problem size it ran, `scene_samples` in summary.json: 64×64 for the example file, 9×9 with
+/// `--samples 9x9`.
+#[test]
+fn bench_takes_the_samples_override() {
+    let scratch = common::Scratch::new("cli-bench");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/bspline_surface.json");
+    let run = |name: &str, samples: &[&str]| {
+        let out = scratch.join(name);
+        let r = prespline()
+            .arg("bench")
+            .arg(&scene)
+            .args([
+                "--frames", "2", "--warmup", "4", "--size", "160x100", "--out",
+            ])
+            .arg(&out)
+            .args(samples)
+            .output()
+            .unwrap();
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        let found = find_key(&summary, "scene_samples");
+        found
+            .and_then(|v| v.as_u64())
+            .expect("scene_samples reported")
+    };
+    assert_eq!(run("file", &[]), 64 * 64);
+    assert_eq!(
+        run("override", &["--samples", "9x9", "--samples", "50"]),
+        81
+    );
+}
+
+/// The first value under `key` anywhere in `v`.
+fn find_key<'a>(v: &'a serde_json::Value, key: &str) -> Option<&'a serde_json::Value> {
+    match v {
+        serde_json::Value::Object(m) => m
+            .get(key)
+            .or_else(|| m.values().find_map(|x| find_key(x, key))),
+        serde_json::Value::Array(a) => a.iter().find_map(|x| find_key(x, key)),
+        _ => None,
+    }
+}

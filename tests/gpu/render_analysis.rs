@@ -16,7 +16,7 @@ use prespline::model::{Edit, KindEdit, PointEdit, SurfaceEdit};
 use prespline::render::analysis::{
     CurveEval, Osculating, PANEL, badge_overlay, osculating_panel_origin, osculating_text,
 };
-use prespline::render::maps::SurfaceMap;
+use prespline::render::maps::{MapScale, SurfaceMap};
 use prespline::render::offscreen::{Shot, render_document, shot_camera};
 use prespline::render::{GpuScene, Highlight, Lod, MapView, ViewOptions};
 use prespline::scene::Scene;
@@ -237,7 +237,10 @@ fn frame(
 }
 
 fn view(map: SurfaceMap) -> Option<MapView> {
-    Some(MapView { map, range: 0.5 })
+    Some(MapView {
+        map,
+        scales: vec![MapScale::symmetric(0.5); 2],
+    })
 }
 
 fn offscreen(renderer: &mut Renderer, shot: &Shot) -> OffscreenTarget {
@@ -367,9 +370,9 @@ fn only_readout(px: &Pixels, rect: [u32; 4]) -> Result<(), String> {
 /// The readout's text colour (sRGB).
 const READOUT: [u8; 4] = [240, 150, 240, 255];
 
-/// `prespline render examples/catmull_rom.json --badges --osculating centripetal@3.3`: the
-/// readout lies over a G1 badge there, and is drawn above it on its opaque panel (it used to
-/// read "cur C2 ture").
+/// `prespline render examples/catmull_rom.json --badges --osculating centripetal@T`, T the
+/// first parameter (in steps of 0.05) whose readout lies over a badge: the readout is drawn
+/// above it on its opaque panel (it used to read "cur C2 ture").
 #[test]
 fn the_osculating_readout_is_not_overlapped_by_badges() {
     let scene = load("examples/catmull_rom.json");
@@ -378,53 +381,57 @@ fn the_osculating_readout_is_not_overlapped_by_badges() {
         .iter()
         .position(|o| o.name == "centripetal")
         .unwrap();
-    let options = ViewOptions {
-        badges: true,
-        osculating_at: Some((i, 3.3)),
-        ..ViewOptions::default()
-    };
     let (mut renderer, sink) = common::renderer();
     let doc = Document::new(&scene);
     let shot = Shot {
         width: 1280,
         height: 720,
         camera: None,
-        options,
+        options: ViewOptions::default(),
         msaa: 0,
     };
-    let px = render_document(&mut renderer, &doc, &shot).unwrap();
-    // Where the readout goes, as the renderer places it.
     let font = renderer.font();
-    let o = Osculating::at(&CurveEval::of(doc.objects[i].sampled.model()).unwrap(), 3.3).unwrap();
     let (w, h) = (shot.width as f64, shot.height as f64);
-    let (x, y, _) = shot_camera(&doc, &shot)
-        .project(o.point, w, h, &doc.bounds())
-        .unwrap();
-    let [tw, th] = font.text_size(&osculating_text("centripetal", &o), TextSize::Normal);
-    let [px0, py0] = osculating_panel_origin([tw, th], (x, y), [w as f32, h as f32]);
-    let rect = [
-        px0 as u32,
-        py0 as u32,
-        (px0 + tw + 10.0) as u32,
-        (py0 + th + 8.0) as u32,
-    ];
-    // A badge lies under the readout here (a join of a curve inside its panel).
+    let camera = shot_camera(&doc, &shot);
     let badges = badge_overlay(&doc, font, |p| {
-        shot_camera(&doc, &shot)
+        camera
             .project(p, w, h, &doc.bounds())
             .map(|(x, y, _)| (x, y))
     });
-    let covered = badges.chunks_exact(6).any(|q| {
-        let (a, b) = (q[0].pos, q[2].pos);
-        a[0] < rect[2] as f32
-            && b[0] > rect[0] as f32
-            && a[1] < rect[3] as f32
-            && b[1] > rect[1] as f32
-    });
-    assert!(
-        covered,
-        "no badge under the readout: the test shows nothing"
-    );
+    // Where the readout at t goes, as the renderer places it.
+    let readout_rect = |t: f64| {
+        let curve = CurveEval::of(doc.objects[i].sampled.model()).unwrap();
+        let o = Osculating::at(&curve, t)?;
+        let (x, y, _) = camera.project(o.point, w, h, &doc.bounds())?;
+        let [tw, th] = font.text_size(&osculating_text("centripetal", &o), TextSize::Normal);
+        let [px0, py0] = osculating_panel_origin([tw, th], (x, y), [w as f32, h as f32]);
+        Some([
+            px0 as u32,
+            py0 as u32,
+            (px0 + tw + 10.0) as u32,
+            (py0 + th + 8.0) as u32,
+        ])
+    };
+    // A badge under the readout (a join of a curve inside its panel).
+    let covered = |rect: [u32; 4]| {
+        badges.chunks_exact(6).any(|q| {
+            let (a, b) = (q[0].pos, q[2].pos);
+            a[0] < rect[2] as f32
+                && b[0] > rect[0] as f32
+                && a[1] < rect[3] as f32
+                && b[1] > rect[1] as f32
+        })
+    };
+    let (t, rect) = (1..120)
+        .map(|k| k as f64 * 0.05)
+        .find_map(|t| readout_rect(t).filter(|&r| covered(r)).map(|r| (t, r)))
+        .expect("no badge under any readout: the test shows nothing");
+    let options = ViewOptions {
+        badges: true,
+        osculating_at: Some((i, t)),
+        ..ViewOptions::default()
+    };
+    let px = render_document(&mut renderer, &doc, &Shot { options, ..shot }).unwrap();
     let magenta = (rect[1]..rect[3])
         .flat_map(|y| (rect[0]..rect[2]).map(move |x| (x, y)))
         .filter(|&(x, y)| px.get(x, y)[..3] == READOUT[..3])
@@ -448,4 +455,186 @@ fn the_osculating_readout_is_not_overlapped_by_badges() {
     }
     assert!(only_readout(&bad, rect).is_err());
     common::teardown(renderer, sink);
+}
+
+/// A B-spline curve whose interior knot has multiplicity degree + 1 is two pieces (C⁻¹, the
+/// "gap" badge): no line may bridge them. Degree 1 over (−3,0) (−1,0) | (1,2) (3,2), seen from
+/// straight above: the pieces are drawn, the diagonal between (−1,0) and (1,2) stays empty. The
+/// negative control is the same points with a simple interior knot, one polyline through all
+/// four, whose diagonal the same probes must see.
+#[test]
+fn curves_with_a_gap_are_drawn_apart() {
+    use prespline::render::analysis::curve_pieces;
+    use prespline::render::camera::OrbitCamera;
+    let scene = |knots: &str| {
+        prespline::scene::parse_scene(&format!(
+            r#"{{"objects": [{{"name": "c", "type": "bspline_curve", "degree": 1, "knots": {knots},
+            "points": [[-3, 0, 0], [-1, 0, 0], [1, 2, 0], [3, 2, 0]], "samples": 41, "color": [1, 1, 1]}}]}}"#
+        ))
+        .unwrap()
+    };
+    let (torn, whole) = (scene("[0, 0, 1, 1, 2, 2]"), scene("[0, 0, 1, 2, 3, 3]"));
+    let camera = OrbitCamera::parse("0,1,20,0,1,0").unwrap();
+    let ink = |scene: &Scene| {
+        let doc = common::editor(scene, None).into_document();
+        let sampled = &doc.objects[0].sampled;
+        let pieces = curve_pieces(sampled.model(), sampled.params()[0]);
+        let (w, h) = (400u32, 400u32);
+        let (mut renderer, sink) = common::renderer();
+        let shot = Shot {
+            width: w,
+            height: h,
+            camera: Some(camera),
+            options: ViewOptions::default(),
+            msaa: 1,
+        };
+        let px = render_document(&mut renderer, &doc, &shot).unwrap();
+        common::teardown(renderer, sink);
+        let background = px.get(0, 0);
+        // Pixels in a 9×9 window around the projection of `p` that differ from the background.
+        let lit = |p: DVec3| {
+            let (x, y, _) = camera
+                .project(p, w as f64, h as f64, &doc.bounds())
+                .unwrap();
+            let (x, y) = (x.round() as i64, y.round() as i64);
+            let mut n = 0;
+            for yy in y - 4..=y + 4 {
+                for xx in x - 4..=x + 4 {
+                    let c = px.get(xx as u32, yy as u32);
+                    n += usize::from((0..3).any(|k| c[k].abs_diff(background[k]) > 40));
+                }
+            }
+            n
+        };
+        let pieces_lit = [DVec3::new(-2.0, 0.0, 0.0), DVec3::new(2.0, 2.0, 0.0)].map(lit);
+        let bridge_lit = [0.3, 0.5, 0.7].map(|s| lit(DVec3::new(-1.0 + 2.0 * s, 2.0 * s, 0.0)));
+        (pieces, pieces_lit, bridge_lit)
+    };
+    let (pieces, pieces_lit, bridge_lit) = ink(&torn);
+    assert_eq!(
+        pieces,
+        [0..20, 20..41],
+        "the sample at the gap starts the right piece"
+    );
+    assert!(
+        pieces_lit.iter().all(|&n| n > 0),
+        "both pieces drawn: {pieces_lit:?}"
+    );
+    assert_eq!(bridge_lit, [0, 0, 0], "nothing bridges the gap");
+    let (pieces, pieces_lit, bridge_lit) = ink(&whole);
+    assert_eq!(pieces, [0..41]);
+    assert!(pieces_lit.iter().all(|&n| n > 0), "{pieces_lit:?}");
+    assert!(
+        bridge_lit.iter().all(|&n| n > 0),
+        "negative control: the probes see a drawn diagonal: {bridge_lit:?}"
+    );
+}
+
+/// The bumpy B-spline surface (moved to the left) next to the 32 teapot patches, Gaussian map.
+fn bumps_beside_the_teapot() -> Scene {
+    let read = |p: &str| -> serde_json::Value {
+        let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(p));
+        serde_json::from_str(&text.unwrap()).unwrap()
+    };
+    let mut scene = read("examples/teapot.json");
+    let mut bumps = read("examples/bspline_surface.json")["objects"][0].clone();
+    for row in bumps["points"].as_array_mut().unwrap() {
+        for p in row.as_array_mut().unwrap() {
+            p[0] = serde_json::json!(p[0].as_f64().unwrap() - 9.0);
+        }
+    }
+    scene["objects"].as_array_mut().unwrap().push(bumps);
+    prespline::scene::parse_scene(&scene.to_string()).unwrap()
+}
+
+/// The fraction of object `i`'s samples whose pixel is clearly coloured (not white or grey),
+/// leaving out those under the legends (bottom right, at most two stacked).
+fn coloured_fraction(doc: &Document, shot: &Shot, px: &Pixels, i: usize) -> f64 {
+    let camera = shot_camera(doc, shot);
+    let (w, h) = (shot.width as f64, shot.height as f64);
+    let grid = doc.objects[i].sampled.grid();
+    let stride = grid.stride();
+    let (mut seen, mut coloured) = (0usize, 0usize);
+    for k in 0..grid.dims[0] * grid.dims[1] {
+        let Some((x, y, _)) = camera.project(grid.data[k * stride], w, h, &doc.bounds()) else {
+            continue;
+        };
+        let legends = x >= w - 340.0 && y >= h - 64.0 - 2.0 * 96.0;
+        if x < 0.0 || y < 0.0 || x >= w || y >= h || legends {
+            continue;
+        }
+        let c = px.get(x as u32, y as u32);
+        let (hi, lo) = (c[..3].iter().max().unwrap(), c[..3].iter().min().unwrap());
+        seen += 1;
+        coloured += usize::from(hi - lo > 40);
+    }
+    assert!(seen > 100, "object {i} is in the picture");
+    coloured as f64 / seen as f64
+}
+
+/// In a mixed scene each surface gets its own colour scale by default: the gently curved bumps
+/// (|K| ≲ 0.7) beside the teapot (|K| up to ~60) still show red and blue. The negative control
+/// is the shared scale, which the teapot sets, so the bumps go almost white.
+#[test]
+fn per_object_ranges_colour_every_surface_in_a_mixed_scene() {
+    use prespline::render::maps::{MapRange, map_scales};
+    let scene = bumps_beside_the_teapot();
+    let doc = common::editor(&scene, Some(SurfaceMap::Gaussian)).into_document();
+    let bumps = doc.objects.len() - 1;
+    let render = |range: MapRange| {
+        let shot = Shot {
+            width: 960,
+            height: 540,
+            camera: None,
+            options: ViewOptions {
+                analysis: Some(SurfaceMap::Gaussian),
+                map_range: range,
+                ..ViewOptions::default()
+            },
+            msaa: 1,
+        };
+        let (mut renderer, sink) = common::renderer();
+        let px = render_document(&mut renderer, &doc, &shot).unwrap();
+        common::teardown(renderer, sink);
+        let fractions = [0, bumps].map(|i| coloured_fraction(&doc, &shot, &px, i));
+        (fractions, px)
+    };
+    // The scales themselves: the bumps' own range is the one it gets alone, the teapot's
+    // patches (teapot_00 … teapot_31) share one.
+    let own = map_scales(&doc, SurfaceMap::Gaussian, MapRange::PerObject);
+    let alone = common::editor(
+        &load("examples/bspline_surface.json"),
+        Some(SurfaceMap::Gaussian),
+    )
+    .into_document();
+    let alone = map_scales(&alone, SurfaceMap::Gaussian, MapRange::PerObject)[0];
+    // Equal up to the rounding of the curvature after the move by −9 in x.
+    assert!((own[bumps].high - alone.high).abs() <= 1e-12 * alone.high);
+    assert_eq!(own[bumps].low, -own[bumps].high);
+    assert!(
+        own[..bumps].iter().all(|s| *s == own[0]),
+        "one scale for the teapot"
+    );
+    let shared = map_scales(&doc, SurfaceMap::Gaussian, MapRange::Shared);
+    assert!(
+        shared[bumps].high > 20.0 * own[bumps].high,
+        "{shared:?} vs {own:?}"
+    );
+
+    let ([teapot, bumpy], px) = render(MapRange::PerObject);
+    if std::env::var_os("PRESPLINE_KEEP").is_some() {
+        px.write_png(Path::new("/tmp/mixed-per-object.png"))
+            .unwrap();
+    }
+    assert!(teapot > 0.05, "teapot coloured: {teapot}");
+    assert!(bumpy > 0.3, "per-object: the bumps show colour: {bumpy}");
+    let ([teapot, bumpy], px) = render(MapRange::Shared);
+    if std::env::var_os("PRESPLINE_KEEP").is_some() {
+        px.write_png(Path::new("/tmp/mixed-shared.png")).unwrap();
+    }
+    assert!(teapot > 0.05, "teapot coloured: {teapot}");
+    assert!(
+        bumpy < 0.05,
+        "negative control, shared scale: the bumps wash out: {bumpy}"
+    );
 }

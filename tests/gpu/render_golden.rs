@@ -287,3 +287,59 @@ fn comparator_bounds_each_fail_on_their_own() {
     let err = check(&everywhere).expect_err("a change of every pixel passed");
     assert!(err.contains("pixels (") && !err.contains("worst"), "{err}");
 }
+
+/// Margins of the drawn pixels (those differing from the corner pixel): [left, right, top,
+/// bottom] in pixels.
+fn margins(px: &Pixels) -> [i64; 4] {
+    let bg = px.get(0, 0);
+    let (mut x0, mut x1, mut y0, mut y1) = (i64::MAX, i64::MIN, i64::MAX, i64::MIN);
+    for y in 0..px.height {
+        for x in 0..px.width {
+            let c = px.get(x, y);
+            if (0..3).any(|k| c[k].abs_diff(bg[k]) > 40) {
+                let (x, y) = (i64::from(x), i64::from(y));
+                (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
+            }
+        }
+    }
+    assert!(x0 <= x1, "something is drawn");
+    let (w, h) = (i64::from(px.width), i64::from(px.height));
+    [x0, w - 1 - x1, y0, h - 1 - y1]
+}
+
+/// The default framing frames the projected bounds: a flat rectangle seen from the default
+/// oblique direction for flat scenes fills the image with equal margins left and right and
+/// top and bottom (within 3 px: line width and rasterisation). Negative control: the same
+/// camera with its target moved a quarter of the rectangle along +y has them clearly unequal.
+#[test]
+fn default_framing_balances_the_margins_of_a_flat_object() {
+    let scene = parse_scene(
+        r#"{"objects": [{"name": "frame", "type": "bspline_curve", "degree": 1,
+        "knots": [0, 0, 1, 2, 3, 4, 4], "points": [[-3, -1, 0], [3, -1, 0], [3, 1, 0], [-3, 1, 0], [-3, -1, 0]],
+        "samples": 200}]}"#,
+    )
+    .unwrap();
+    let [left, right, top, bottom] = margins(&render_scene(&scene, None, ViewOptions::default()));
+    assert!((left - right).abs() <= 3, "left {left} right {right}");
+    assert!((top - bottom).abs() <= 3, "top {top} bottom {bottom}");
+    // 90 % of the tighter direction is filled: 5 % margins on each side of it.
+    assert!(
+        (left.min(top) - 20).abs() <= 6 || (left - 32).abs() <= 6,
+        "margins {left} {right} {top} {bottom}"
+    );
+    let doc = Document::new(&scene);
+    let shot = Shot {
+        width: 640,
+        height: 400,
+        camera: None,
+        options: ViewOptions::default(),
+        msaa: 4,
+    };
+    let mut moved = prespline::render::offscreen::shot_camera(&doc, &shot);
+    moved.target.y += 0.5;
+    let [_, _, top, bottom] = margins(&render_scene(&scene, Some(moved), ViewOptions::default()));
+    assert!(
+        (top - bottom).abs() > 20,
+        "negative control: an off-centre target shows: top {top} bottom {bottom}"
+    );
+}

@@ -338,8 +338,8 @@ impl Kind for CatmullRomModel {
         out.copy_from_slice(&self.chain_form().curve().derivatives(u, order));
     }
 
-    fn junctions(&self) -> Option<Vec<f64>> {
-        Some(self.spline.breakpoints())
+    fn junctions(&self) -> Option<(Vec<f64>, bool)> {
+        Some((self.spline.breakpoints(), self.spline.closed()))
     }
 
     /// The interpolated points.
@@ -417,8 +417,8 @@ impl Kind for BezierSplineModel {
         out.copy_from_slice(&self.chain_form().curve().derivatives(u, order));
     }
 
-    fn junctions(&self) -> Option<Vec<f64>> {
-        Some(self.spline.knots().to_vec())
+    fn junctions(&self) -> Option<(Vec<f64>, bool)> {
+        Some((self.spline.knots().to_vec(), false))
     }
 
     /// Bézier points, or the de Boor polygon of splines edited through it (their Bézier points
