@@ -31,8 +31,9 @@ pub fn shot_camera(doc: &Document, shot: &Shot) -> OrbitCamera {
     shot.camera.unwrap_or_else(|| {
         let bounds = doc.bounds();
         let mut c = OrbitCamera::default_for(&bounds);
+        let nets = shot.options.control_nets != super::style::NetMode::Off;
         c.frame_points(
-            &framing_points(doc),
+            &framing_points(doc, nets),
             &bounds,
             shot.width as f64 / shot.height as f64,
         );
@@ -40,10 +41,11 @@ pub fn shot_camera(doc: &Document, shot: &Shot) -> OrbitCamera {
     })
 }
 
-/// What the default framing fits: the drawn samples and the control points, every k-th of
-/// them so that at most about 8192 are projected per fitting step.
+/// What the default framing fits: the drawn samples, and the control points when `nets` are
+/// drawn (hidden ones, such as ERBS local patches' points above a surface, would leave an
+/// empty band), every k-th of them so that at most about 8192 are projected per fitting step.
 #[must_use]
-pub fn framing_points(doc: &Document) -> Vec<DVec3> {
+pub fn framing_points(doc: &Document, nets: bool) -> Vec<DVec3> {
     const MAX: usize = 8192;
     let count = |i: usize| {
         let g = doc.objects[i].sampled.grid();
@@ -51,6 +53,7 @@ pub fn framing_points(doc: &Document) -> Vec<DVec3> {
     };
     let samples: usize = (0..doc.objects.len()).map(count).sum();
     let handles: Vec<DVec3> = (0..doc.objects.len())
+        .filter(|_| nets)
         .flat_map(|i| doc.handles(i).into_iter().map(|(_, p)| p))
         .collect();
     let every = (samples + handles.len()).div_ceil(MAX).max(1);
