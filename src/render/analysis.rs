@@ -147,7 +147,7 @@ pub fn curve_joins(model: ModelRef<'_>) -> Vec<Join> {
 /// a sample at the gap's knot belongs to the piece on its right (the evaluator's right limit).
 #[must_use]
 pub fn curve_pieces(model: ModelRef<'_>, params: &[f64]) -> Vec<std::ops::Range<usize>> {
-    let whole = std::iter::once(0..params.len()).collect();
+    let whole: Vec<_> = std::iter::once(0..params.len()).collect();
     // Only B-spline, Bézier and NURBS curves can tear: chains share their junction points and
     // ERBS curves blend smoothly.
     let ModelRef::Curve(c) = model else {

@@ -70,12 +70,10 @@ impl OrbitCamera {
         }
     }
 
-    /// Frames the projected bounds: from the current direction, the eight corners of the box
-    /// project centred in the image and fill 90 % of it in the tighter direction, so a flat
-    /// object seen at an angle gets equal margins above and below (centring the box's centre,
-    /// or fitting its bounding sphere, leaves the near side crowded and the far side empty).
-    /// Alternates a distance fit (bisection) with moving the target in the view plane by the
-    /// projected box's offset; perspective makes each move approximate, so a few rounds.
+    /// Places the target at the bounds' centre and picks the smallest distance at which all
+    /// eight corners of the box project inside 90 % of the image (bisection; the sphere-fit
+    /// distance is the safe upper bound). The viewer's framing; `render` frames the projected
+    /// drawing instead ([`OrbitCamera::frame_points`]).
     pub fn frame(&mut self, bounds: &Bounds, aspect: f64) {
         self.target = bounds.centre();
         let half = 0.5 * self.fov_y;
@@ -87,17 +85,64 @@ impl OrbitCamera {
         }
         let corners: Vec<DVec3> = (0..8)
             .map(|i| {
-                let pick = |bit: usize, lo: f64, hi: f64| if i & bit == 0 { lo } else { hi };
                 DVec3::new(
-                    pick(1, bounds.min.x, bounds.max.x),
-                    pick(2, bounds.min.y, bounds.max.y),
-                    pick(4, bounds.min.z, bounds.max.z),
+                    if i & 1 == 0 {
+                        bounds.min.x
+                    } else {
+                        bounds.max.x
+                    },
+                    if i & 2 == 0 {
+                        bounds.min.y
+                    } else {
+                        bounds.max.y
+                    },
+                    if i & 4 == 0 {
+                        bounds.min.z
+                    } else {
+                        bounds.max.z
+                    },
                 )
             })
             .collect();
+        let fits = |cam: &OrbitCamera| {
+            let (near, far) = cam.clip_planes(bounds);
+            let vp = DMat4::perspective_rh(cam.fov_y, aspect, near, far) * cam.view();
+            corners.iter().all(|&p| {
+                let c = vp * p.extend(1.0);
+                c.w > 0.0 && (c.x / c.w).abs() <= 0.9 && (c.y / c.w).abs() <= 0.9
+            })
+        };
+        let (mut lo, mut hi) = (0.0, safe);
+        for _ in 0..40 {
+            let mid = 0.5 * (lo + hi);
+            let probe = OrbitCamera {
+                distance: mid,
+                ..*self
+            };
+            if fits(&probe) { hi = mid } else { lo = mid }
+        }
+        self.distance = hi;
+    }
+
+    /// Frames the projected bounds of `points` (inside `bounds`): from the current direction
+    /// their projections are centred in the image and fill 90 % of it in the tighter
+    /// direction, so a flat object seen at an angle gets equal margins above and below
+    /// (centring the bounds' centre, or fitting their sphere, leaves the near side crowded and
+    /// the far side empty). Alternates a distance fit (bisection) with moving the target in the
+    /// view plane by the projected box's offset; perspective makes each move approximate, so a
+    /// few rounds.
+    pub fn frame_points(&mut self, points: &[DVec3], bounds: &Bounds, aspect: f64) {
+        self.target = bounds.centre();
+        let half = 0.5 * self.fov_y;
+        let half_h = (half.tan() * aspect.min(1.0)).atan();
+        let safe = bounds.radius() / half_h.min(half).sin() * 1.05;
+        if bounds.is_empty() || points.is_empty() {
+            self.distance = safe;
+            return;
+        }
         for _ in 0..8 {
-            self.fit_distance(&corners, bounds, aspect, safe);
-            let Some([x0, x1, y0, y1]) = self.projected_box(&corners, bounds, aspect) else {
+            self.fit_distance(points, bounds, aspect, safe);
+            let Some([x0, x1, y0, y1]) = self.projected_box(points, bounds, aspect) else {
                 break;
             };
             let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
@@ -108,7 +153,7 @@ impl OrbitCamera {
             let h = self.distance * half.tan();
             self.target += right * (cx * h * aspect) + up * (cy * h);
         }
-        self.fit_distance(&corners, bounds, aspect, safe);
+        self.fit_distance(points, bounds, aspect, safe);
     }
 
     /// The NDC box [x0, x1, y0, y1] of `points`; `None` when one is behind the eye.
@@ -309,7 +354,13 @@ mod tests {
         b.include(DVec3::splat(-1.0));
         b.include(DVec3::splat(1.0));
         let mut c = OrbitCamera::default();
-        c.frame(&b, 1.5);
+        let corners: Vec<DVec3> = (0..8)
+            .map(|i| {
+                let s = |bit: usize| if i & bit == 0 { -1.0 } else { 1.0 };
+                DVec3::new(s(1), s(2), s(4))
+            })
+            .collect();
+        c.frame_points(&corners, &b, 1.5);
         let p = DVec3::new(0.3, -0.2, 0.5);
         let (x, y, z) = c.project(p, 1200.0, 800.0, &b).unwrap();
         assert!((0.0..1.0).contains(&z));

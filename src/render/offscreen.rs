@@ -12,6 +12,7 @@ use super::overlays::overlay_lines;
 use super::style::{Palette, ViewOptions};
 use crate::editor::Document;
 use crate::gpu::{GpuResult, OffscreenDesc, Pixels, Renderer};
+use glam::DVec3;
 
 /// One offscreen image.
 #[derive(Debug, Clone)]
@@ -30,9 +31,38 @@ pub fn shot_camera(doc: &Document, shot: &Shot) -> OrbitCamera {
     shot.camera.unwrap_or_else(|| {
         let bounds = doc.bounds();
         let mut c = OrbitCamera::default_for(&bounds);
-        c.frame(&bounds, shot.width as f64 / shot.height as f64);
+        let nets = shot.options.control_nets != super::style::NetMode::Off;
+        c.frame_points(
+            &framing_points(doc, nets),
+            &bounds,
+            shot.width as f64 / shot.height as f64,
+        );
         c
     })
+}
+
+/// What the default framing fits: the drawn samples, and the control points when `nets` are
+/// drawn (hidden ones, such as ERBS local patches' points above a surface, would leave an
+/// empty band), every k-th of them so that at most about 8192 are projected per fitting step.
+#[must_use]
+pub fn framing_points(doc: &Document, nets: bool) -> Vec<DVec3> {
+    const MAX: usize = 8192;
+    let count = |i: usize| {
+        let g = doc.objects[i].sampled.grid();
+        g.dims[0] * g.dims[1]
+    };
+    let samples: usize = (0..doc.objects.len()).map(count).sum();
+    let handles: Vec<DVec3> = (0..doc.objects.len())
+        .filter(|_| nets)
+        .flat_map(|i| doc.handles(i).into_iter().map(|(_, p)| p))
+        .collect();
+    let every = (samples + handles.len()).div_ceil(MAX).max(1);
+    let mut points: Vec<DVec3> = handles.into_iter().step_by(every).collect();
+    for o in &doc.objects {
+        let g = o.sampled.grid();
+        points.extend(g.data.iter().step_by(g.stride() * every).copied());
+    }
+    points
 }
 
 /// Renders `doc` into an image and reads it back.
