@@ -93,6 +93,9 @@ pub struct Frame<'a> {
     pub(crate) stats: DrawStats,
     /// Offscreen only: copy the image into the readback buffer at the end of the frame.
     pub(crate) capture: bool,
+    /// Rendering starts from the attachments' contents (a restored or saved static layer)
+    /// instead of clearing them.
+    pub(crate) load: bool,
 }
 
 impl<'a> Frame<'a> {
@@ -124,6 +127,7 @@ impl<'a> Frame<'a> {
             bound: Bound::default(),
             stats: DrawStats::default(),
             capture: false,
+            load: false,
         }
     }
 
@@ -308,9 +312,20 @@ impl<'a> Frame<'a> {
                 float32: self.clear,
             },
         };
+        let load_op = if self.load {
+            vk::AttachmentLoadOp::LOAD
+        } else {
+            vk::AttachmentLoadOp::CLEAR
+        };
+        // Depth is kept only where a static layer may be saved from it.
+        let depth_store = if v.layer {
+            vk::AttachmentStoreOp::STORE
+        } else {
+            vk::AttachmentStoreOp::DONT_CARE
+        };
         let mut color = vk::RenderingAttachmentInfo::default()
             .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-            .load_op(vk::AttachmentLoadOp::CLEAR)
+            .load_op(load_op)
             .clear_value(clear_color);
         color = match v.msaa {
             // Only the resolved image is kept; the multisampled one is discarded.
@@ -328,8 +343,8 @@ impl<'a> Frame<'a> {
         let depth = vk::RenderingAttachmentInfo::default()
             .image_view(v.depth.1)
             .image_layout(vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)
-            .load_op(vk::AttachmentLoadOp::CLEAR)
-            .store_op(vk::AttachmentStoreOp::DONT_CARE)
+            .load_op(load_op)
+            .store_op(depth_store)
             .clear_value(vk::ClearValue {
                 depth_stencil: vk::ClearDepthStencilValue {
                     depth: 1.0,

@@ -25,3 +25,4 @@ mod splines;
 mod structural_cli;
 mod structural_edits;
 mod structural_shape;
+mod support;
