@@ -5,7 +5,7 @@ use clap::{Args, Parser, Subcommand};
 use prespline::cli::files::{SampleOverride, SamplesArg};
 use prespline::cli::{self, CliError};
 use prespline::render::maps::SurfaceMap;
-use prespline::render::{NetMode, OrbitCamera, ViewOptions, Wire};
+use prespline::render::{NetMode, OrbitCamera, Redraw, ViewOptions, Wire};
 use prespline::sampling::budget::{self, MemoryBudget};
 use prespline::scene::escape_controls;
 use prespline::view::scenario::Scenario;
@@ -83,6 +83,11 @@ enum Command {
         /// Open with a surface analysis map on: gaussian, mean, kmax, kmin or zebra (M cycles).
         #[arg(long, value_name = "MAP", value_parser = SurfaceMap::parse)]
         analysis: Option<SurfaceMap>,
+        /// How a gesture redraws: retained (what it cannot change is drawn once into a static
+        /// layer; each frame restores it and draws only what moves) or full (every object,
+        /// every frame). Both give the same pixels.
+        #[arg(long, default_value = "retained", value_parser = Redraw::parse, value_name = "retained|full")]
+        redraw: Redraw,
     },
     /// Run a scripted, reproducible editing session and report where every millisecond goes.
     Bench {
@@ -123,6 +128,11 @@ enum Command {
         /// Show a surface analysis map throughout: gaussian, mean, kmax, kmin or zebra.
         #[arg(long, value_name = "MAP", value_parser = SurfaceMap::parse)]
         analysis: Option<SurfaceMap>,
+        /// How a gesture redraws: retained (what it cannot change is drawn once into a static
+        /// layer; each frame restores it and draws only what moves) or full (every object,
+        /// every frame). Both give the same pixels.
+        #[arg(long, default_value = "retained", value_parser = Redraw::parse, value_name = "retained|full")]
+        redraw: Redraw,
     },
     /// Render a scene headless (no display needed) into a PNG image.
     Render {
@@ -285,6 +295,7 @@ fn main() -> ExitCode {
             recover,
             memory,
             analysis,
+            redraw,
         } => cli::view::run(&cli::view::ViewOptions {
             scene: scene.as_deref(),
             size,
@@ -296,6 +307,7 @@ fn main() -> ExitCode {
             memory: memory.budget(),
             recover: recover.as_ref().map(Option::as_deref),
             analysis,
+            redraw,
         }),
         Command::Bench {
             scene,
@@ -310,6 +322,7 @@ fn main() -> ExitCode {
             memory,
             no_lod,
             analysis,
+            redraw,
         } => {
             let args = cli::bench::BenchArgs {
                 scene,
@@ -324,6 +337,7 @@ fn main() -> ExitCode {
                 memory: memory.budget(),
                 lod: !no_lod,
                 analysis,
+                redraw,
             };
             cli::bench::run(&args).map(|line| eprintln!("{}", escape_controls(&line)))
         }

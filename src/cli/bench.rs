@@ -14,6 +14,7 @@ use crate::gpu::{FRAMES_IN_FLIGHT, OffscreenDesc, Renderer, RendererDesc};
 use crate::profile::{
     FrameRecord, Phase, Progress, Recorder, RunInfo, Summary, compare, write_all,
 };
+use crate::render::Redraw;
 use crate::render::maps::SurfaceMap;
 use crate::sampling::budget::MemoryBudget;
 use crate::scene::Scene;
@@ -41,6 +42,8 @@ pub struct BenchArgs {
     pub lod: bool,
     /// A surface analysis map shown throughout (`--analysis`).
     pub analysis: Option<SurfaceMap>,
+    /// How gestures redraw (`--redraw`).
+    pub redraw: Redraw,
 }
 
 /// Runs the benchmark, writes the reports and returns the closing line.
@@ -88,6 +91,7 @@ pub fn run(args: &BenchArgs) -> Result<String, CliError> {
             ..RunInfo::default()
         };
         info = info.with("target", if args.window { "window" } else { "offscreen" });
+        info = info.with("redraw", args.redraw.name());
         let paths = write_all(&dir, &info, &frames).map_err(|e| CliError(e.to_string()))?;
         written.extend(paths);
         if !args.window {
@@ -116,12 +120,13 @@ pub const COMPARISON_TXT: &str = "comparison.txt";
 /// `bench: drag on demo, 120 frames + 10 warm-up, 1280x720, incremental, headless`.
 fn banner(args: &BenchArgs, scene_name: &str, mode: &str) -> String {
     format!(
-        "bench: {} on {scene_name}, {} frames + {} warm-up, {}x{}, {mode}, {}",
+        "bench: {} on {scene_name}, {} frames + {} warm-up, {}x{}, {mode}, redraw {}, {}",
         args.scenario.name(),
         args.frames,
         args.warmup,
         args.size.0,
         args.size.1,
+        args.redraw.name(),
         if args.window { "window" } else { "headless" }
     )
 }
@@ -176,6 +181,7 @@ fn run_headless(
     )
     .map_err(CliError)?;
     session.set_naive(naive);
+    session.set_redraw(args.redraw);
     session.options.lod = args.lod;
     session.set_map(args.analysis);
     let total = args.warmup + args.frames;
@@ -270,6 +276,7 @@ fn run_window(
         lod: args.lod,
         analysis: args.analysis,
         memory: args.memory,
+        redraw: args.redraw,
     })
     .map_err(CliError)?;
     Ok((run.frames, run.device))

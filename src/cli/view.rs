@@ -32,6 +32,8 @@ pub struct ViewOptions<'a> {
     pub recover: Option<Option<&'a Path>>,
     /// A surface analysis map shown from the start (`--analysis`; M cycles it later).
     pub analysis: Option<crate::render::maps::SurfaceMap>,
+    /// How gestures redraw (`--redraw`).
+    pub redraw: crate::render::Redraw,
 }
 
 pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
@@ -102,6 +104,7 @@ pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
         lod: true,
         analysis: opts.analysis,
         memory: opts.memory,
+        redraw: opts.redraw,
     };
     let title = args.title.clone();
     let run = app::run(args).map_err(CliError)?;

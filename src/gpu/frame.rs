@@ -96,6 +96,8 @@ pub struct Frame<'a> {
     /// Rendering starts from the attachments' contents (a restored or saved static layer)
     /// instead of clearing them.
     pub(crate) load: bool,
+    /// Draws are clipped to this pixel rectangle within the viewport (`None`: the viewport).
+    pub(crate) scissor: Option<vk::Rect2D>,
 }
 
 impl<'a> Frame<'a> {
@@ -128,6 +130,7 @@ impl<'a> Frame<'a> {
             stats: DrawStats::default(),
             capture: false,
             load: false,
+            scissor: None,
         }
     }
 
@@ -212,6 +215,27 @@ impl<'a> Frame<'a> {
         self.capture = true;
     }
 
+    /// The camera of subsequent 3D draws.
+    pub fn camera(&self) -> Camera {
+        self.camera
+    }
+
+    /// The clear colour (linear RGBA).
+    pub fn clear_color(&self) -> [f32; 4] {
+        self.clear
+    }
+
+    /// The viewport, `[x, y, width, height]` in pixels.
+    pub fn viewport(&self) -> [u32; 4] {
+        let r = self.viewport;
+        [
+            r.offset.x as u32,
+            r.offset.y as u32,
+            r.extent.width,
+            r.extent.height,
+        ]
+    }
+
     /// Sets the camera used by subsequent 3D draws.
     pub fn set_camera(&mut self, camera: Camera) {
         self.camera = camera;
@@ -276,10 +300,37 @@ impl<'a> Frame<'a> {
             },
             extent: vk::Extent2D { width, height },
         };
+        self.scissor = None;
         if self.rendering {
             self.apply_viewport();
         }
         Ok(())
+    }
+
+    /// Clips later draws to the pixel rectangle `[x, y, width, height]` (origin top-left),
+    /// intersected with the viewport; `None` clips to the viewport again.
+    pub fn set_scissor(&mut self, rect: Option<[u32; 4]>) {
+        let v = self.viewport;
+        self.scissor = rect.map(|[x, y, w, h]| {
+            let (vx, vy) = (v.offset.x as u32, v.offset.y as u32);
+            let x0 = x.clamp(vx, vx + v.extent.width);
+            let y0 = y.clamp(vy, vy + v.extent.height);
+            let x1 = x.saturating_add(w).clamp(x0, vx + v.extent.width);
+            let y1 = y.saturating_add(h).clamp(y0, vy + v.extent.height);
+            vk::Rect2D {
+                offset: vk::Offset2D {
+                    x: x0 as i32,
+                    y: y0 as i32,
+                },
+                extent: vk::Extent2D {
+                    width: x1 - x0,
+                    height: y1 - y0,
+                },
+            }
+        });
+        if self.rendering {
+            self.apply_viewport();
+        }
     }
 
     fn apply_viewport(&self) {
@@ -297,7 +348,7 @@ impl<'a> Frame<'a> {
         unsafe {
             let raw = &self.ctx.device.raw;
             raw.cmd_set_viewport(self.cmd, 0, &[viewport]);
-            raw.cmd_set_scissor(self.cmd, 0, &[r]);
+            raw.cmd_set_scissor(self.cmd, 0, &[self.scissor.unwrap_or(r)]);
         }
     }
 

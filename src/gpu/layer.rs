@@ -39,16 +39,29 @@ impl StaticLayer {
         extent: vk::Extent2D,
         format: vk::Format,
     ) -> GpuResult<Self> {
-        let usage = vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST;
-        let desc = |name, format| ImageDesc {
+        // Only copied, but every image gets a view, which needs an attachment usage.
+        let copies = vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST;
+        let desc = |name, format, usage| ImageDesc {
             name,
             extent,
             format,
             samples: vk::SampleCountFlags::TYPE_1,
-            usage,
+            usage: copies | usage,
         };
-        let color = Image::new(device, &desc("static layer colour", format))?;
-        match Image::new(device, &desc("static layer depth", DEPTH_FORMAT)) {
+        let color = Image::new(
+            device,
+            &desc(
+                "static layer colour",
+                format,
+                vk::ImageUsageFlags::COLOR_ATTACHMENT,
+            ),
+        )?;
+        let depth = desc(
+            "static layer depth",
+            DEPTH_FORMAT,
+            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+        );
+        match Image::new(device, &depth) {
             Ok(depth) => Ok(Self {
                 color,
                 depth,

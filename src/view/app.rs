@@ -60,6 +60,8 @@ pub struct ViewArgs {
     /// What pre-evaluation may take; structural edits and curvature maps that would need
     /// more are refused on the status line.
     pub memory: crate::sampling::budget::MemoryBudget,
+    /// How gestures redraw (`--redraw`).
+    pub redraw: crate::render::Redraw,
 }
 
 /// What a viewer run measured.
@@ -237,6 +239,7 @@ impl App {
         )?;
         session.set_autosave(self.args.autosave.clone());
         session.set_naive(self.args.naive);
+        session.set_redraw(self.args.redraw);
         session.options.lod = self.args.lod;
         if self.args.analysis.is_some() {
             session.set_map(self.args.analysis);
