@@ -219,7 +219,8 @@ pub fn screen_rect(camera: &Camera, bounds: [DVec3; 2], viewport: [u32; 4]) -> [
         )
         .as_vec3();
         let c = camera.view_proj * Vec4::new(p.x, p.y, p.z, 1.0);
-        if !(c.w > 1e-6) || !c.is_finite() {
+        // Also catches a NaN w (every comparison with NaN is false).
+        if c.w.partial_cmp(&1e-6) != Some(std::cmp::Ordering::Greater) || !c.is_finite() {
             return viewport;
         }
         for a in 0..2 {

@@ -187,7 +187,7 @@ fn nest(doc: &mut Document, levels: usize) {
 
 #[test]
 fn edits_change_no_sample_outside_the_support_of_their_target() {
-    let mut rng = Rng::new(0x5eed_22);
+    let mut rng = Rng::new(0x005e_ed22);
     let mut doc = Document::new(&scene());
     let n = check_document(&mut doc, &mut rng, 12);
     assert!(n > 100, "only {n} edits checked");

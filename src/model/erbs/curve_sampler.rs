@@ -257,7 +257,7 @@ impl CurveLevel {
         };
         let own = match (rest.is_empty(), local) {
             (false, LocalLevel::Erbs(child)) => child.support(rest),
-            _ => vec![0..self.axis.local_len(l)],
+            _ => std::iter::once(0..self.axis.local_len(l)).collect(),
         };
         own.iter()
             .flat_map(|r| self.axis.pieces(l).iter().filter_map(|p| p.level_range(r)))
