@@ -96,6 +96,9 @@ pub struct Frame<'a> {
     /// Rendering starts from the attachments' contents (a restored or saved static layer)
     /// instead of clearing them.
     pub(crate) load: bool,
+    /// Store depth at the end of rendering (a static layer will be saved from it); other
+    /// frames let the driver discard it.
+    pub(crate) keep_depth: bool,
     /// Draws are clipped to this pixel rectangle within the viewport (`None`: the viewport).
     pub(crate) scissor: Option<vk::Rect2D>,
 }
@@ -130,6 +133,7 @@ impl<'a> Frame<'a> {
             stats: DrawStats::default(),
             capture: false,
             load: false,
+            keep_depth: false,
             scissor: None,
         }
     }
@@ -368,8 +372,8 @@ impl<'a> Frame<'a> {
         } else {
             vk::AttachmentLoadOp::CLEAR
         };
-        // Depth is kept only where a static layer may be saved from it.
-        let depth_store = if v.layer {
+        // Depth is kept only where a static layer will be saved from it.
+        let depth_store = if v.layer && self.keep_depth {
             vk::AttachmentStoreOp::STORE
         } else {
             vk::AttachmentStoreOp::DONT_CARE

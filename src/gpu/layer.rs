@@ -134,11 +134,23 @@ impl Frame<'_> {
         self.layer().is_some()
     }
 
+    /// Announces a [`Frame::save_static_layer`] before the frame's first draw, so rendering
+    /// stores its depth (other frames let the driver discard it).
+    pub fn keep_depth(&mut self) {
+        if !self.rendering {
+            self.keep_depth = true;
+        }
+    }
+
     /// Saves what was drawn so far (colour and depth) into the target's static layer and goes
     /// on drawing over it. Returns the save's token for [`Frame::restore_static_layer`];
-    /// `None` when the target has no layer (nothing is recorded then).
+    /// `None` when the target has no layer, or rendering began without
+    /// [`Frame::keep_depth`] (nothing is recorded then).
     pub fn save_static_layer(&mut self) -> GpuResult<Option<u64>> {
         let (view, cmd) = (self.view, self.cmd);
+        if !self.keep_depth {
+            return Ok(None);
+        }
         let Some(layer) = self.layer() else {
             return Ok(None);
         };

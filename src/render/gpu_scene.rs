@@ -601,6 +601,7 @@ impl GpuScene {
         };
         if !restored {
             self.layer = None;
+            frame.keep_depth();
             self.build_layer(frame, doc, opts, order, place, key)?;
             if self.layer.is_none() {
                 return Ok(true);
