@@ -381,6 +381,20 @@ fn wrap(text: &str, width: usize) -> Vec<String> {
 mod tests {
     use super::*;
 
+    #[test]
+    fn the_redraw_line_says_how_the_frame_was_drawn() {
+        assert_eq!(
+            redraw_line(Some((1900, 522_200))),
+            "redraw: retained, 1.9 k of 522.2 k triangles"
+        );
+        assert_eq!(redraw_line(None), "redraw: full");
+        let hud = Hud {
+            retained: Some((12, 2_000_000)),
+            ..Hud::new()
+        };
+        assert_eq!(hud.lines()[3], "redraw: retained, 12 of 2.00 M triangles");
+    }
+
     /// Every vertex of the help overlay inside the window.
     fn fits(width: f32, height: f32) -> bool {
         let v = help_overlay(&Font::new(1.0), width, height);
