@@ -215,7 +215,9 @@ fn bench_records_the_redraw_mode() {
     for (flag, expect) in [(None, "retained"), (Some("full"), "full")] {
         let out = scratch.join(expect);
         let mut c = prespline();
-        c.args(["bench", "--frames", "3", "--warmup", "4", "--size", "200x120"]);
+        c.args([
+            "bench", "--frames", "3", "--warmup", "4", "--size", "200x120",
+        ]);
         if let Some(f) = flag {
             c.args(["--redraw", f]);
         }
