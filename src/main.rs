@@ -5,7 +5,7 @@ use clap::{Args, Parser, Subcommand};
 use prespline::cli::files::{SampleOverride, SamplesArg};
 use prespline::cli::{self, CliError};
 use prespline::render::maps::{MapRange, SurfaceMap};
-use prespline::render::{NetMode, OrbitCamera, ViewOptions, Wire};
+use prespline::render::{NetMode, OrbitCamera, Redraw, ViewOptions, Wire};
 use prespline::sampling::budget::{self, MemoryBudget};
 use prespline::scene::escape_controls;
 use prespline::view::scenario::Scenario;
@@ -87,6 +87,11 @@ enum Command {
         analysis: Option<SurfaceMap>,
         #[command(flatten)]
         map_range: MapRangeArgs,
+        /// How a gesture redraws: retained (what it cannot change is drawn once into a static
+        /// layer; each frame restores it and draws only what moves) or full (every object,
+        /// every frame). Both give the same pixels.
+        #[arg(long, default_value = "retained", value_parser = Redraw::parse, value_name = "retained|full")]
+        redraw: Redraw,
     },
     /// Run a scripted, reproducible editing session and report where every millisecond goes.
     Bench {
@@ -131,6 +136,11 @@ enum Command {
         analysis: Option<SurfaceMap>,
         #[command(flatten)]
         map_range: MapRangeArgs,
+        /// How a gesture redraws: retained (what it cannot change is drawn once into a static
+        /// layer; each frame restores it and draws only what moves) or full (every object,
+        /// every frame). Both give the same pixels.
+        #[arg(long, default_value = "retained", value_parser = Redraw::parse, value_name = "retained|full")]
+        redraw: Redraw,
     },
     /// Render a scene headless (no display needed) into a PNG image.
     Render {
@@ -309,6 +319,7 @@ fn main() -> ExitCode {
             memory,
             analysis,
             map_range,
+            redraw,
         } => cli::view::run(&cli::view::ViewOptions {
             scene: scene.as_deref(),
             size,
@@ -321,6 +332,7 @@ fn main() -> ExitCode {
             recover: recover.as_ref().map(Option::as_deref),
             analysis,
             map_range: map_range.map_range,
+            redraw,
         }),
         Command::Bench {
             scene,
@@ -337,6 +349,7 @@ fn main() -> ExitCode {
             no_lod,
             analysis,
             map_range,
+            redraw,
         } => {
             let args = cli::bench::BenchArgs {
                 scene,
@@ -353,6 +366,7 @@ fn main() -> ExitCode {
                 analysis,
                 map_range: map_range.map_range,
                 samples: samples.counts(),
+                redraw,
             };
             cli::bench::run(&args).map(|line| eprintln!("{}", escape_controls(&line)))
         }

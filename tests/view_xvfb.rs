@@ -687,3 +687,59 @@ fn an_elided_status_goes_to_stderr_whole() {
     );
     assert!(!dir.join("x.obj").exists());
 }
+
+/// A drag in the window, screenshots in the middle of it and after it: `--redraw retained`
+/// (the default) gives exactly the pixels of `--redraw full`. The window's own frames run
+/// through the swapchain's static layer under the validation layer.
+#[test]
+fn a_retained_drag_looks_exactly_like_a_full_redraw() {
+    if !common::display() {
+        return;
+    }
+    const DRAG: &str = r#"[
+ {"frame": 3, "move_to": {"object": "bspline_surface", "point": [3, 4]}},
+ {"frame": 4, "press": "left"},
+ {"frame": 5, "move_by": [10, -25]},
+ {"frame": 6, "move_by": [-4, -20]},
+ {"frame": 7, "move_by": [15, 8]},
+ {"frame": 8, "screenshot": "MID"},
+ {"frame": 9, "move_by": [-12, 6]},
+ {"frame": 10, "release": "left"},
+ {"frame": 12, "screenshot": "LAST"},
+ {"frame": 13, "quit": true}
+]"#;
+    let dir = Scratch::new("view-retained");
+    let mut shots = Vec::new();
+    for redraw in ["retained", "full"] {
+        let (mid, last) = (
+            dir.join(format!("{redraw}-mid.png")),
+            dir.join(format!("{redraw}-last.png")),
+        );
+        let script = dir.file(
+            &format!("{redraw}.json"),
+            &DRAG
+                .replace("MID", mid.to_str().unwrap())
+                .replace("LAST", last.to_str().unwrap()),
+        );
+        let out = run(prespline(&dir)
+            .args(["view", "--size", "480x320", "--redraw", redraw, "--script"])
+            .arg(&script)
+            .arg("--save-as")
+            .arg(dir.join(format!("{redraw}.json"))));
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "viewer ({redraw}) failed: {err}");
+        shots.push([mid, last].map(|p| Pixels::read_png(&p).unwrap()));
+    }
+    for (k, name) in ["mid-drag", "last"].iter().enumerate() {
+        let (a, b) = (&shots[0][k], &shots[1][k]);
+        let diff = common::compare_images(b, a, 0).unwrap();
+        assert_eq!(
+            diff.differing, 0,
+            "{name} screenshot: retained differs from full in {} pixels",
+            diff.differing
+        );
+    }
+    // The negative control of the comparison: the mid-drag and last images differ.
+    let moved = common::compare_images(&shots[0][0], &shots[0][1], 0).unwrap();
+    assert!(moved.differing > 0, "the drag moved nothing");
+}

@@ -14,6 +14,7 @@ use crate::gpu::{FRAMES_IN_FLIGHT, OffscreenDesc, Renderer, RendererDesc};
 use crate::profile::{
     FrameRecord, Phase, Progress, Recorder, RunInfo, Summary, compare, write_all,
 };
+use crate::render::Redraw;
 use crate::render::maps::SurfaceMap;
 use crate::sampling::budget::MemoryBudget;
 use crate::scene::Scene;
@@ -45,6 +46,8 @@ pub struct BenchArgs {
     pub samples: super::files::SampleOverride,
     /// How the map's colour scale is chosen (`--map-range`).
     pub map_range: crate::render::maps::MapRange,
+    /// How gestures redraw (`--redraw`).
+    pub redraw: Redraw,
 }
 
 /// Runs the benchmark, writes the reports and returns the closing line.
@@ -103,6 +106,7 @@ pub fn run(args: &BenchArgs) -> Result<String, CliError> {
             .map(|o| o.model.sample_dims().iter().product::<usize>())
             .sum();
         info = info.with("scene_samples", samples);
+        info = info.with("redraw", args.redraw.name());
         let paths = write_all(&dir, &info, &frames).map_err(|e| CliError(e.to_string()))?;
         written.extend(paths);
         if !args.window {
@@ -131,12 +135,13 @@ pub const COMPARISON_TXT: &str = "comparison.txt";
 /// `bench: drag on demo, 120 frames + 10 warm-up, 1280x720, incremental, headless`.
 fn banner(args: &BenchArgs, scene_name: &str, mode: &str) -> String {
     format!(
-        "bench: {} on {scene_name}, {} frames + {} warm-up, {}x{}, {mode}, {}",
+        "bench: {} on {scene_name}, {} frames + {} warm-up, {}x{}, {mode}, redraw {}, {}",
         args.scenario.name(),
         args.frames,
         args.warmup,
         args.size.0,
         args.size.1,
+        args.redraw.name(),
         if args.window { "window" } else { "headless" }
     )
 }
@@ -191,6 +196,7 @@ fn run_headless(
     )
     .map_err(CliError)?;
     session.set_naive(naive);
+    session.set_redraw(args.redraw);
     session.options.lod = args.lod;
     session.options.map_range = args.map_range;
     session.set_map(args.analysis);
@@ -287,6 +293,7 @@ fn run_window(
         analysis: args.analysis,
         map_range: args.map_range,
         memory: args.memory,
+        redraw: args.redraw,
     })
     .map_err(CliError)?;
     Ok((run.frames, run.device))

@@ -34,6 +34,8 @@ pub struct ViewOptions<'a> {
     pub analysis: Option<crate::render::maps::SurfaceMap>,
     /// How the map's colour scale is chosen (`--map-range`).
     pub map_range: crate::render::maps::MapRange,
+    /// How gestures redraw (`--redraw`).
+    pub redraw: crate::render::Redraw,
 }
 
 pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
@@ -105,6 +107,7 @@ pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
         analysis: opts.analysis,
         map_range: opts.map_range,
         memory: opts.memory,
+        redraw: opts.redraw,
     };
     let title = args.title.clone();
     let run = app::run(args).map_err(CliError)?;

@@ -122,6 +122,30 @@ impl Frame<'_> {
         batch: &SurfaceBatch,
         style: &SurfaceStyle,
     ) -> GpuResult<()> {
+        self.surface_batch(mirror, batch, None, style)
+    }
+
+    /// Draws some cells of one surface (the batch's first) as [`Frame::draw_surface_batch`]
+    /// draws them: `cells` are (first index, index count) ranges of the strided mesh's
+    /// triangle list ([`super::grid::grid_triangles_strided`]), drawn in the order given. The
+    /// retained redraw draws a surface's static and dynamic chunks apart with it.
+    pub fn draw_surface_cells(
+        &mut self,
+        mirror: &Mirror,
+        batch: &SurfaceBatch,
+        cells: &[(u32, u32)],
+        style: &SurfaceStyle,
+    ) -> GpuResult<()> {
+        self.surface_batch(mirror, batch, Some(cells), style)
+    }
+
+    fn surface_batch(
+        &mut self,
+        mirror: &Mirror,
+        batch: &SurfaceBatch,
+        cells: Option<&[(u32, u32)]>,
+        style: &SurfaceStyle,
+    ) -> GpuResult<()> {
         let (base, runs) = batch.runs(mirror.len())?;
         let Some(longest) = runs.iter().map(|r| r.1).max() else {
             return Ok(());
@@ -144,9 +168,10 @@ impl Frame<'_> {
             front: style.front,
             back: style.back,
         };
-        self.stats.surface_triangles += u64::from(count / 3) * batch.offsets.len() as u64;
+        let cells = check_cells(cells, count, &runs)?;
         self.bind_and_push(self.ctx.pipelines.surface, &push);
-        self.draw_indexed(mirror, base, index_buffer, count, &runs);
+        let indices = self.draw_indexed(mirror, base, index_buffer, count, &runs, cells);
+        self.stats.surface_triangles += indices / 3;
         Ok(())
     }
 
@@ -161,6 +186,30 @@ impl Frame<'_> {
         mirror: &Mirror,
         scalars: Option<&Mirror>,
         batch: &SurfaceBatch,
+        style: MapStyle,
+    ) -> GpuResult<()> {
+        self.surface_map_batch(mirror, scalars, batch, None, style)
+    }
+
+    /// Some cells of one surface coloured by a map: [`Frame::draw_surface_cells`] for
+    /// [`Frame::draw_surface_map_batch`].
+    pub fn draw_surface_map_cells(
+        &mut self,
+        mirror: &Mirror,
+        scalars: Option<&Mirror>,
+        batch: &SurfaceBatch,
+        cells: &[(u32, u32)],
+        style: MapStyle,
+    ) -> GpuResult<()> {
+        self.surface_map_batch(mirror, scalars, batch, Some(cells), style)
+    }
+
+    fn surface_map_batch(
+        &mut self,
+        mirror: &Mirror,
+        scalars: Option<&Mirror>,
+        batch: &SurfaceBatch,
+        cells: Option<&[(u32, u32)]>,
         style: MapStyle,
     ) -> GpuResult<()> {
         let (base, runs) = batch.runs(mirror.len())?;
@@ -204,7 +253,7 @@ impl Frame<'_> {
             eye: [eye.x, eye.y, eye.z, 0.0],
             params,
         };
-        self.stats.surface_triangles += u64::from(count / 3) * batch.offsets.len() as u64;
+        let cells = check_cells(cells, count, &runs)?;
         self.bind_and_push(self.ctx.pipelines.surface_map, &push);
         let scalar_buffer = scalars.slot(self.slot).raw();
         // SAFETY: recording inside a rendering scope; the scalar mirror has VERTEX_BUFFER
@@ -216,7 +265,8 @@ impl Frame<'_> {
                 .raw
                 .cmd_bind_vertex_buffers(self.cmd, 1, &[scalar_buffer], &[0])
         };
-        self.draw_indexed(mirror, base, index_buffer, count, &runs);
+        let indices = self.draw_indexed(mirror, base, index_buffer, count, &runs, cells);
+        self.stats.surface_triangles += indices / 3;
         Ok(())
     }
 
@@ -261,13 +311,14 @@ impl Frame<'_> {
             color,
         };
         self.bind_and_push(self.ctx.pipelines.wire, &push);
-        self.draw_indexed(mirror, base, index_buffer, count, &runs);
+        self.draw_indexed(mirror, base, index_buffer, count, &runs, None);
         Ok(())
     }
 
     /// For each run (vertex offset, surfaces), the first `surfaces · count` indices of
-    /// `index_buffer` (copies of one grid's `count`): one `vkCmdDrawMultiIndexedEXT` (per
-    /// `maxMultiDrawCount` runs) where supported, else one draw per run.
+    /// `index_buffer` (copies of one grid's `count`), or with `cells` the given index ranges
+    /// of the first run's surface: one `vkCmdDrawMultiIndexedEXT` (per `maxMultiDrawCount`
+    /// draws) where supported, else one draw each.
     fn draw_indexed(
         &mut self,
         mirror: &Mirror,
@@ -275,19 +326,28 @@ impl Frame<'_> {
         index_buffer: vk::Buffer,
         count: u32,
         runs: &[(i32, u32)],
-    ) {
+        cells: Option<&[(u32, u32)]>,
+    ) -> u64 {
         self.bind_vertices(mirror.slot(self.slot).raw(), base);
         self.bind_indices(index_buffer);
+        // (first index, index count, vertex offset) of every draw.
+        let draws: Vec<(u32, u32, i32)> = match cells {
+            Some(cells) => cells.iter().map(|&(f, n)| (f, n, runs[0].0)).collect(),
+            None => runs.iter().map(|&(v, s)| (0, count * s, v)).collect(),
+        };
+        let indices = draws.iter().map(|d| u64::from(d.1)).sum::<u64>();
         let device = self.ctx.device;
         match &device.multi_draw {
             Some(multi) => {
-                for chunk in runs.chunks(multi.max_count as usize) {
+                for chunk in draws.chunks(multi.max_count as usize) {
                     let infos: Vec<vk::MultiDrawIndexedInfoEXT> = chunk
                         .iter()
-                        .map(|&(vertex_offset, surfaces)| vk::MultiDrawIndexedInfoEXT {
-                            first_index: 0,
-                            index_count: count * surfaces,
-                            vertex_offset,
+                        .map(|&(first_index, index_count, vertex_offset)| {
+                            vk::MultiDrawIndexedInfoEXT {
+                                first_index,
+                                index_count,
+                                vertex_offset,
+                            }
                         })
                         .collect();
                     // SAFETY: recording inside a rendering scope; the extension and its
@@ -309,14 +369,14 @@ impl Frame<'_> {
                 }
             }
             None => {
-                for &(vertex_offset, surfaces) in runs {
+                for &(first_index, index_count, vertex_offset) in &draws {
                     // SAFETY: recording inside a rendering scope; ranges checked by the caller.
                     unsafe {
                         device.raw.cmd_draw_indexed(
                             self.cmd,
-                            count * surfaces,
+                            index_count,
                             1,
-                            0,
+                            first_index,
                             vertex_offset,
                             0,
                         )
@@ -325,6 +385,7 @@ impl Frame<'_> {
                 }
             }
         }
+        indices
     }
 
     /// Draws a wide polyline through the points of `run` in this frame's slot of `mirror`.
@@ -499,6 +560,28 @@ impl Frame<'_> {
         // SAFETY: recording inside a rendering scope; the data was just written this frame.
         unsafe { self.ctx.device.raw.cmd_draw(self.cmd, count, 1, 0, 0) };
         self.stats.draws += 1;
+    }
+}
+
+/// Cell ranges must lie in one grid's `count` indices, whole triangles, for a batch of one
+/// surface.
+fn check_cells<'c>(
+    cells: Option<&'c [(u32, u32)]>,
+    count: u32,
+    runs: &[(i32, u32)],
+) -> GpuResult<Option<&'c [(u32, u32)]>> {
+    let Some(cells) = cells else {
+        return Ok(None);
+    };
+    let fits = |&(f, n): &(u32, u32)| {
+        f % 3 == 0 && n % 3 == 0 && f.checked_add(n).is_some_and(|end| end <= count)
+    };
+    if runs.len() == 1 && runs[0].1 == 1 && cells.iter().all(fits) {
+        Ok(Some(cells))
+    } else {
+        Err(GpuError::InvalidArgument(format!(
+            "cell ranges {cells:?} do not lie in one surface of {count} indices"
+        )))
     }
 }
 

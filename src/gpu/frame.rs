@@ -93,6 +93,14 @@ pub struct Frame<'a> {
     pub(crate) stats: DrawStats,
     /// Offscreen only: copy the image into the readback buffer at the end of the frame.
     pub(crate) capture: bool,
+    /// Rendering starts from the attachments' contents (a restored or saved static layer)
+    /// instead of clearing them.
+    pub(crate) load: bool,
+    /// Store depth at the end of rendering (a static layer will be saved from it); other
+    /// frames let the driver discard it.
+    pub(crate) keep_depth: bool,
+    /// Draws are clipped to this pixel rectangle within the viewport (`None`: the viewport).
+    pub(crate) scissor: Option<vk::Rect2D>,
 }
 
 impl<'a> Frame<'a> {
@@ -124,6 +132,9 @@ impl<'a> Frame<'a> {
             bound: Bound::default(),
             stats: DrawStats::default(),
             capture: false,
+            load: false,
+            keep_depth: false,
+            scissor: None,
         }
     }
 
@@ -208,6 +219,27 @@ impl<'a> Frame<'a> {
         self.capture = true;
     }
 
+    /// The camera of subsequent 3D draws.
+    pub fn camera(&self) -> Camera {
+        self.camera
+    }
+
+    /// The clear colour (linear RGBA).
+    pub fn clear_color(&self) -> [f32; 4] {
+        self.clear
+    }
+
+    /// The viewport, `[x, y, width, height]` in pixels.
+    pub fn viewport(&self) -> [u32; 4] {
+        let r = self.viewport;
+        [
+            r.offset.x as u32,
+            r.offset.y as u32,
+            r.extent.width,
+            r.extent.height,
+        ]
+    }
+
     /// Sets the camera used by subsequent 3D draws.
     pub fn set_camera(&mut self, camera: Camera) {
         self.camera = camera;
@@ -272,10 +304,37 @@ impl<'a> Frame<'a> {
             },
             extent: vk::Extent2D { width, height },
         };
+        self.scissor = None;
         if self.rendering {
             self.apply_viewport();
         }
         Ok(())
+    }
+
+    /// Clips later draws to the pixel rectangle `[x, y, width, height]` (origin top-left),
+    /// intersected with the viewport; `None` clips to the viewport again.
+    pub fn set_scissor(&mut self, rect: Option<[u32; 4]>) {
+        let v = self.viewport;
+        self.scissor = rect.map(|[x, y, w, h]| {
+            let (vx, vy) = (v.offset.x as u32, v.offset.y as u32);
+            let x0 = x.clamp(vx, vx + v.extent.width);
+            let y0 = y.clamp(vy, vy + v.extent.height);
+            let x1 = x.saturating_add(w).clamp(x0, vx + v.extent.width);
+            let y1 = y.saturating_add(h).clamp(y0, vy + v.extent.height);
+            vk::Rect2D {
+                offset: vk::Offset2D {
+                    x: x0 as i32,
+                    y: y0 as i32,
+                },
+                extent: vk::Extent2D {
+                    width: x1 - x0,
+                    height: y1 - y0,
+                },
+            }
+        });
+        if self.rendering {
+            self.apply_viewport();
+        }
     }
 
     fn apply_viewport(&self) {
@@ -293,7 +352,7 @@ impl<'a> Frame<'a> {
         unsafe {
             let raw = &self.ctx.device.raw;
             raw.cmd_set_viewport(self.cmd, 0, &[viewport]);
-            raw.cmd_set_scissor(self.cmd, 0, &[r]);
+            raw.cmd_set_scissor(self.cmd, 0, &[self.scissor.unwrap_or(r)]);
         }
     }
 
@@ -308,9 +367,20 @@ impl<'a> Frame<'a> {
                 float32: self.clear,
             },
         };
+        let load_op = if self.load {
+            vk::AttachmentLoadOp::LOAD
+        } else {
+            vk::AttachmentLoadOp::CLEAR
+        };
+        // Depth is kept only where a static layer will be saved from it.
+        let depth_store = if v.layer && self.keep_depth {
+            vk::AttachmentStoreOp::STORE
+        } else {
+            vk::AttachmentStoreOp::DONT_CARE
+        };
         let mut color = vk::RenderingAttachmentInfo::default()
             .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-            .load_op(vk::AttachmentLoadOp::CLEAR)
+            .load_op(load_op)
             .clear_value(clear_color);
         color = match v.msaa {
             // Only the resolved image is kept; the multisampled one is discarded.
@@ -328,8 +398,8 @@ impl<'a> Frame<'a> {
         let depth = vk::RenderingAttachmentInfo::default()
             .image_view(v.depth.1)
             .image_layout(vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)
-            .load_op(vk::AttachmentLoadOp::CLEAR)
-            .store_op(vk::AttachmentStoreOp::DONT_CARE)
+            .load_op(load_op)
+            .store_op(depth_store)
             .clear_value(vk::ClearValue {
                 depth_stencil: vk::ClearDepthStencilValue {
                     depth: 1.0,

@@ -6,6 +6,7 @@ use gpu_allocator::vulkan::Allocation;
 
 use super::device::Device;
 use super::error::{GpuResult, VkResultExt};
+use super::layer::StaticLayer;
 use super::pipeline::DEPTH_FORMAT;
 
 /// Parameters for [`Image::new`].
@@ -141,6 +142,8 @@ pub(crate) struct Attachments {
     pub msaa: Option<Image>,
     pub depth: Image,
     pub samples: vk::SampleCountFlags,
+    /// The retained static layer (single-sampled targets whose colour image can be copied).
+    pub layer: Option<StaticLayer>,
 }
 
 impl Attachments {
@@ -149,7 +152,9 @@ impl Attachments {
         extent: vk::Extent2D,
         color_format: vk::Format,
         samples: vk::SampleCountFlags,
+        copyable: bool,
     ) -> GpuResult<Self> {
+        let with_layer = copyable && samples == vk::SampleCountFlags::TYPE_1;
         let msaa = if samples != vk::SampleCountFlags::TYPE_1 {
             Some(Image::new(
                 device,
@@ -172,17 +177,38 @@ impl Attachments {
                 extent,
                 format: DEPTH_FORMAT,
                 samples,
-                usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT
-                    | vk::ImageUsageFlags::TRANSIENT_ATTACHMENT,
+                usage: if with_layer {
+                    vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT
+                        | vk::ImageUsageFlags::TRANSFER_SRC
+                        | vk::ImageUsageFlags::TRANSFER_DST
+                } else {
+                    vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT
+                        | vk::ImageUsageFlags::TRANSIENT_ATTACHMENT
+                },
             },
         );
-        match depth {
-            Ok(depth) => Ok(Self {
+        let layer = match depth {
+            Ok(_) if with_layer => Some(StaticLayer::new(device, extent, color_format)),
+            _ => None,
+        };
+        match (depth, layer) {
+            (Ok(depth), Some(Err(e))) => {
+                // SAFETY: created just above and never used by the GPU.
+                unsafe {
+                    depth.destroy(device);
+                    if let Some(m) = msaa {
+                        m.destroy(device);
+                    }
+                }
+                Err(e)
+            }
+            (Ok(depth), layer) => Ok(Self {
                 msaa,
                 depth,
                 samples,
+                layer: layer.and_then(Result::ok),
             }),
-            Err(e) => {
+            (Err(e), _) => {
                 if let Some(m) = msaa {
                     // SAFETY: created just above and never used by the GPU.
                     unsafe { m.destroy(device) };
@@ -204,6 +230,9 @@ impl Attachments {
                 m.destroy(device);
             }
             self.depth.destroy(device);
+            if let Some(l) = self.layer {
+                l.destroy(device);
+            }
         }
     }
 }

@@ -69,6 +69,7 @@ mod frame;
 mod grid;
 mod image;
 mod instance;
+mod layer;
 mod memory;
 mod mirror;
 mod offscreen;

@@ -61,10 +61,12 @@ impl OffscreenTarget {
                 extent,
                 format: OFFSCREEN_FORMAT,
                 samples: vk::SampleCountFlags::TYPE_1,
-                usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
+                usage: vk::ImageUsageFlags::COLOR_ATTACHMENT
+                    | vk::ImageUsageFlags::TRANSFER_SRC
+                    | vk::ImageUsageFlags::TRANSFER_DST,
             },
         )?;
-        let attachments = match Attachments::new(device, extent, OFFSCREEN_FORMAT, samples) {
+        let attachments = match Attachments::new(device, extent, OFFSCREEN_FORMAT, samples, true) {
             Ok(a) => a,
             Err(e) => {
                 // SAFETY: created just above and never used by the GPU.
@@ -153,6 +155,7 @@ impl OffscreenTarget {
             extent: self.extent,
             format: OFFSCREEN_FORMAT,
             samples: self.attachments.samples,
+            layer: self.attachments.layer.is_some(),
         }
     }
 

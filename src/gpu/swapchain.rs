@@ -11,6 +11,7 @@ use super::device::Device;
 use super::error::{GpuError, GpuResult, VkResultExt, vk_error};
 use super::image::{Attachments, create_view};
 use super::instance::Instance;
+use super::layer::StaticLayer;
 use super::target::TargetView;
 
 /// Parameters for [`super::Renderer::create_swapchain`].
@@ -47,6 +48,8 @@ pub struct Swapchain {
     vsync: bool,
     samples: vk::SampleCountFlags,
     present_mode: vk::PresentModeKHR,
+    /// Whether the images take transfers (then the attachments have a static layer).
+    copyable: bool,
     /// Set on resize, out-of-date or suboptimal; the next begin recreates.
     pub(crate) stale: bool,
     /// Swapchains replaced by a rebuild, kept with their semaphores until presentation is
@@ -100,6 +103,11 @@ impl Swapchain {
         self.present_mode
     }
 
+    /// The static layer of the current attachments.
+    pub(crate) fn layer_mut(&mut self) -> Option<&mut StaticLayer> {
+        self.attachments.as_mut()?.layer.as_mut()
+    }
+
     pub(crate) fn view(&self, image_index: u32) -> Option<TargetView> {
         let a = self.attachments.as_ref()?;
         let i = image_index as usize;
@@ -111,6 +119,7 @@ impl Swapchain {
             extent: self.extent,
             format: self.format.format,
             samples: self.samples,
+            layer: a.layer.is_some(),
         })
     }
 
@@ -221,6 +230,7 @@ impl Swapchain {
             views: Vec::new(),
             render_finished: Vec::new(),
             attachments: None,
+            copyable: false,
             format: vk::SurfaceFormatKHR::default(),
             extent: vk::Extent2D::default(),
             wanted: vk::Extent2D {
@@ -269,7 +279,12 @@ impl Swapchain {
             .ok_or_else(|| GpuError::Surface("surface reports no formats".into()))?;
         let present_mode = choose_present_mode(&modes, self.vsync);
         let old = self.raw;
-        let info = swapchain_info(self.surface, &caps, format, extent, present_mode, old);
+        let transfers = vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST;
+        self.copyable = caps.supported_usage_flags.contains(transfers);
+        let mut info = swapchain_info(self.surface, &caps, format, extent, present_mode, old);
+        if self.copyable {
+            info = info.image_usage(vk::ImageUsageFlags::COLOR_ATTACHMENT | transfers);
+        }
         // SAFETY: parameters were validated against the surface capabilities above.
         let raw = unsafe { swapchain_fn.create_swapchain(&info, None) }.vk("vkCreateSwapchainKHR");
         if old != vk::SwapchainKHR::null() {
@@ -365,6 +380,7 @@ impl Swapchain {
             self.extent,
             self.format.format,
             self.samples,
+            self.copyable,
         )?);
         Ok(())
     }

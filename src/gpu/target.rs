@@ -14,4 +14,6 @@ pub(crate) struct TargetView {
     pub extent: vk::Extent2D,
     pub format: vk::Format,
     pub samples: vk::SampleCountFlags,
+    /// The target has a static layer (its depth is stored at the end of rendering).
+    pub layer: bool,
 }

@@ -289,6 +289,7 @@ pub trait DynSampler {
     fn apply(&mut self, edit: &ObjectEdit) -> Result<DirtyRegion, EditError>;
     fn rebuild_touched(&mut self) -> DirtyRegion;
     fn full(&mut self) -> DirtyRegion;
+    fn support(&self, target: Target) -> Vec<DirtyRegion>;
 }
 
 impl<S> DynSampler for Tracked<S>
@@ -332,6 +333,10 @@ where
 
     fn full(&mut self) -> DirtyRegion {
         Sampler::full(self)
+    }
+
+    fn support(&self, target: Target) -> Vec<DirtyRegion> {
+        Sampler::support(self, target)
     }
 }
 

@@ -344,6 +344,12 @@ impl SampledObject {
         self.sampler().grid()
     }
 
+    /// The samples whose values edits of `target` can change ([`crate::sampling::Sampler::support`]).
+    #[must_use]
+    pub fn support(&self, target: Target) -> Vec<DirtyRegion> {
+        self.sampler().support(target)
+    }
+
     /// Sample parameters per direction.
     #[must_use]
     pub fn params(&self) -> Vec<&[f64]> {

@@ -5,6 +5,9 @@
 use super::analysis::curve_pieces;
 use super::lod::{GridMetrics, Lod};
 use super::map_mirror::{MapScalars, MapView, SurfaceSlot};
+use super::retained::{
+    Gesture, LayerKey, Redraw, SplitCells, overlaps, sample_bounds, screen_rect, split_cells,
+};
 use super::style::{NetMode, Palette, ViewOptions, Wire};
 use crate::editor::{
     Applied, ControlLayout, ControlsChange, Document, Handle, LOCAL_CURVE_SAMPLES,
@@ -41,6 +44,8 @@ struct ObjectGpu {
     /// World-space measures of the samples for choosing strides; `None` until measured after
     /// the samples last changed (the inner `None`: not measurable, drawn in full).
     metrics: Option<Option<GridMetrics>>,
+    /// World-space bounds of the samples, measured when a static layer needs them.
+    bounds: Option<Option<[DVec3; 2]>>,
 }
 
 /// Surfaces of one grid shape and colour in one arena: drawn with one multi-draw per stride.
@@ -50,6 +55,14 @@ struct SurfaceGroup {
     members: Vec<usize>,
     shape: GridShape,
     arena: usize,
+}
+
+/// Surfaces of one group drawn at one stride: one multi-draw in a full redraw.
+#[derive(Debug, Clone, PartialEq)]
+struct Batch {
+    group: usize,
+    stride: GridStride,
+    members: Vec<usize>,
 }
 
 /// Floats per arena mirror at most (256 MiB); a larger object gets an arena of its own.
@@ -71,6 +84,10 @@ pub struct DrawReport {
     pub triangles: u64,
     /// Triangles the surfaces would have at full resolution.
     pub full_triangles: u64,
+    /// The frame started from the static layer: `triangles` of `retained_of` (the triangles
+    /// of a full redraw at the same levels of detail) were drawn.
+    pub retained: bool,
+    pub retained_of: u64,
 }
 
 /// Which handle the cursor is over and which one is selected (for highlighting).
@@ -108,6 +125,28 @@ pub struct GpuScene {
     /// The curvature map's scalars, built by the first upload after the map changed.
     scalars: Option<MapScalars>,
     scratch: Vec<f32>,
+    /// `--redraw`: whether gestures draw from a static layer.
+    redraw: Redraw,
+    /// The gesture in progress ([`GpuScene::set_gesture`]).
+    gesture: Option<Gesture>,
+    /// The static layer of the gesture, once built.
+    layer: Option<Layer>,
+    /// Test hook: the dynamic set misses one chunk (a negative control).
+    drop_chunk: bool,
+}
+
+/// A static layer in the target and what it was built for.
+struct Layer {
+    key: LayerKey,
+    token: u64,
+    /// The support of the gesture's target when the layer was built.
+    support: Vec<crate::sampling::DirtyRegion>,
+    /// The dragged surface's cells (`None`: the gesture moves a curve).
+    cells: Option<SplitCells>,
+    /// Surfaces after the dragged one in draw order, with their screen rectangles.
+    later: Vec<(usize, [u32; 4])>,
+    /// Something drawn in the layer changed: the next frame draws in full.
+    stale: bool,
 }
 
 /// Reflection-line bands of the zebra map over the height of the reflected view ray.
@@ -125,6 +164,10 @@ impl GpuScene {
             map: None,
             scalars: None,
             scratch: Vec::new(),
+            redraw: Redraw::default(),
+            gesture: None,
+            layer: None,
+            drop_chunk: false,
         };
         // On failure, give back what was created.
         match scene.fill(renderer, doc, &places, &sizes) {
@@ -173,6 +216,7 @@ impl GpuScene {
                 controls_resized: false,
                 lod: None,
                 metrics: None,
+                bounds: None,
             });
             filled?;
         }
@@ -183,6 +227,18 @@ impl GpuScene {
     /// every frame slot; a control display with a new layout replaces its mirror at the next
     /// upload. The report is all it reads: what the edits were does not matter here.
     pub fn consume(&mut self, applied: &Applied) {
+        if let Some(layer) = &mut self.layer {
+            let moved = |c: &crate::editor::ObjectChange| {
+                c.object == layer.key.gesture.object
+                    && c.samples
+                        .iter()
+                        .all(|r| layer.support.iter().any(|s| s.contains(r)))
+            };
+            // Samples drawn in the layer changed (an undo, another object, a structural edit).
+            if applied.structure_changed() || !applied.changes.iter().all(moved) {
+                layer.stale = true;
+            }
+        }
         for c in &applied.changes {
             let o = &mut self.objects[c.object];
             for region in &c.samples {
@@ -255,9 +311,14 @@ impl GpuScene {
         for (i, o) in self.objects.iter_mut().enumerate() {
             let ranges = o.dirty[slot].take();
             if !ranges.is_empty() {
-                // New samples may project differently: measure and choose the stride again.
-                o.lod = None;
-                o.metrics = None;
+                // New samples may project differently: measure and choose the stride again,
+                // except for the object a gesture moves (its level of detail is frozen
+                // until the gesture ends).
+                if self.gesture.is_none_or(|g| g.object != i) {
+                    o.lod = None;
+                    o.metrics = None;
+                }
+                o.bounds = None;
                 let cols = doc.objects[i].sampled.grid().dims[1];
                 let per = floats_per_sample(doc, i);
                 let mut w = frame.write_mirror(&mut self.arenas[o.samples.arena]);
@@ -302,9 +363,46 @@ impl GpuScene {
         Ok(stats)
     }
 
+    /// How gestures redraw (`--redraw`); `Full` drops any static layer.
+    pub fn set_redraw(&mut self, redraw: Redraw) {
+        self.redraw = redraw;
+        if redraw == Redraw::Full {
+            self.layer = None;
+        }
+    }
+
+    /// How gestures redraw.
+    pub fn redraw(&self) -> Redraw {
+        self.redraw
+    }
+
+    /// The gesture in progress (`None`: none). Its object's level of detail stays as it is
+    /// until the gesture ends, then is chosen again; a new gesture builds a new static layer.
+    pub fn set_gesture(&mut self, gesture: Option<Gesture>) {
+        if self.gesture == gesture {
+            return;
+        }
+        if let Some(o) = self.gesture.and_then(|g| self.objects.get_mut(g.object)) {
+            o.lod = None;
+            o.metrics = None;
+        }
+        self.gesture = gesture;
+        self.layer = None;
+    }
+
+    /// Test hook, a negative control: the dynamic set of the next static layers misses one
+    /// chunk, whose old pixels then stay in the layer.
+    #[doc(hidden)]
+    pub fn set_drop_chunk(&mut self, drop: bool) {
+        self.drop_chunk = drop;
+        self.layer = None;
+    }
+
     /// Records the draws of every object. Each surface is drawn at the stride `lod` picks for
     /// it (strided index buffers over the full-resolution mirrors; choosing a stride copies
-    /// nothing); surfaces of one group sharing a stride are one multi-draw.
+    /// nothing); surfaces of one group sharing a stride are one multi-draw. During a gesture
+    /// with [`Redraw::Retained`] the surfaces come from the static layer where it is valid
+    /// (see [`super::retained`]).
     pub fn draw(
         &mut self,
         frame: &mut Frame<'_>,
@@ -319,49 +417,21 @@ impl GpuScene {
             self.lod_view = Some(*lod);
             self.objects.iter_mut().for_each(|o| o.lod = None);
         }
-        // Opaque surfaces first, then lines and points on top of them.
-        for group in &self.groups {
-            let color = palette.surface(doc.objects[group.members[0]].color);
-            let style = SurfaceStyle {
-                front: color,
-                back: palette.back_of(color),
-                ..SurfaceStyle::default()
-            };
-            let mut by_stride: BTreeMap<(u32, u32), Vec<usize>> = BTreeMap::new();
-            for &i in &group.members {
-                let o = &mut self.objects[i];
-                let stride = if opts.lod {
-                    let grid = doc.objects[i].sampled.grid();
-                    let metrics = o.metrics.get_or_insert_with(|| GridMetrics::new(grid));
-                    *o.lod.get_or_insert_with(|| lod.stride(metrics.as_ref()))
-                } else {
-                    GridStride::FULL
-                };
-                by_stride
-                    .entry((stride.rows, stride.cols))
-                    .or_default()
-                    .push(o.samples.offset);
-            }
-            for ((rows, cols), offsets) in &by_stride {
-                let stride = GridStride {
-                    rows: *rows,
-                    cols: *cols,
-                };
-                let n = offsets.len() as u64;
-                report.triangles += 2 * stride.cells(group.shape) * n;
-                report.full_triangles += 2 * GridStride::FULL.cells(group.shape) * n;
-                let batch = SurfaceBatch {
-                    shape: group.shape,
-                    stride,
-                    offsets,
-                };
-                self.draw_surfaces(frame, group.arena, &batch, &style)?;
-                let every = match opts.wire {
-                    Wire::Off => continue,
-                    Wire::Isolines(every) => every.max(1),
-                    Wire::Full => 1,
-                };
-                frame.draw_wire_batch(&self.arenas[group.arena], &batch, every, palette.wire)?;
+        let order = self.surface_order(doc, opts, lod);
+        for b in &order {
+            let shape = self.groups[b.group].shape;
+            let n = b.members.len() as u64;
+            report.triangles += 2 * b.stride.cells(shape) * n;
+            report.full_triangles += 2 * GridStride::FULL.cells(shape) * n;
+        }
+        let before = frame.stats().surface_triangles;
+        if self.draw_retained(frame, doc, opts, &order)? {
+            report.retained = true;
+            report.retained_of = report.triangles;
+            report.triangles = frame.stats().surface_triangles - before;
+        } else {
+            for b in &order {
+                self.draw_batch(frame, doc, opts, b, &b.members)?;
             }
         }
         for (i, o) in self.objects.iter().enumerate() {
@@ -389,32 +459,309 @@ impl GpuScene {
         Ok(report)
     }
 
-    /// A batch of surfaces, shaded or coloured by the map. Until the first upload after a
-    /// map change has built its scalars, curvature maps draw plain shading.
+    /// The surfaces in draw order: per group, per stride (ascending), the members sharing it.
+    fn surface_order(&mut self, doc: &Document, opts: &ViewOptions, lod: &Lod) -> Vec<Batch> {
+        let mut order = Vec::new();
+        for (g, group) in self.groups.iter().enumerate() {
+            let mut by_stride: BTreeMap<(u32, u32), Vec<usize>> = BTreeMap::new();
+            for &i in &group.members {
+                let o = &mut self.objects[i];
+                let stride = if opts.lod {
+                    let grid = doc.objects[i].sampled.grid();
+                    let metrics = o.metrics.get_or_insert_with(|| GridMetrics::new(grid));
+                    *o.lod.get_or_insert_with(|| lod.stride(metrics.as_ref()))
+                } else {
+                    GridStride::FULL
+                };
+                by_stride
+                    .entry((stride.rows, stride.cols))
+                    .or_default()
+                    .push(i);
+            }
+            for ((rows, cols), members) in by_stride {
+                order.push(Batch {
+                    group: g,
+                    stride: GridStride { rows, cols },
+                    members,
+                });
+            }
+        }
+        order
+    }
+
+    /// The surfaces `members` of batch `b` (shaded or mapped, then their isolines).
+    fn draw_batch(
+        &self,
+        frame: &mut Frame<'_>,
+        doc: &Document,
+        opts: &ViewOptions,
+        b: &Batch,
+        members: &[usize],
+    ) -> GpuResult<()> {
+        if members.is_empty() {
+            return Ok(());
+        }
+        let palette = Palette::default();
+        let group = &self.groups[b.group];
+        let offsets: Vec<usize> = members
+            .iter()
+            .map(|&i| self.objects[i].samples.offset)
+            .collect();
+        let batch = SurfaceBatch {
+            shape: group.shape,
+            stride: b.stride,
+            offsets: &offsets,
+        };
+        self.draw_surfaces(
+            frame,
+            group.arena,
+            &batch,
+            None,
+            &self.group_style(doc, b.group),
+        )?;
+        let every = match opts.wire {
+            Wire::Off => return Ok(()),
+            Wire::Isolines(every) => every.max(1),
+            Wire::Full => 1,
+        };
+        frame.draw_wire_batch(&self.arenas[group.arena], &batch, every, palette.wire)
+    }
+
+    /// Cell ranges of surface `i` of batch `b` (no isolines: retained redraw needs them off).
+    fn draw_cells(
+        &self,
+        frame: &mut Frame<'_>,
+        doc: &Document,
+        b: &Batch,
+        i: usize,
+        cells: &[(u32, u32)],
+    ) -> GpuResult<()> {
+        if cells.is_empty() {
+            return Ok(());
+        }
+        let group = &self.groups[b.group];
+        let offsets = [self.objects[i].samples.offset];
+        let batch = SurfaceBatch {
+            shape: group.shape,
+            stride: b.stride,
+            offsets: &offsets,
+        };
+        let style = self.group_style(doc, b.group);
+        self.draw_surfaces(frame, group.arena, &batch, Some(cells), &style)
+    }
+
+    fn group_style(&self, doc: &Document, g: usize) -> SurfaceStyle {
+        let palette = Palette::default();
+        let color = palette.surface(doc.objects[self.groups[g].members[0]].color);
+        SurfaceStyle {
+            front: color,
+            back: palette.back_of(color),
+            ..SurfaceStyle::default()
+        }
+    }
+
+    /// Draws the surfaces from the static layer when a gesture allows it: restores a valid
+    /// layer or builds one, then draws the dynamic set. `false`: nothing was drawn, draw
+    /// everything (no gesture, `--redraw full`, isolines on, or a target without a layer).
+    fn draw_retained(
+        &mut self,
+        frame: &mut Frame<'_>,
+        doc: &Document,
+        opts: &ViewOptions,
+        order: &[Batch],
+    ) -> GpuResult<bool> {
+        let Some(g) = self.gesture.filter(|_| self.redraw == Redraw::Retained) else {
+            self.layer = None;
+            return Ok(false);
+        };
+        if opts.wire != Wire::Off || g.object >= self.objects.len() || !frame.has_static_layer() {
+            self.layer = None;
+            return Ok(false);
+        }
+        let place = order.iter().enumerate().find_map(|(bi, b)| {
+            let m = b.members.iter().position(|&i| i == g.object)?;
+            Some((bi, m))
+        });
+        let key = LayerKey {
+            camera: frame.camera(),
+            clear: frame.clear_color(),
+            viewport: frame.viewport(),
+            extent: frame.extent(),
+            opts: *opts,
+            lod: self.lod_view,
+            map: self.map.clone(),
+            scalars: self.scalars.is_some(),
+            objects: self.objects.len(),
+            gesture: g,
+            stride: place.map(|(bi, _)| order[bi].stride),
+        };
+        let valid = self
+            .layer
+            .as_ref()
+            .is_some_and(|l| !l.stale && l.key == key);
+        let restored = match &self.layer {
+            Some(l) if valid => frame.restore_static_layer(l.token)?,
+            _ => false,
+        };
+        if !restored {
+            self.layer = None;
+            frame.keep_depth();
+            self.build_layer(frame, doc, opts, order, place, key)?;
+            if self.layer.is_none() {
+                return Ok(true);
+            }
+        }
+        self.draw_dynamic(frame, doc, opts, order, place)?;
+        Ok(true)
+    }
+
+    /// Draws everything but the dynamic chunks in full order, saves it as the static layer
+    /// and notes what later frames need.
+    fn build_layer(
+        &mut self,
+        frame: &mut Frame<'_>,
+        doc: &Document,
+        opts: &ViewOptions,
+        order: &[Batch],
+        place: Option<(usize, usize)>,
+        key: LayerKey,
+    ) -> GpuResult<()> {
+        let g = key.gesture;
+        let support = doc.objects[g.object].sampled.support(g.target);
+        let cells = place.map(|(bi, _)| {
+            let shape = self.groups[order[bi].group].shape;
+            split_cells(shape, order[bi].stride, &support, self.drop_chunk)
+        });
+        for (bi, b) in order.iter().enumerate() {
+            match (place, &cells) {
+                (Some((pb, m)), Some(c)) if pb == bi => {
+                    self.draw_batch(frame, doc, opts, b, &b.members[..m])?;
+                    self.draw_cells(frame, doc, b, g.object, &c.fixed)?;
+                    self.draw_batch(frame, doc, opts, b, &b.members[m + 1..])?;
+                }
+                _ => self.draw_batch(frame, doc, opts, b, &b.members)?,
+            }
+        }
+        let Some(token) = frame.save_static_layer()? else {
+            // The target lost its layer: finish this frame without one.
+            if let (Some((pb, _)), Some(c)) = (place, &cells) {
+                self.draw_cells(frame, doc, &order[pb], g.object, &c.dynamic)?;
+            }
+            return Ok(());
+        };
+        let mut later = Vec::new();
+        if let Some((pb, m)) = place {
+            let (camera, viewport) = (frame.camera(), frame.viewport());
+            let after = order[pb].members[m + 1..]
+                .iter()
+                .chain(order[pb + 1..].iter().flat_map(|b| &b.members));
+            for &i in after {
+                let o = &mut self.objects[i];
+                let bounds = *o
+                    .bounds
+                    .get_or_insert_with(|| sample_bounds(doc.objects[i].sampled.grid(), None));
+                if let Some(b) = bounds {
+                    later.push((i, screen_rect(&camera, b, viewport)));
+                }
+            }
+        }
+        self.layer = Some(Layer {
+            key,
+            token,
+            support,
+            cells,
+            later,
+            stale: false,
+        });
+        Ok(())
+    }
+
+    /// The dynamic chunks, then, clipped to their screen rectangle, the surfaces after them
+    /// in draw order that reach it (so ties in depth go as in a full redraw).
+    fn draw_dynamic(
+        &self,
+        frame: &mut Frame<'_>,
+        doc: &Document,
+        opts: &ViewOptions,
+        order: &[Batch],
+        place: Option<(usize, usize)>,
+    ) -> GpuResult<()> {
+        // A gesture on a curve has no dynamic surface: its samples are drawn with the lines.
+        let (Some((pb, _)), Some(layer)) = (place, &self.layer) else {
+            return Ok(());
+        };
+        let Some(cells) = &layer.cells else {
+            return Ok(());
+        };
+        let g = layer.key.gesture;
+        self.draw_cells(frame, doc, &order[pb], g.object, &cells.dynamic)?;
+        let grid = doc.objects[g.object].sampled.grid();
+        let Some(bounds) = sample_bounds(grid, Some(&cells.chunks)) else {
+            return Ok(());
+        };
+        let rect = screen_rect(&frame.camera(), bounds, frame.viewport());
+        if rect[2] == 0 || rect[3] == 0 {
+            return Ok(());
+        }
+        let reached: Vec<usize> = layer
+            .later
+            .iter()
+            .filter(|(_, r)| overlaps(*r, rect))
+            .map(|&(i, _)| i)
+            .collect();
+        if reached.is_empty() {
+            return Ok(());
+        }
+        frame.set_scissor(Some(rect));
+        for b in order {
+            let members: Vec<usize> = b
+                .members
+                .iter()
+                .copied()
+                .filter(|i| reached.contains(i))
+                .collect();
+            self.draw_batch(frame, doc, opts, b, &members)?;
+        }
+        frame.set_scissor(None);
+        Ok(())
+    }
+
+    /// A batch of surfaces (with `cells`, those cells of its one surface), shaded or coloured
+    /// by the map. Until the first upload after a map change has built its scalars,
+    /// curvature maps draw plain shading.
     fn draw_surfaces(
         &self,
         frame: &mut Frame<'_>,
         arena: usize,
         batch: &SurfaceBatch,
+        cells: Option<&[(u32, u32)]>,
         style: &SurfaceStyle,
     ) -> GpuResult<()> {
         let mirror = &self.arenas[arena];
+        let plain = |frame: &mut Frame<'_>| match cells {
+            Some(c) => frame.draw_surface_cells(mirror, batch, c, style),
+            None => frame.draw_surface_batch(mirror, batch, style),
+        };
+        let mapped = |frame: &mut Frame<'_>, scalars: Option<&Mirror>, map| match cells {
+            Some(c) => frame.draw_surface_map_cells(mirror, scalars, batch, c, map),
+            None => frame.draw_surface_map_batch(mirror, scalars, batch, map),
+        };
         let Some(view) = &self.map else {
-            return frame.draw_surface_batch(mirror, batch, style);
+            return plain(frame);
         };
         if !view.map.needs_curvature() {
             let zebra = MapStyle::Zebra {
                 stripes: ZEBRA_STRIPES,
             };
-            return frame.draw_surface_map_batch(mirror, None, batch, zebra);
+            return mapped(frame, None, zebra);
         }
         match &self.scalars {
             // The scalars are on each surface's scale already (−1 … 1).
             Some(s) if s.view.map == view.map => {
                 let scale = MapStyle::Scale { range: 1.0 };
-                frame.draw_surface_map_batch(mirror, Some(&s.mirrors[arena]), batch, scale)
+                mapped(frame, Some(&s.mirrors[arena]), scale)
             }
-            _ => frame.draw_surface_batch(mirror, batch, style),
+            _ => plain(frame),
         }
     }
 

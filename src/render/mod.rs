@@ -11,12 +11,14 @@ pub mod map_mirror;
 pub mod maps;
 pub mod offscreen;
 pub mod overlays;
+pub mod retained;
 pub mod style;
 
 pub use camera::{Bounds, OrbitCamera};
 pub use gpu_scene::{DrawReport, GpuScene, Highlight, UploadStats};
 pub use lod::Lod;
 pub use map_mirror::MapView;
+pub use retained::{Gesture, Redraw};
 pub use style::{NetMode, Palette, ViewOptions, Wire};
 
 use crate::gpu::ValidationMode;

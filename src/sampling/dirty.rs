@@ -26,6 +26,22 @@ impl DirtyRegion {
         Self::surface(samples, 0..1)
     }
 
+    /// Every sample of a `rows × cols` grid.
+    #[must_use]
+    pub fn whole([rows, cols]: [usize; 2]) -> Self {
+        Self::surface(0..rows, 0..cols)
+    }
+
+    /// Whether every sample of `other` is in this region.
+    #[must_use]
+    pub fn contains(&self, other: &DirtyRegion) -> bool {
+        other.is_empty()
+            || (self.rows.start <= other.rows.start
+                && other.rows.end <= self.rows.end
+                && self.cols.start <= other.cols.start
+                && other.cols.end <= self.cols.end)
+    }
+
     /// A rectangle of surface samples.
     #[must_use]
     pub fn surface(rows: Range<usize>, cols: Range<usize>) -> Self {

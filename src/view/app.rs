@@ -62,6 +62,8 @@ pub struct ViewArgs {
     /// What pre-evaluation may take; structural edits and curvature maps that would need
     /// more are refused on the status line.
     pub memory: crate::sampling::budget::MemoryBudget,
+    /// How gestures redraw (`--redraw`).
+    pub redraw: crate::render::Redraw,
 }
 
 /// What a viewer run measured.
@@ -239,6 +241,7 @@ impl App {
         )?;
         session.set_autosave(self.args.autosave.clone());
         session.set_naive(self.args.naive);
+        session.set_redraw(self.args.redraw);
         session.options.lod = self.args.lod;
         session.options.map_range = self.args.map_range;
         if self.args.analysis.is_some() {

@@ -26,6 +26,9 @@ pub struct Hud {
     pub gpu_ms: Option<f64>,
     /// Surface triangles drawn last frame and at full resolution (level of detail).
     pub triangles: (u64, u64),
+    /// Last frame came from the static layer: surface triangles drawn and those a full
+    /// redraw draws (`None`: a full redraw).
+    pub retained: Option<(u64, u64)>,
     pub visible: bool,
 }
 
@@ -58,9 +61,9 @@ impl Hud {
             / n as f64
     }
 
-    /// The HUD lines: frame time, edit cost and bytes copied, level of detail.
+    /// The HUD lines: frame time, edit cost and bytes copied, level of detail, redraw.
     #[must_use]
-    pub fn lines(&self) -> [String; 3] {
+    pub fn lines(&self) -> [String; 4] {
         let mean = self.mean();
         let fps = if mean > 0.0 { 1000.0 / mean } else { 0.0 };
         let gpu = self
@@ -75,6 +78,7 @@ impl Hud {
                 self.bytes as f64 / 1024.0
             ),
             lod_line(self.triangles),
+            redraw_line(self.retained),
         ]
     }
 
@@ -250,17 +254,33 @@ fn wrap_chars(text: &str, width: usize) -> Vec<String> {
     lines
 }
 
+/// A triangle count, short.
+fn count_text(n: u64) -> String {
+    if n >= 1_000_000 {
+        format!("{:.2} M", n as f64 / 1e6)
+    } else if n >= 1000 {
+        format!("{:.1} k", n as f64 / 1e3)
+    } else {
+        n.to_string()
+    }
+}
+
+/// `redraw: retained, N of M triangles` for a frame drawn from the static layer, else
+/// `redraw: full`.
+fn redraw_line(retained: Option<(u64, u64)>) -> String {
+    match retained {
+        Some((n, m)) => format!(
+            "redraw: retained, {} of {} triangles",
+            count_text(n),
+            count_text(m)
+        ),
+        None => "redraw: full".into(),
+    }
+}
+
 /// The level-of-detail line: surface triangles drawn and what the full grids would take.
 fn lod_line((drawn, full): (u64, u64)) -> String {
-    let k = |n: u64| {
-        if n >= 1_000_000 {
-            format!("{:.2} M", n as f64 / 1e6)
-        } else if n >= 1000 {
-            format!("{:.1} k", n as f64 / 1e3)
-        } else {
-            n.to_string()
-        }
-    };
+    let k = count_text;
     if drawn == full {
         format!("LOD full: {} triangles", k(full))
     } else {
@@ -360,6 +380,20 @@ fn wrap(text: &str, width: usize) -> Vec<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_redraw_line_says_how_the_frame_was_drawn() {
+        assert_eq!(
+            redraw_line(Some((1900, 522_200))),
+            "redraw: retained, 1.9 k of 522.2 k triangles"
+        );
+        assert_eq!(redraw_line(None), "redraw: full");
+        let hud = Hud {
+            retained: Some((12, 2_000_000)),
+            ..Hud::new()
+        };
+        assert_eq!(hud.lines()[3], "redraw: retained, 12 of 2.00 M triangles");
+    }
 
     /// Every vertex of the help overlay inside the window.
     fn fits(width: f32, height: f32) -> bool {

@@ -9,7 +9,8 @@ use super::stage::Stage;
 use super::tools::{Axis, Drag, Transform, TransformKind};
 use crate::editor::{Document, Handle};
 use crate::gpu::LineVertex;
-use crate::model::{Index2, LocalPath, Model};
+use crate::model::{Index2, LocalPath, Model, Target as EditTarget};
+use crate::render::Gesture;
 use glam::{DMat4, DVec3};
 
 /// What a transform acts on.
@@ -65,6 +66,38 @@ impl Mode {
             self,
             Mode::Transform { .. } | Mode::Refine(_) | Mode::WeightEntry { .. }
         )
+    }
+
+    /// What the gesture in progress moves, for the renderer's static layer: a dragged or
+    /// transformed point (its weight with Alt), or a transformed ERBS local.
+    #[must_use]
+    pub fn gesture(&self) -> Option<Gesture> {
+        let point = |h: &Handle, weight: bool| match *h {
+            Handle::Point { object, point } => Gesture {
+                object,
+                target: if weight {
+                    EditTarget::Weight(point)
+                } else {
+                    EditTarget::Point(point)
+                },
+            },
+            Handle::LocalPoint { object, local, .. } => Gesture {
+                object,
+                target: EditTarget::Local(local),
+            },
+        };
+        match self {
+            Mode::Drag { handle, .. } => Some(point(handle, false)),
+            Mode::Weight { handle, .. } => Some(point(handle, true)),
+            Mode::Transform { target, .. } => Some(match target {
+                Target::Point(h) => point(h, false),
+                Target::Local(object, path) => Gesture {
+                    object: *object,
+                    target: EditTarget::Local(*path),
+                },
+            }),
+            _ => None,
+        }
     }
 
     /// Whether the osculating circle follows the cursor in this mode.

@@ -241,6 +241,17 @@ impl Session {
     }
 
     /// Re-samples and uploads edited objects in full on every edit (`bench --naive`).
+    /// How gestures redraw (`--redraw`).
+    pub fn set_redraw(&mut self, redraw: crate::render::Redraw) {
+        self.gpu.set_redraw(redraw);
+    }
+
+    /// Test hook: the retained redraw's dynamic set misses one chunk (a negative control).
+    #[doc(hidden)]
+    pub fn set_drop_chunk(&mut self, drop: bool) {
+        self.gpu.set_drop_chunk(drop);
+    }
+
     pub fn set_naive(&mut self, naive: bool) {
         self.stage.editor.naive = naive;
     }
@@ -366,8 +377,15 @@ impl Session {
             s.size,
             frame.samples(),
         );
+        self.gpu.set_gesture(self.mode.gesture());
         let report = self.gpu.draw(frame, s.doc(), &self.options, &hl, &lod)?;
-        self.hud.triangles = (report.triangles, report.full_triangles);
+        if report.retained {
+            self.hud.triangles = (report.retained_of, report.full_triangles);
+            self.hud.retained = Some((report.triangles, report.retained_of));
+        } else {
+            self.hud.triangles = (report.triangles, report.full_triangles);
+            self.hud.retained = None;
+        }
         let mut lines = overlay_lines(s.doc(), &self.options, s.bounds.radius());
         lines.extend(self.mode.preview(s));
         let font = frame.font();

@@ -25,4 +25,5 @@ mod splines;
 mod structural_cli;
 mod structural_edits;
 mod structural_shape;
+mod support;
 mod undo_chains;

@@ -253,3 +253,38 @@ fn find_key<'a>(v: &'a serde_json::Value, key: &str) -> Option<&'a serde_json::V
         _ => None,
     }
 }
+
+/// `--redraw` is recorded in the summary (default `retained`), and a bad value is one line.
+#[test]
+fn bench_records_the_redraw_mode() {
+    let scratch = common::Scratch::new("cli-bench-redraw");
+    for (flag, expect) in [(None, "retained"), (Some("full"), "full")] {
+        let out = scratch.join(expect);
+        let mut c = prespline();
+        c.args([
+            "bench", "--frames", "3", "--warmup", "4", "--size", "200x120",
+        ]);
+        if let Some(f) = flag {
+            c.args(["--redraw", f]);
+        }
+        let r = c.arg("--out").arg(&out).output().unwrap();
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert!(r.status.success(), "{err}");
+        assert!(err.contains(&format!("redraw {expect}")), "banner: {err}");
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        let text = summary.to_string();
+        assert!(
+            text.contains(&format!("\"redraw\":\"{expect}\"")),
+            "summary.json lacks the mode: {text}"
+        );
+    }
+    let r = prespline()
+        .args(["bench", "--redraw", "partial"])
+        .output()
+        .unwrap();
+    assert!(!r.status.success());
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(err.contains("--redraw takes retained or full"), "{err}");
+}

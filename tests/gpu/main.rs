@@ -17,3 +17,4 @@ mod render_analysis;
 mod render_golden;
 mod render_lod;
 mod render_mirror;
+mod retained;

@@ -33,6 +33,10 @@ pub trait ChainModel: Clone + std::fmt::Debug {
 pub trait ChainEdit: KindEdit<Model: ChainModel> {
     /// Indices of the chain points this edit may change, computed before it is applied.
     fn chain_points(&self, model: &Self::Model) -> Vec<usize>;
+
+    /// Indices of the chain points a move of handle `handle` may change, known before any move
+    /// (what a drag of it reaches); none for a handle the model does not have.
+    fn handle_points(model: &Self::Model, handle: usize) -> Vec<usize>;
 }
 
 fn geom_error(e: GeomError) -> EditError {
@@ -142,6 +146,14 @@ impl ChainEdit for CatmullRomEdit {
     fn chain_points(&self, m: &CatmullRomModel) -> Vec<usize> {
         let CatmullRomEdit::Point(p) = self;
         m.spline.bezier_points_of(p.point())
+    }
+
+    fn handle_points(m: &CatmullRomModel, handle: usize) -> Vec<usize> {
+        if handle < m.spline.points().len() {
+            m.spline.bezier_points_of(handle)
+        } else {
+            Vec::new()
+        }
     }
 }
 
@@ -280,6 +292,15 @@ impl ChainEdit for BezierSplineEdit {
                 .unwrap_or_default(),
             BezierSplineEdit::Set { values, .. } => values.iter().map(|&(i, _)| i).collect(),
         }
+    }
+
+    /// The points a move carries depend on the continuity and the handle, not on the move.
+    fn handle_points(m: &BezierSplineModel, handle: usize) -> Vec<usize> {
+        BezierSplineEdit::Move {
+            point: handle,
+            delta: DVec3::ONE,
+        }
+        .chain_points(m)
     }
 }
 

@@ -2,8 +2,8 @@
 //! multiplicity d at the junctions) in a [`SplineCurveSampler`], fed one control point at a time.
 
 use crate::model::spline::curve_sampler::SplineCurveSampler;
-use crate::model::{ChainEdit, ChainModel, CurveEdit, PointEdit};
-use crate::sampling::dirty::DirtyRegion;
+use crate::model::{ChainEdit, ChainModel, CurveEdit, Index2, PointEdit, Target};
+use crate::sampling::dirty::{DirtyRegion, DirtySet};
 use crate::sampling::grid::SampleGrid;
 use crate::sampling::object::Sampler;
 
@@ -63,5 +63,23 @@ impl<E: ChainEdit> Sampler for ChainCurveSampler<E> {
 
     fn full(&mut self) -> DirtyRegion {
         self.chain.full()
+    }
+
+    /// The segments around every chain point a move of the handle reaches, as disjoint runs
+    /// (a closed Catmull–Rom spline's first point reaches both ends).
+    fn support(&self, target: Target) -> Vec<DirtyRegion> {
+        let Target::Point(Index2::One(handle)) = target else {
+            return vec![DirtyRegion::whole(self.grid().dims)];
+        };
+        let mut runs = DirtySet::default();
+        for point in E::handle_points(&self.model, handle) {
+            for r in self.chain.support(Target::Point(Index2::One(point))) {
+                runs.insert(r.rows);
+            }
+        }
+        runs.ranges()
+            .iter()
+            .map(|r| DirtyRegion::curve(r.clone()))
+            .collect()
     }
 }

@@ -6,7 +6,7 @@
 
 use crate::geom::erbs::{ErbsCurve, LocalCurve};
 use crate::geom::knots::uniform_params;
-use crate::model::{ErbsCurveEdit, ErbsCurveModel, ErbsEdit, KindEdit, LocalEdit};
+use crate::model::{ErbsCurveEdit, ErbsCurveModel, ErbsEdit, KindEdit, LocalEdit, Target};
 use crate::sampling::dirty::DirtyRegion;
 use crate::sampling::grid::{PartialSet, SampleGrid};
 use crate::sampling::object::Sampler;
@@ -246,6 +246,24 @@ impl CurveLevel {
         }
     }
 
+    /// The level samples the local at `path` covers, piece by piece (a local whose path goes
+    /// on below a polynomial local: that local's).
+    fn support(&self, path: &[usize]) -> Vec<Range<usize>> {
+        let Some((&l, rest)) = path.split_first() else {
+            return Vec::new();
+        };
+        let Some(local) = self.locals.get(l) else {
+            return Vec::new();
+        };
+        let own = match (rest.is_empty(), local) {
+            (false, LocalLevel::Erbs(child)) => child.support(rest),
+            _ => std::iter::once(0..self.axis.local_len(l)).collect(),
+        };
+        own.iter()
+            .flat_map(|r| self.axis.pieces(l).iter().filter_map(|p| p.level_range(r)))
+            .collect()
+    }
+
     /// After [`ErbsCurve::insert_knot`] inside interval i of this level's curve: the two
     /// restricted locals and the new one are pre-evaluated, the others keep theirs, and the
     /// samples strictly inside the interval are blended again — the only ones that change.
@@ -390,6 +408,22 @@ impl Sampler for ErbsCurveSampler {
     fn full(&mut self) -> DirtyRegion {
         self.level = Self::level(&self.model, self.level.order);
         DirtyRegion::curve(0..self.level.axis.len())
+    }
+
+    fn support(&self, target: Target) -> Vec<DirtyRegion> {
+        let path = match target {
+            Target::Local(path) => path.to_curve(),
+            _ => None,
+        };
+        match path {
+            Some(p) => self
+                .level
+                .support(p.steps())
+                .into_iter()
+                .map(DirtyRegion::curve)
+                .collect(),
+            None => vec![DirtyRegion::whole(self.level.grid.dims)],
+        }
     }
 }
 

@@ -9,7 +9,9 @@
 use crate::geom::erbs::{ErbsKnots, ErbsSurface, LocalPatch};
 use crate::geom::knots::uniform_params;
 use crate::geom::point::binomial;
-use crate::model::{ErbsEdit, ErbsSurfaceEdit, ErbsSurfaceModel, KindEdit, LocalEdit};
+use crate::model::{
+    ErbsEdit, ErbsSurfaceEdit, ErbsSurfaceModel, KindEdit, LocalEdit, Target as EditTarget,
+};
 use crate::sampling::dirty::DirtyRegion;
 use crate::sampling::fallback::{NormalSource, resolve_degenerate};
 use crate::sampling::grid::{PartialSet, SampleGrid};
@@ -455,6 +457,39 @@ impl SurfaceLevel {
             p.transform(a, delta);
         }
         transform_samples(&mut self.grid.data, a, stride, delta);
+    }
+
+    /// The level samples the patch at `path` covers, rectangle by rectangle (a path going on
+    /// below a polynomial patch: that patch's).
+    fn support(&self, path: &[[usize; 2]]) -> Vec<[Range<usize>; 2]> {
+        let Some((&[k, l], rest)) = path.split_first() else {
+            return Vec::new();
+        };
+        let Some(patch) = self
+            .patches
+            .get(k * self.nv() + l)
+            .filter(|_| l < self.nv())
+        else {
+            return Vec::new();
+        };
+        let own = match (rest.is_empty(), patch) {
+            (false, PatchLevel::Erbs(child)) => child.support(rest),
+            _ => vec![[0..self.axes[0].local_len(k), 0..self.axes[1].local_len(l)]],
+        };
+        let mut out = Vec::new();
+        for [ru, rv] in &own {
+            for pu in self.axes[0].pieces(k) {
+                let Some(rows) = pu.level_range(ru) else {
+                    continue;
+                };
+                for pv in self.axes[1].pieces(l) {
+                    if let Some(cols) = pv.level_range(rv) {
+                        out.push([rows.clone(), cols]);
+                    }
+                }
+            }
+        }
+        out
     }
 
     /// Applies `op` to the patch at `path` and returns this level's change.
@@ -960,6 +995,22 @@ impl Sampler for ErbsSurfaceSampler {
                 self.level = Self::tabulated(&self.model, set, normals);
                 self.sample_all()
             }
+        }
+    }
+
+    fn support(&self, target: EditTarget) -> Vec<DirtyRegion> {
+        let path = match target {
+            EditTarget::Local(path) => path.to_surface(),
+            _ => None,
+        };
+        match path {
+            Some(p) => self
+                .level
+                .support(p.steps())
+                .into_iter()
+                .map(|[rows, cols]| DirtyRegion::surface(rows, cols))
+                .collect(),
+            None => vec![DirtyRegion::whole(self.level.grid.dims)],
         }
     }
 }

@@ -2,7 +2,7 @@
 
 use crate::geom::BSplineCurve;
 use crate::geom::point::to_homogeneous;
-use crate::model::{CurveEdit, CurveModel, KindEdit, PointNet};
+use crate::model::{CurveEdit, CurveModel, Index2, KindEdit, PointNet, Target};
 use crate::sampling::dirty::DirtyRegion;
 use crate::sampling::grid::{PartialSet, SampleGrid};
 use crate::sampling::kernels::shading;
@@ -203,6 +203,16 @@ impl Sampler for SplineCurveSampler {
             .is_rational()
             .then(|| vec![DVec4::ZERO; self.grid.data.len()]);
         self.rebuild_range(0..self.table.len())
+    }
+
+    fn support(&self, target: Target) -> Vec<DirtyRegion> {
+        let range = match target {
+            Target::Point(Index2::One(k)) | Target::Weight(Index2::One(k)) => {
+                self.table.range_of(k)
+            }
+            _ => None,
+        };
+        vec![range.map_or_else(|| DirtyRegion::whole(self.grid.dims), DirtyRegion::curve)]
     }
 }
 

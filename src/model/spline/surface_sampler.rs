@@ -2,7 +2,7 @@
 
 use super::curve_sampler::PointState;
 use crate::geom::TensorSurface;
-use crate::model::{KindEdit, SurfaceEdit, SurfaceModel};
+use crate::model::{Index2, KindEdit, SurfaceEdit, SurfaceModel, Target};
 use crate::sampling::dirty::DirtyRegion;
 use crate::sampling::fallback::{NormalSource, resolve_degenerate};
 use crate::sampling::grid::{PartialSet, SampleGrid};
@@ -294,6 +294,19 @@ impl Sampler for SplineSurfaceSampler {
             .then(|| vec![DVec4::ZERO; self.grid.data.len()]);
         let [mu, mv] = self.grid.dims;
         self.rebuild_rect(0..mu, 0..mv)
+    }
+
+    fn support(&self, target: Target) -> Vec<DirtyRegion> {
+        let rect = match target {
+            Target::Point(Index2::Two(k, l)) | Target::Weight(Index2::Two(k, l)) => {
+                self.tables[0].range_of(k).zip(self.tables[1].range_of(l))
+            }
+            _ => None,
+        };
+        vec![rect.map_or_else(
+            || DirtyRegion::whole(self.grid.dims),
+            |(rows, cols)| DirtyRegion::surface(rows, cols),
+        )]
     }
 }
 

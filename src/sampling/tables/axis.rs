@@ -232,6 +232,12 @@ impl HermiteTable {
     pub fn range(&self, k: usize) -> Range<usize> {
         self.ranges[k].clone()
     }
+
+    /// The samples control point k influences, `None` for an index past the control points.
+    #[must_use]
+    pub fn range_of(&self, k: usize) -> Option<Range<usize>> {
+        self.ranges.get(k).cloned()
+    }
 }
 
 /// I_k for every control point k: spans are non-decreasing in the sample index, so

@@ -1,0 +1,335 @@
+//! The retained static layer of a target: one colour and one depth image of the target's size
+//! that a frame can save its attachments into mid-frame and a later frame can start from,
+//! instead of clearing ([`Frame::save_static_layer`], [`Frame::restore_static_layer`]).
+//!
+//! Only single-sampled targets have one: a multisampled depth buffer cannot be resolved into a
+//! layer that restores bit for bit, and lavapipe, where redrawing costs most, renders MSAA 1.
+//!
+//! Synchronization: the layer images stay in `TRANSFER_SRC_OPTIMAL` between uses. A save
+//! discards them (`UNDEFINED` → `TRANSFER_DST_OPTIMAL`, after the reads of earlier restores),
+//! copies and returns them to `TRANSFER_SRC_OPTIMAL` with its writes made visible to later
+//! copies; a restore reads them there. The target's attachments go to the transfer layouts
+//! and back around each copy.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use ash::vk;
+
+use super::barrier::{self, image_barrier};
+use super::device::Device;
+use super::error::{GpuError, GpuResult};
+use super::frame::{Frame, FrameTarget};
+use super::image::{Image, ImageDesc};
+use super::pipeline::DEPTH_FORMAT;
+
+/// Distinct for every save of every layer in the process, so a stale token never matches.
+static NEXT_TOKEN: AtomicU64 = AtomicU64::new(1);
+
+/// A target's static layer: its images and which save they hold.
+pub(crate) struct StaticLayer {
+    pub color: Image,
+    pub depth: Image,
+    /// The token of the save the images hold (`None`: never saved).
+    pub saved: Option<u64>,
+}
+
+impl StaticLayer {
+    pub(crate) fn new(
+        device: &Device,
+        extent: vk::Extent2D,
+        format: vk::Format,
+    ) -> GpuResult<Self> {
+        // Only copied, but every image gets a view, which needs an attachment usage.
+        let copies = vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST;
+        let desc = |name, format, usage| ImageDesc {
+            name,
+            extent,
+            format,
+            samples: vk::SampleCountFlags::TYPE_1,
+            usage: copies | usage,
+        };
+        let color = Image::new(
+            device,
+            &desc(
+                "static layer colour",
+                format,
+                vk::ImageUsageFlags::COLOR_ATTACHMENT,
+            ),
+        )?;
+        let depth = desc(
+            "static layer depth",
+            DEPTH_FORMAT,
+            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+        );
+        match Image::new(device, &depth) {
+            Ok(depth) => Ok(Self {
+                color,
+                depth,
+                saved: None,
+            }),
+            Err(e) => {
+                // SAFETY: created just above and never used by the GPU.
+                unsafe { color.destroy(device) };
+                Err(e)
+            }
+        }
+    }
+
+    /// # Safety
+    /// No submitted GPU work that uses the images may still be pending.
+    pub(crate) unsafe fn destroy(self, device: &Device) {
+        // SAFETY: the caller's guarantee.
+        unsafe {
+            self.color.destroy(device);
+            self.depth.destroy(device);
+        }
+    }
+}
+
+use vk::AccessFlags2 as A;
+use vk::ImageLayout as L;
+use vk::PipelineStageFlags2 as S;
+
+const DEPTH_STAGES: S =
+    S::from_raw(S::EARLY_FRAGMENT_TESTS.as_raw() | S::LATE_FRAGMENT_TESTS.as_raw());
+const DEPTH_ACCESS: A = A::from_raw(
+    A::DEPTH_STENCIL_ATTACHMENT_READ.as_raw() | A::DEPTH_STENCIL_ATTACHMENT_WRITE.as_raw(),
+);
+const COLOR_ACCESS: A =
+    A::from_raw(A::COLOR_ATTACHMENT_READ.as_raw() | A::COLOR_ATTACHMENT_WRITE.as_raw());
+
+/// Copy of a whole single-level image of `extent`.
+fn whole_copy(aspect: vk::ImageAspectFlags, extent: vk::Extent2D) -> vk::ImageCopy {
+    let layers = vk::ImageSubresourceLayers {
+        aspect_mask: aspect,
+        mip_level: 0,
+        base_array_layer: 0,
+        layer_count: 1,
+    };
+    vk::ImageCopy {
+        src_subresource: layers,
+        src_offset: vk::Offset3D::default(),
+        dst_subresource: layers,
+        dst_offset: vk::Offset3D::default(),
+        extent: vk::Extent3D {
+            width: extent.width,
+            height: extent.height,
+            depth: 1,
+        },
+    }
+}
+
+impl Frame<'_> {
+    /// The layer of this frame's target (`None` for multisampled targets and swapchains whose
+    /// images cannot be copied).
+    fn layer(&mut self) -> Option<&mut StaticLayer> {
+        match &mut self.target {
+            FrameTarget::Offscreen(t) => t.attachments.layer.as_mut(),
+            FrameTarget::Swapchain { swapchain, .. } => swapchain.layer_mut(),
+        }
+    }
+
+    /// Whether this frame's target has a static layer.
+    pub fn has_static_layer(&mut self) -> bool {
+        self.layer().is_some()
+    }
+
+    /// Announces a [`Frame::save_static_layer`] before the frame's first draw, so rendering
+    /// stores its depth (other frames let the driver discard it).
+    pub fn keep_depth(&mut self) {
+        if !self.rendering {
+            self.keep_depth = true;
+        }
+    }
+
+    /// Saves what was drawn so far (colour and depth) into the target's static layer and goes
+    /// on drawing over it. Returns the save's token for [`Frame::restore_static_layer`];
+    /// `None` when the target has no layer, or rendering began without
+    /// [`Frame::keep_depth`] (nothing is recorded then).
+    pub fn save_static_layer(&mut self) -> GpuResult<Option<u64>> {
+        let (view, cmd) = (self.view, self.cmd);
+        if !self.keep_depth {
+            return Ok(None);
+        }
+        let Some(layer) = self.layer() else {
+            return Ok(None);
+        };
+        let (lc, ld) = (layer.color.raw, layer.depth.raw);
+        // The clear and the draws so far must land in the attachments first.
+        self.ensure_rendering();
+        let raw = &self.ctx.device.raw;
+        // SAFETY: `cmd` is recording inside the rendering scope begun above.
+        unsafe { raw.cmd_end_rendering(cmd) };
+        self.rendering = false;
+        let to_src = [
+            image_barrier(
+                view.image,
+                view.format,
+                (S::COLOR_ATTACHMENT_OUTPUT, A::COLOR_ATTACHMENT_WRITE),
+                (S::COPY, A::TRANSFER_READ),
+                (L::COLOR_ATTACHMENT_OPTIMAL, L::TRANSFER_SRC_OPTIMAL),
+            ),
+            image_barrier(
+                view.depth.0,
+                DEPTH_FORMAT,
+                (DEPTH_STAGES, A::DEPTH_STENCIL_ATTACHMENT_WRITE),
+                (S::COPY, A::TRANSFER_READ),
+                (L::DEPTH_STENCIL_ATTACHMENT_OPTIMAL, L::TRANSFER_SRC_OPTIMAL),
+            ),
+            // Earlier restores read the layer: they finish before it is overwritten.
+            image_barrier(
+                lc,
+                view.format,
+                (S::COPY, A::NONE),
+                (S::COPY, A::TRANSFER_WRITE),
+                (L::UNDEFINED, L::TRANSFER_DST_OPTIMAL),
+            ),
+            image_barrier(
+                ld,
+                DEPTH_FORMAT,
+                (S::COPY, A::NONE),
+                (S::COPY, A::TRANSFER_WRITE),
+                (L::UNDEFINED, L::TRANSFER_DST_OPTIMAL),
+            ),
+        ];
+        let back = [
+            image_barrier(
+                view.image,
+                view.format,
+                (S::COPY, A::NONE),
+                (S::COLOR_ATTACHMENT_OUTPUT, COLOR_ACCESS),
+                (L::TRANSFER_SRC_OPTIMAL, L::COLOR_ATTACHMENT_OPTIMAL),
+            ),
+            image_barrier(
+                view.depth.0,
+                DEPTH_FORMAT,
+                (S::COPY, A::NONE),
+                (DEPTH_STAGES, DEPTH_ACCESS),
+                (L::TRANSFER_SRC_OPTIMAL, L::DEPTH_STENCIL_ATTACHMENT_OPTIMAL),
+            ),
+            image_barrier(
+                lc,
+                view.format,
+                (S::COPY, A::TRANSFER_WRITE),
+                (S::COPY, A::TRANSFER_READ),
+                (L::TRANSFER_DST_OPTIMAL, L::TRANSFER_SRC_OPTIMAL),
+            ),
+            image_barrier(
+                ld,
+                DEPTH_FORMAT,
+                (S::COPY, A::TRANSFER_WRITE),
+                (S::COPY, A::TRANSFER_READ),
+                (L::TRANSFER_DST_OPTIMAL, L::TRANSFER_SRC_OPTIMAL),
+            ),
+        ];
+        let color_copy = [whole_copy(vk::ImageAspectFlags::COLOR, view.extent)];
+        let depth_copy = [whole_copy(vk::ImageAspectFlags::DEPTH, view.extent)];
+        // SAFETY: recording outside a rendering scope; the target's attachments and the layer
+        // (same size and formats, TRANSFER usages) are live for this frame; the barriers put
+        // every image in the layout its copy names.
+        unsafe {
+            barrier::record(raw, cmd, &to_src);
+            raw.cmd_copy_image(
+                cmd,
+                view.image,
+                L::TRANSFER_SRC_OPTIMAL,
+                lc,
+                L::TRANSFER_DST_OPTIMAL,
+                &color_copy,
+            );
+            raw.cmd_copy_image(
+                cmd,
+                view.depth.0,
+                L::TRANSFER_SRC_OPTIMAL,
+                ld,
+                L::TRANSFER_DST_OPTIMAL,
+                &depth_copy,
+            );
+            barrier::record(raw, cmd, &back);
+        }
+        self.load = true;
+        self.bound = Default::default();
+        let token = NEXT_TOKEN.fetch_add(1, Ordering::Relaxed);
+        if let Some(layer) = self.layer() {
+            layer.saved = Some(token);
+        }
+        Ok(Some(token))
+    }
+
+    /// Starts the frame from the static layer saved with `token` instead of clearing: one
+    /// `vkCmdCopyImage` each of colour and depth. Returns `false`, recording nothing, when the
+    /// layer holds another save (or none, or the target has no layer): draw the whole frame
+    /// then. Must come before the frame's first draw.
+    pub fn restore_static_layer(&mut self, token: u64) -> GpuResult<bool> {
+        if self.rendering {
+            return Err(GpuError::InvalidArgument(
+                "restore_static_layer after the frame began drawing".into(),
+            ));
+        }
+        let (view, cmd) = (self.view, self.cmd);
+        let Some(layer) = self.layer().filter(|l| l.saved == Some(token)) else {
+            return Ok(false);
+        };
+        let (lc, ld) = (layer.color.raw, layer.depth.raw);
+        let to_dst = [
+            image_barrier(
+                view.image,
+                view.format,
+                (S::COLOR_ATTACHMENT_OUTPUT, A::NONE),
+                (S::COPY, A::TRANSFER_WRITE),
+                (L::COLOR_ATTACHMENT_OPTIMAL, L::TRANSFER_DST_OPTIMAL),
+            ),
+            image_barrier(
+                view.depth.0,
+                DEPTH_FORMAT,
+                (DEPTH_STAGES, A::NONE),
+                (S::COPY, A::TRANSFER_WRITE),
+                (L::DEPTH_STENCIL_ATTACHMENT_OPTIMAL, L::TRANSFER_DST_OPTIMAL),
+            ),
+        ];
+        let back = [
+            image_barrier(
+                view.image,
+                view.format,
+                (S::COPY, A::TRANSFER_WRITE),
+                (S::COLOR_ATTACHMENT_OUTPUT, COLOR_ACCESS),
+                (L::TRANSFER_DST_OPTIMAL, L::COLOR_ATTACHMENT_OPTIMAL),
+            ),
+            image_barrier(
+                view.depth.0,
+                DEPTH_FORMAT,
+                (S::COPY, A::TRANSFER_WRITE),
+                (DEPTH_STAGES, DEPTH_ACCESS),
+                (L::TRANSFER_DST_OPTIMAL, L::DEPTH_STENCIL_ATTACHMENT_OPTIMAL),
+            ),
+        ];
+        let color_copy = [whole_copy(vk::ImageAspectFlags::COLOR, view.extent)];
+        let depth_copy = [whole_copy(vk::ImageAspectFlags::DEPTH, view.extent)];
+        let raw = &self.ctx.device.raw;
+        // SAFETY: recording outside a rendering scope (checked above); the layer holds a save
+        // of this target (same size and formats) in TRANSFER_SRC_OPTIMAL, made visible to
+        // copies by the save's closing barrier; the attachments were made attachments at begin.
+        unsafe {
+            barrier::record(raw, cmd, &to_dst);
+            raw.cmd_copy_image(
+                cmd,
+                lc,
+                L::TRANSFER_SRC_OPTIMAL,
+                view.image,
+                L::TRANSFER_DST_OPTIMAL,
+                &color_copy,
+            );
+            raw.cmd_copy_image(
+                cmd,
+                ld,
+                L::TRANSFER_SRC_OPTIMAL,
+                view.depth.0,
+                L::TRANSFER_DST_OPTIMAL,
+                &depth_copy,
+            );
+            barrier::record(raw, cmd, &back);
+        }
+        self.load = true;
+        Ok(true)
+    }
+}

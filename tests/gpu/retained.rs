@@ -1,0 +1,426 @@
+//! Retained redraw (`--redraw retained`) against the full redraw, bit for bit at MSAA 1, on
+//! lavapipe with validation and synchronization validation: two viewer sessions of the same
+//! scene take the same input frame by frame, one drawing from its static layer, one in full,
+//! and every frame of the first must equal the second's exactly. Random scenes (Bézier,
+//! B-spline and rational surfaces and curves, an exact twin of a surface to force depth ties,
+//! Catmull–Rom and Bézier splines, ERBS surfaces with locals nested to depth 2) and random
+//! gestures (point drags, weight drags, G/R/S of ERBS locals), with maps on and off; orbit,
+//! resize, toggles and undo during and after gestures. A negative control drops one chunk
+//! from the dynamic set and must be caught.
+
+use crate::common::{self, Rng, compare_images};
+use prespline::editor::Handle;
+use prespline::gpu::{OffscreenDesc, OffscreenTarget, Pixels, Renderer, ValidationSink};
+use prespline::render::Redraw;
+use prespline::render::maps::SurfaceMap;
+use prespline::sampling::budget::MemoryBudget;
+use prespline::scene::{Scene, parse_scene};
+use prespline::view::Session;
+use prespline::view::input::{InputEvent, Key, Modifiers, MouseButton};
+use prespline::view::script::Action;
+
+const SIZE: [u32; 2] = [320, 240];
+
+struct Run {
+    session: Session,
+    target: OffscreenTarget,
+}
+
+/// The same session twice: `[retained, full]`.
+struct Pair {
+    renderer: Renderer,
+    sink: ValidationSink,
+    runs: Vec<Run>,
+    /// Frames the retained run drew from its static layer.
+    retained_frames: usize,
+    frames: usize,
+}
+
+impl Pair {
+    fn new(scene: &Scene, map: Option<SurfaceMap>) -> Self {
+        let (mut renderer, sink) = common::renderer();
+        let mut runs = Vec::new();
+        for redraw in [Redraw::Retained, Redraw::Full] {
+            let target = renderer
+                .create_offscreen(&OffscreenDesc {
+                    width: SIZE[0],
+                    height: SIZE[1],
+                    samples: 1,
+                })
+                .unwrap();
+            let mut session = Session::open(
+                &mut renderer,
+                scene,
+                std::env::temp_dir().join("prespline-retained-test.json"),
+                SIZE,
+                MemoryBudget::machine_default(),
+            )
+            .unwrap();
+            session.set_redraw(redraw);
+            session.set_map(map);
+            runs.push(Run { session, target });
+        }
+        Pair {
+            renderer,
+            sink,
+            runs,
+            retained_frames: 0,
+            frames: 0,
+        }
+    }
+
+    /// One frame of both sessions after `actions`; their images.
+    fn frame(&mut self, actions: &[Action]) -> [Pixels; 2] {
+        let mut images = Vec::new();
+        for run in &mut self.runs {
+            for a in actions {
+                run.session.perform(a.clone());
+            }
+            run.session.apply_pending();
+            let mut frame = self.renderer.begin_offscreen(&mut run.target).unwrap();
+            run.session.upload(&mut frame).unwrap();
+            run.session.record(&mut frame, false).unwrap();
+            frame.capture();
+            frame.finish().unwrap();
+            images.push(self.renderer.read_pixels(&run.target).unwrap());
+        }
+        self.frames += 1;
+        if self.runs[0].session.hud.retained.is_some() {
+            self.retained_frames += 1;
+        }
+        assert!(
+            self.runs[1].session.hud.retained.is_none(),
+            "--redraw full drew from a layer"
+        );
+        let full = images.pop().unwrap();
+        [images.pop().unwrap(), full]
+    }
+
+    /// Frames until the first that differs (its number and how), or `None`.
+    fn first_difference(&mut self, script: &[Vec<Action>]) -> Option<String> {
+        for (k, actions) in script.iter().enumerate() {
+            let [retained, full] = self.frame(actions);
+            let diff = compare_images(&full, &retained, 0).unwrap();
+            if diff.differing > 0 {
+                return Some(format!(
+                    "frame {k}: {} pixels differ (worst {})",
+                    diff.differing, diff.worst
+                ));
+            }
+        }
+        None
+    }
+
+    fn resize(&mut self, w: u32, h: u32) {
+        for run in &mut self.runs {
+            let t = self
+                .renderer
+                .create_offscreen(&OffscreenDesc {
+                    width: w,
+                    height: h,
+                    samples: 1,
+                })
+                .unwrap();
+            let old = std::mem::replace(&mut run.target, t);
+            self.renderer.destroy_offscreen(old).unwrap();
+            run.session.resize(w, h);
+        }
+    }
+
+    fn finish(self) {
+        let Pair {
+            mut renderer,
+            sink,
+            runs,
+            ..
+        } = self;
+        for run in runs {
+            run.session.destroy(&mut renderer);
+            renderer.destroy_offscreen(run.target).unwrap();
+        }
+        common::teardown(renderer, sink);
+    }
+}
+
+fn button(pressed: bool) -> Action {
+    Action::Input(InputEvent::Button {
+        button: MouseButton::Left,
+        pressed,
+    })
+}
+
+fn mods(alt: bool) -> Action {
+    Action::Input(InputEvent::Modifiers(Modifiers {
+        ctrl: false,
+        shift: false,
+        alt,
+    }))
+}
+
+fn key(c: char) -> Action {
+    Action::Key {
+        key: Key::Char(c),
+        mods: Modifiers::default(),
+    }
+}
+
+fn ctrl(c: char) -> Action {
+    Action::Key {
+        key: Key::Char(c),
+        mods: Modifiers {
+            ctrl: true,
+            shift: false,
+            alt: false,
+        },
+    }
+}
+
+/// A drag of `handle` along a random path (`alt`: its weight).
+fn drag(rng: &mut Rng, handle: Handle, alt: bool, frames: usize) -> Vec<Vec<Action>> {
+    let mut s = vec![vec![mods(alt), Action::MoveTo(handle)], vec![button(true)]];
+    for _ in 0..frames {
+        let d = |rng: &mut Rng| f64::from(rng.f32(-12.0, 12.0));
+        s.push(vec![Action::MoveBy(d(rng), d(rng))]);
+    }
+    s.push(vec![button(false), mods(false)]);
+    s
+}
+
+/// Selects `handle` (its ERBS local too) and grabs, rotates or scales that local with the
+/// cursor, then confirms.
+fn transform(rng: &mut Rng, handle: Handle, frames: usize) -> Vec<Vec<Action>> {
+    let kind = ['g', 'r', 's'][rng.range(0, 3)];
+    let mut s = vec![
+        vec![Action::MoveTo(handle)],
+        vec![button(true), button(false)],
+        vec![Action::MoveBy(25.0, 5.0)],
+        vec![key(kind)],
+    ];
+    for _ in 0..frames {
+        s.push(vec![Action::MoveBy(
+            f64::from(rng.f32(-8.0, 8.0)),
+            f64::from(rng.f32(-8.0, 8.0)),
+        )]);
+    }
+    s.push(vec![Action::Key {
+        key: Key::Enter,
+        mods: Modifiers::default(),
+    }]);
+    s
+}
+
+fn points_json(rng: &mut Rng, nu: usize, nv: usize, x0: f64) -> String {
+    let rows: Vec<String> = (0..nu)
+        .map(|i| {
+            let row: Vec<String> = (0..nv)
+                .map(|j| {
+                    format!(
+                        "[{}, {}, {}]",
+                        x0 + i as f64,
+                        j as f64 - 1.5,
+                        rng.f32(-0.8, 0.8)
+                    )
+                })
+                .collect();
+            format!("[{}]", row.join(", "))
+        })
+        .collect();
+    format!("[{}]", rows.join(", "))
+}
+
+/// Bézier, B-spline and rational surfaces (the first with an exact twin drawn after it, so
+/// depth ties decide pixels), curves of each kind, a Catmull–Rom and a Bézier spline.
+fn random_scene(rng: &mut Rng) -> Scene {
+    let bez = points_json(rng, 4, 4, -4.0);
+    let bsp = points_json(rng, 5, 4, -0.5);
+    let nurbs = points_json(rng, 4, 5, 3.0);
+    let weights: Vec<String> = (0..4)
+        .map(|_| {
+            let w: Vec<String> = (0..5).map(|_| format!("{}", rng.f32(0.5, 2.0))).collect();
+            format!("[{}]", w.join(", "))
+        })
+        .collect();
+    let text = format!(
+        r#"{{"objects": [
+  {{"name": "bez", "type": "bezier_surface", "points": {bez}, "samples": [70, 66]}},
+  {{"name": "twin", "type": "bezier_surface", "points": {bez}, "samples": [70, 66]}},
+  {{"name": "bsp", "type": "bspline_surface", "degree": [2, 3],
+    "knots": [[0, 0, 0, 1, 2, 3, 3, 3], [0, 0, 0, 0, 1, 1, 1, 1]], "points": {bsp}, "samples": [80, 40]}},
+  {{"name": "nurbs", "type": "bspline_surface", "degree": [3, 2],
+    "knots": [[0, 0, 0, 0, 1, 1, 1, 1], [0, 0, 0, 1, 2, 3, 3, 3]], "points": {nurbs},
+    "weights": [{w}], "samples": [50, 90]}},
+  {{"name": "curve", "type": "bspline_curve", "degree": 3, "knots": [0, 0, 0, 0, 1, 2, 2, 2, 2],
+    "points": [[-4, -3, {a}], [-2, -2, 1], [0, -3, {b}], [2, -2, 0], [4, -3, 0.5]],
+    "weights": [1, 2, 0.7, 1, 1], "samples": 200}},
+  {{"name": "bcurve", "type": "bezier_curve", "points": [[-4, 3, 0], [0, {c}, 1], [4, 3, 0]], "samples": 100}},
+  {{"name": "cr", "type": "catmull_rom", "points": [[-4, 4, 0], [-2, 5, {a}], [0, 4, 0], [2, 5, 1], [4, 4, 0]], "samples": 120}},
+  {{"name": "bs", "type": "bezier_spline", "degree": 3, "knots": [0, 1, 2], "continuity": "C0",
+    "points": [[-4, -5, 0], [-3, -4, 1], [-2, -5, 0], [-1, -4, {b}], [0, -5, 0], [1, -4, 0], [2, -5, 0]], "samples": 120}}
+]}}"#,
+        w = weights.join(", "),
+        a = rng.f32(-1.0, 1.0),
+        b = rng.f32(-1.0, 1.0),
+        c = rng.f32(1.0, 5.0),
+    );
+    parse_scene(&text).unwrap()
+}
+
+fn erbs_scene() -> Scene {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/erbs_surface.json"
+    ))
+    .unwrap();
+    parse_scene(&text).unwrap()
+}
+
+/// A random handle of `object` in the retained run's document.
+fn handle_of(pair: &Pair, rng: &mut Rng, object: usize) -> Handle {
+    let handles = pair.runs[0].session.doc().handles(object);
+    handles[rng.range(0, handles.len())].0
+}
+
+fn check(pair: &mut Pair, script: &[Vec<Action>], what: &str) {
+    if let Some(d) = pair.first_difference(script) {
+        panic!("{what}: retained differs from full at {d}");
+    }
+}
+
+#[test]
+fn retained_frames_equal_full_redraws_over_random_scenes_and_gestures() {
+    for seed in 0..3u64 {
+        let mut rng = Rng::new(0x5eed + seed);
+        let scene = random_scene(&mut rng);
+        let map = match seed {
+            1 => Some(SurfaceMap::parse("gaussian").unwrap()),
+            2 => Some(SurfaceMap::parse("zebra").unwrap()),
+            _ => None,
+        };
+        let mut pair = Pair::new(&scene, map);
+        check(&mut pair, &[vec![]], "first frame");
+        // Point drags on every object, weight drags on the rational ones.
+        for object in 0..pair.runs[0].session.doc().objects.len() {
+            let h = handle_of(&pair, &mut rng, object);
+            let script = drag(&mut rng, h, false, 6);
+            check(&mut pair, &script, &format!("seed {seed}: drag of {h:?}"));
+        }
+        for object in [0, 3, 4] {
+            let h = handle_of(&pair, &mut rng, object);
+            let script = drag(&mut rng, h, true, 5);
+            check(
+                &mut pair,
+                &script,
+                &format!("seed {seed}: weight drag of {h:?}"),
+            );
+        }
+        assert!(
+            pair.retained_frames * 2 > pair.frames,
+            "seed {seed}: only {} of {} frames were retained: the test would prove nothing",
+            pair.retained_frames,
+            pair.frames
+        );
+        pair.finish();
+    }
+}
+
+#[test]
+fn erbs_local_transforms_at_depth_two_redraw_exactly() {
+    let mut rng = Rng::new(7);
+    let mut pair = Pair::new(&erbs_scene(), None);
+    check(&mut pair, &[vec![]], "first frame");
+    // Nest a local (X on a selected local makes it an ERBS surface of its own), then work on
+    // locals at depth 2.
+    let h = handle_of(&pair, &mut rng, 0);
+    check(
+        &mut pair,
+        &[
+            vec![Action::MoveTo(h)],
+            vec![button(true), button(false)],
+            vec![key('x')],
+        ],
+        "nesting",
+    );
+    let deep: Vec<Handle> = pair.runs[0]
+        .session
+        .doc()
+        .handles(0)
+        .into_iter()
+        .map(|(h, _)| h)
+        .filter(|h| matches!(h, Handle::LocalPoint { local, .. } if local.steps().len() >= 2))
+        .collect();
+    assert!(!deep.is_empty(), "X made no local at depth 2");
+    for _ in 0..4 {
+        let h = deep[rng.range(0, deep.len())];
+        let script = transform(&mut rng, h, 5);
+        check(&mut pair, &script, &format!("transform of {h:?}"));
+        let script = drag(&mut rng, h, false, 4);
+        check(&mut pair, &script, &format!("drag of {h:?}"));
+    }
+    assert!(
+        pair.retained_frames > 10,
+        "{} retained frames",
+        pair.retained_frames
+    );
+    pair.finish();
+}
+
+#[test]
+fn orbit_resize_toggles_and_undo_during_and_after_gestures_give_the_full_image() {
+    let mut rng = Rng::new(11);
+    let scene = random_scene(&mut rng);
+    let mut pair = Pair::new(&scene, None);
+    let h = handle_of(&pair, &mut rng, 2);
+    let mut script = drag(&mut rng, h, false, 3);
+    let release = script.pop().unwrap();
+    // During the gesture: a toggle (level of detail), a map, undo; then after it: orbit,
+    // resize (below), more toggles.
+    script.push(vec![key('d')]);
+    script.push(vec![Action::MoveBy(5.0, 3.0)]);
+    script.push(vec![key('m')]);
+    script.push(vec![Action::MoveBy(-4.0, 2.0)]);
+    script.push(vec![ctrl('z')]);
+    script.push(vec![Action::MoveBy(3.0, -6.0)]);
+    script.push(release);
+    script.push(vec![ctrl('z')]);
+    script.push(vec![ctrl('z'), key('m')]);
+    // Orbit: a drag on empty space (the corner).
+    script.push(vec![Action::Input(InputEvent::CursorMoved {
+        x: 3.0,
+        y: 3.0,
+    })]);
+    script.push(vec![button(true)]);
+    script.push(vec![Action::MoveBy(20.0, 4.0)]);
+    script.push(vec![Action::MoveBy(10.0, 0.0), button(false)]);
+    check(&mut pair, &script, "toggles, undo and orbit");
+    let used = pair.retained_frames;
+    assert!(used > 0, "no frame was retained");
+    // A gesture, a resize in the middle of it, and the gesture going on.
+    let h = handle_of(&pair, &mut rng, 0);
+    let mut script = drag(&mut rng, h, false, 4);
+    let tail = script.split_off(4);
+    check(&mut pair, &script, "before the resize");
+    pair.resize(280, 200);
+    check(&mut pair, &tail, "after the resize");
+    pair.finish();
+}
+
+#[test]
+fn a_dynamic_set_missing_one_chunk_is_caught() {
+    let mut rng = Rng::new(3);
+    let scene = random_scene(&mut rng);
+    let mut pair = Pair::new(&scene, None);
+    pair.runs[0].session.set_drop_chunk(true);
+    // The middle control point of the B-spline surface: its support is inside the surface.
+    let h = Handle::Point {
+        object: 2,
+        point: prespline::model::Index2::Two(2, 2),
+    };
+    let script = drag(&mut rng, h, false, 6);
+    let found = pair.first_difference(&script);
+    assert!(
+        found.is_some(),
+        "a stale chunk in the static layer went unnoticed ({} retained frames)",
+        pair.retained_frames
+    );
+    pair.finish();
+}
