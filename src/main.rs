@@ -167,6 +167,8 @@ enum Command {
         output: PathBuf,
         #[command(flatten)]
         samples: SamplesArgs,
+        #[command(flatten)]
+        memory: MemoryArgs,
     },
 }
 
@@ -195,8 +197,12 @@ struct MemoryArgs {
 }
 
 impl MemoryArgs {
+    /// The command's budget, which also becomes the one every count read from its files,
+    /// edits and flags is held to before anything is built from it (`budget::check_build`).
     fn budget(self) -> MemoryBudget {
-        MemoryBudget::from_flag(self.memory_limit)
+        let budget = MemoryBudget::from_flag(self.memory_limit);
+        budget::set_build_budget(budget);
+        budget
     }
 }
 
@@ -357,8 +363,12 @@ fn main() -> ExitCode {
             input,
             output,
             samples,
-        } => cli::files::convert(&input, &output, &samples.counts())
-            .map(|line| eprintln!("{}", escape_controls(&line))),
+            memory,
+        } => {
+            memory.budget();
+            cli::files::convert(&input, &output, &samples.counts())
+        }
+        .map(|line| eprintln!("{}", escape_controls(&line))),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

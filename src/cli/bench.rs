@@ -48,6 +48,14 @@ pub fn run(args: &BenchArgs) -> Result<String, CliError> {
     if args.frames == 0 {
         return Err(CliError("--frames must be at least 1".into()));
     }
+    // Every frame keeps a record (and a frame-time entry in the progress line) until the
+    // reports are written: the counts pass the budget before the recorder reserves them.
+    let frames = args.frames as u128 + args.warmup as u128;
+    crate::sampling::budget::check_build(
+        format_args!("--frames {} with --warmup {}", args.frames, args.warmup),
+        frames * (std::mem::size_of::<crate::profile::FrameRecord>() as u128 + 8),
+    )
+    .map_err(CliError)?;
     let (scene, scene_name) = match &args.scene {
         Some(p) => (
             super::files::load_scene(p, &Default::default())?,

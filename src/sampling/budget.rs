@@ -346,8 +346,11 @@ fn samples_text(samples: &[usize]) -> String {
 /// Where a budget came from (said in the refusal so the user knows what to change).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BudgetSource {
-    /// Half of the machine's physical memory (or of the cgroup limit when lower).
+    /// Half of the machine's physical memory.
     HalfOfPhysical,
+    /// Half of the process's memory limit (cgroup `memory.max` or `ulimit -v`), lower than
+    /// physical memory.
+    HalfOfLimit,
     /// Physical memory could not be read: [`FALLBACK_BUDGET`].
     Fallback,
     /// `--memory-limit`.
@@ -374,8 +377,9 @@ impl MemoryBudget {
         }
     }
 
-    /// Half of physical memory (`MemTotal` in /proc/meminfo, lowered to a cgroup v2 limit when
-    /// there is one), or [`FALLBACK_BUDGET`] where neither can be read.
+    /// Half of physical memory (`MemTotal` in /proc/meminfo, lowered to a cgroup v2 limit or
+    /// an address-space limit when there is one), or [`FALLBACK_BUDGET`] where none can be
+    /// read.
     #[must_use]
     pub fn machine_default() -> Self {
         let physical = std::fs::read_to_string("/proc/meminfo")
@@ -384,13 +388,25 @@ impl MemoryBudget {
         let cgroup = std::fs::read_to_string("/sys/fs/cgroup/memory.max")
             .ok()
             .and_then(|t| t.trim().parse::<u64>().ok());
+        // An address-space limit (`ulimit -v`) is a ceiling too: allocating past it aborts.
+        let address_space = std::fs::read_to_string("/proc/self/limits")
+            .ok()
+            .and_then(|t| address_space_limit(&t));
+        let cgroup = match (cgroup, address_space) {
+            (Some(c), Some(a)) => Some(c.min(a)),
+            (c, a) => c.or(a),
+        };
         match (physical, cgroup) {
             (None, None) => MemoryBudget {
                 bytes: FALLBACK_BUDGET,
                 source: BudgetSource::Fallback,
             },
-            (p, c) => MemoryBudget {
-                bytes: p.unwrap_or(u64::MAX).min(c.unwrap_or(u64::MAX)) / 2,
+            (p, Some(c)) if p.is_none_or(|p| c < p) => MemoryBudget {
+                bytes: c / 2,
+                source: BudgetSource::HalfOfLimit,
+            },
+            (p, _) => MemoryBudget {
+                bytes: p.unwrap_or(u64::MAX) / 2,
                 source: BudgetSource::HalfOfPhysical,
             },
         }
@@ -399,6 +415,9 @@ impl MemoryBudget {
     fn describe(&self) -> String {
         let why = match self.source {
             BudgetSource::HalfOfPhysical => "half of physical memory; --memory-limit overrides",
+            BudgetSource::HalfOfLimit => {
+                "half of the process's memory limit (cgroup or ulimit -v); --memory-limit overrides"
+            }
             BudgetSource::Fallback => {
                 "physical memory unknown, fixed default; --memory-limit overrides"
             }
@@ -406,6 +425,64 @@ impl MemoryBudget {
         };
         format!("{} ({why})", format_bytes(self.bytes))
     }
+}
+
+thread_local! {
+    /// The budget counts read from files, edits and flags are held to on this thread before
+    /// anything is built from them ([`check_build`]); `None` until set or first asked.
+    static BUILD_BUDGET: std::cell::Cell<Option<MemoryBudget>> = const { std::cell::Cell::new(None) };
+}
+
+/// The budget [`check_build`] holds counts to on this thread: the one set by
+/// [`set_build_budget`] (each command sets its `--memory-limit`), else the machine's default.
+///
+/// It is kept per thread rather than passed down because the counts that must pass it sit deep
+/// in parsers and edit constructors (an ERBS `from` in a nested local, a `to_erbs` edit) that
+/// take no budget; one checkpoint per construction, reached from every entry, is what makes
+/// "nothing is built before the budget" hold for all of them.
+#[must_use]
+pub fn build_budget() -> MemoryBudget {
+    BUILD_BUDGET.with(|b| match b.get() {
+        Some(budget) => budget,
+        None => {
+            let budget = MemoryBudget::machine_default();
+            b.set(Some(budget));
+            budget
+        }
+    })
+}
+
+/// Sets the budget [`check_build`] uses on this thread; returns the previous one.
+pub fn set_build_budget(budget: MemoryBudget) -> Option<MemoryBudget> {
+    BUILD_BUDGET.with(|b| b.replace(Some(budget)))
+}
+
+/// Refuses, as one line, building `what` (e.g. "1000000000000 local curves of degree 3") when
+/// its `bytes` exceed the build budget. Called with counts from a file, an edit, a script or the
+/// command line before anything is allocated for them.
+pub fn check_build(what: impl std::fmt::Display, bytes: u128) -> Result<(), String> {
+    let budget = build_budget();
+    if bytes > u128::from(budget.bytes) {
+        return Err(format!(
+            "{what} need about {} to build, over the memory budget of {}",
+            format_bytes(u64::try_from(bytes).unwrap_or(u64::MAX)),
+            budget.describe()
+        ));
+    }
+    Ok(())
+}
+
+/// The soft "Max address space" limit in bytes from /proc/self/limits text; `None` when
+/// unlimited or unreadable.
+fn address_space_limit(limits: &str) -> Option<u64> {
+    let line = limits
+        .lines()
+        .find(|l| l.starts_with("Max address space"))?;
+    line["Max address space".len()..]
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()
 }
 
 /// `MemTotal` in bytes from /proc/meminfo text.
@@ -625,6 +702,29 @@ mod tests {
         assert!(parse_size("G").is_err());
         assert!(parse_size("0").is_err());
         assert!(parse_size("-1G").is_err());
+    }
+
+    #[test]
+    fn address_space_limit_is_read_from_proc_limits() {
+        let limited = "Limit                     Soft Limit           Hard Limit           Units     \nMax address space         2147483648           unlimited            bytes     \n";
+        assert_eq!(address_space_limit(limited), Some(2 << 30));
+        let unlimited =
+            "Max address space         unlimited            unlimited            bytes     \n";
+        assert_eq!(address_space_limit(unlimited), None);
+    }
+
+    #[test]
+    fn builds_over_the_build_budget_are_refused_in_one_line() {
+        let before = set_build_budget(MemoryBudget::from_flag(Some(1 << 20)));
+        let refused = check_build("3 things", 2 << 20);
+        let fits = check_build("3 things", 1 << 20);
+        if let Some(b) = before {
+            set_build_budget(b);
+        }
+        let e = refused.unwrap_err();
+        assert!(e.starts_with("3 things need about 2.0 MiB"), "{e}");
+        assert!(!e.contains('\n'));
+        assert_eq!(fits, Ok(()));
     }
 
     #[test]

@@ -10,6 +10,7 @@ use super::parse::{
 };
 use crate::geom::erbs::{ErbsCurve, ErbsKnots, ErbsSurface, LocalCurve, LocalPatch};
 use crate::model::SplineForm;
+use crate::sampling::budget::check_build;
 use serde_json::{Map, Value};
 
 /// Fields an ERBS body holds besides the object's (or the local entry's) own.
@@ -59,6 +60,11 @@ pub(super) fn erbs_curve(
         )?;
         check_degree(at, "local_degree", d)?;
         check_count(at, "local_curves", "", n)?;
+        check_build(
+            format_args!("{n} local curves of degree {d}"),
+            ErbsCurve::from_curve_bytes(n, d),
+        )
+        .map_err(|e| at.err("local_curves", e))?;
         ErbsCurve::from_curve(&c, n, d, bf, closed).map_err(|e| geom(at, e))?
     } else {
         check_fields(at, obj, &with(outer, &CURVE_FIELDS))?;
@@ -188,6 +194,14 @@ pub(super) fn erbs_surface(
         check_degree(at, "local_degree", degree[0].max(degree[1]))?;
         check_count(at, "local_patches", "u direction: ", count[0])?;
         check_count(at, "local_patches", "v direction: ", count[1])?;
+        check_build(
+            format_args!(
+                "{}×{} local patches of degree [{}, {}]",
+                count[0], count[1], degree[0], degree[1]
+            ),
+            ErbsSurface::from_surface_bytes(count, degree),
+        )
+        .map_err(|e| at.err("local_patches", e))?;
         return ErbsSurface::from_surface(&s, count, degree, bf, closed).map_err(|e| geom(at, e));
     }
     check_fields(at, obj, &with(outer, &CURVE_FIELDS))?;

@@ -15,6 +15,7 @@ use crate::model::points::check_vector;
 use crate::model::registry::IntoObject;
 use crate::model::{Index2, MAX_CURVE_SAMPLES, MAX_DEGREE, check_samples, check_surface_samples};
 use crate::sampling::SampleMode;
+use crate::sampling::budget::check_build;
 use curve_sampler::ErbsCurveSampler;
 use glam::{DMat4, DVec3, DVec4};
 use std::fmt::Debug;
@@ -719,7 +720,14 @@ impl ErbsNet for ErbsCurve {
         bf: BFunctionKind,
     ) -> Result<Self, GeomError> {
         match local {
-            LocalCurve::Spline { curve, .. } => ErbsCurve::from_curve(curve, n, degree, bf, false),
+            LocalCurve::Spline { curve, .. } => {
+                check_build(
+                    format_args!("{n} local curves of degree {degree}"),
+                    ErbsCurve::from_curve_bytes(n, degree),
+                )
+                .map_err(|e| GeomError::new("to_erbs", e))?;
+                ErbsCurve::from_curve(curve, n, degree, bf, false)
+            }
             LocalCurve::Erbs(_) => Err(GeomError::new("to_erbs", "already an ERBS local")),
         }
     }
@@ -841,6 +849,14 @@ impl ErbsNet for ErbsSurface {
     ) -> Result<Self, GeomError> {
         match local {
             LocalPatch::Spline { surface, .. } => {
+                check_build(
+                    format_args!(
+                        "{}×{} local patches of degree [{}, {}]",
+                        count[0], count[1], degree[0], degree[1]
+                    ),
+                    ErbsSurface::from_surface_bytes(count, degree),
+                )
+                .map_err(|e| GeomError::new("to_erbs", e))?;
                 ErbsSurface::from_surface(surface, count, degree, bf, [false, false])
             }
             LocalPatch::Erbs(_) => Err(GeomError::new("to_erbs", "already an ERBS local")),
