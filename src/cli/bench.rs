@@ -48,14 +48,6 @@ pub fn run(args: &BenchArgs) -> Result<String, CliError> {
     if args.frames == 0 {
         return Err(CliError("--frames must be at least 1".into()));
     }
-    // Every frame keeps a record (and a frame-time entry in the progress line) until the
-    // reports are written: the counts pass the budget before the recorder reserves them.
-    let frames = args.frames as u128 + args.warmup as u128;
-    crate::sampling::budget::check_build(
-        format_args!("--frames {} with --warmup {}", args.frames, args.warmup),
-        frames * (std::mem::size_of::<crate::profile::FrameRecord>() as u128 + 8),
-    )
-    .map_err(CliError)?;
     let (scene, scene_name) = match &args.scene {
         Some(p) => (
             super::files::load_scene(p, &Default::default())?,
@@ -65,6 +57,14 @@ pub fn run(args: &BenchArgs) -> Result<String, CliError> {
     };
     super::render::check_drawable(&scene, Path::new(&scene_name), &args.memory)?;
     super::render::check_analysis(&scene, args.analysis, &args.memory)?;
+    // Every frame keeps a record (and a frame-time entry in the progress line) until the
+    // reports are written: the counts pass the budget before the recorder reserves them.
+    let frames = args.frames as u128 + args.warmup as u128;
+    crate::sampling::budget::check_build(
+        format_args!("--frames {} with --warmup {}", args.frames, args.warmup),
+        frames * (std::mem::size_of::<crate::profile::FrameRecord>() as u128 + 8),
+    )
+    .map_err(CliError)?;
     let modes: &[bool] = if args.naive { &[false, true] } else { &[false] };
     let mut summaries = Vec::new();
     let mut written = Vec::new();

@@ -9,6 +9,7 @@
 //! [`MemoryBudget`] (by default half of physical memory; `--memory-limit` overrides).
 
 use super::object::SampleMode;
+use crate::geom::erbs::{ErbsCurve, ErbsSurface, LocalCurve, LocalPatch};
 use crate::model::{Model, ModelRef};
 use crate::scene::Scene;
 use std::fmt::Write;
@@ -18,6 +19,8 @@ const F64: u128 = 8;
 const VEC3: u128 = 24;
 const VEC4: u128 = 32;
 const F32: u128 = 4;
+/// A span index.
+const USIZE: u128 = std::mem::size_of::<usize>() as u128;
 /// Frames in flight, each with its own mirror (see `gpu::FRAMES_IN_FLIGHT`; `sampling` does not
 /// depend on `gpu`).
 const MIRROR_SLOTS: u128 = 2;
@@ -35,6 +38,9 @@ pub struct Extent {
     pub rational: bool,
     /// ERBS objects: local curves (patches) per direction; `None` for Bézier/B-spline/NURBS.
     pub erbs_locals: Option<Vec<usize>>,
+    /// ERBS locals that are ERBS themselves: each a level of its own, pre-evaluated at the
+    /// parent's samples inside its support (its `samples`).
+    pub nested: Vec<Extent>,
 }
 
 impl Extent {
@@ -57,53 +63,31 @@ impl Extent {
                 degree: vec![m.curve().degree()],
                 rational: m.curve().is_rational(),
                 erbs_locals: None,
+                nested: Vec::new(),
             },
             ModelRef::CatmullRom(_) => Extent {
                 samples,
                 degree: vec![3],
                 rational: false,
                 erbs_locals: None,
+                nested: Vec::new(),
             },
             ModelRef::BezierSpline(m) => Extent {
                 samples,
                 degree: vec![m.spline().degree()],
                 rational: false,
                 erbs_locals: None,
+                nested: Vec::new(),
             },
             ModelRef::Surface(m) => Extent {
                 samples,
                 degree: m.surface().degree().to_vec(),
                 rational: m.surface().is_rational(),
                 erbs_locals: None,
+                nested: Vec::new(),
             },
-            ModelRef::ErbsCurve(m) => {
-                let c = m.curve();
-                Extent {
-                    samples,
-                    degree: vec![
-                        c.local_curves()
-                            .iter()
-                            .map(|l| l.degree())
-                            .max()
-                            .unwrap_or(0),
-                    ],
-                    rational: false,
-                    erbs_locals: Some(vec![c.local_curves().len()]),
-                }
-            }
-            ModelRef::ErbsSurface(m) => {
-                let s = m.surface();
-                let degree = s.local_patches().iter().fold(vec![0, 0], |d, p| {
-                    let [a, b] = p.degree();
-                    vec![d[0].max(a), d[1].max(b)]
-                });
-                Extent {
-                    samples,
-                    degree,
-                    rational: false,
-                    erbs_locals: Some(s.count().to_vec()),
-                }
-            }
+            ModelRef::ErbsCurve(m) => erbs_curve_extent(m.curve(), samples[0]),
+            ModelRef::ErbsSurface(m) => erbs_surface_extent(m.surface(), [samples[0], samples[1]]),
         }
     }
 
@@ -114,6 +98,72 @@ impl Extent {
     /// Samples in the grid (product over the directions).
     fn sample_count(&self) -> u128 {
         self.samples.iter().map(|&m| m as u128).product()
+    }
+}
+
+/// Samples of a parent's `m` over `domain` that fall in `support` (both ends counted).
+fn samples_in(m: usize, domain: (f64, f64), support: (f64, f64)) -> usize {
+    let width = domain.1 - domain.0;
+    let part = if width > 0.0 {
+        ((support.1 - support.0) / width).clamp(0.0, 1.0)
+    } else {
+        1.0
+    };
+    ((part * (m.saturating_sub(1)) as f64).ceil() as usize + 1).min(m)
+}
+
+/// An ERBS curve's extent at `m` samples, its ERBS locals (to any depth) at the samples in
+/// their supports.
+fn erbs_curve_extent(c: &ErbsCurve, m: usize) -> Extent {
+    let locals = c.local_curves();
+    let nested = locals
+        .iter()
+        .enumerate()
+        .filter_map(|(l, local)| match local {
+            LocalCurve::Erbs(inner) => Some(erbs_curve_extent(
+                inner,
+                samples_in(m, c.domain(), c.knots().support(l)),
+            )),
+            LocalCurve::Spline { .. } => None,
+        })
+        .collect();
+    Extent {
+        samples: vec![m],
+        degree: vec![locals.iter().map(LocalCurve::degree).max().unwrap_or(0)],
+        rational: false,
+        erbs_locals: Some(vec![locals.len()]),
+        nested,
+    }
+}
+
+/// As [`erbs_curve_extent`] for a surface at `dims` samples.
+fn erbs_surface_extent(s: &ErbsSurface, dims: [usize; 2]) -> Extent {
+    let [_, nv] = s.count();
+    let domain = s.domain();
+    let nested = s
+        .local_patches()
+        .iter()
+        .enumerate()
+        .filter_map(|(idx, p)| match p {
+            LocalPatch::Erbs(inner) => {
+                let (k, l) = (idx / nv.max(1), idx % nv.max(1));
+                let support = [s.knots()[0].support(k), s.knots()[1].support(l)];
+                let sub = [0, 1].map(|d| samples_in(dims[d], domain[d], support[d]));
+                Some(erbs_surface_extent(inner, sub))
+            }
+            LocalPatch::Spline { .. } => None,
+        })
+        .collect();
+    let degree = s.local_patches().iter().fold(vec![0, 0], |d, p| {
+        let [a, b] = p.degree();
+        vec![d[0].max(a), d[1].max(b)]
+    });
+    Extent {
+        samples: dims.to_vec(),
+        degree,
+        rational: false,
+        erbs_locals: Some(s.count().to_vec()),
+        nested,
     }
 }
 
@@ -223,7 +273,8 @@ pub fn estimate(extent: &Extent, mode: SampleMode, uses: Uses) -> Estimate {
             Some(_) => 2,
             None => 1,
         };
-        table_bytes += copies * m * rows * (d + 1) * F64;
+        // Besides the basis values, every table keeps each sample's parameter and span.
+        table_bytes += copies * m * (rows * (d + 1) * F64 + F64 + USIZE);
         table_formula.push(format!(
             "{}{m} samples × {rows} derivative orders × {} basis functions",
             if copies > 1 {
@@ -296,6 +347,46 @@ pub fn estimate(extent: &Extent, mode: SampleMode, uses: Uses) -> Estimate {
                 ),
             );
         }
+    }
+    if !extent.nested.is_empty() {
+        // A nested level keeps what an ERBS object of its own would, less the normals and
+        // curvatures (only the top level has them).
+        let nested: u128 = extent
+            .nested
+            .iter()
+            .map(|x| {
+                let e = estimate(x, mode, Uses::default());
+                e.parts
+                    .iter()
+                    .filter(|p| !matches!(p.what, "normals" | "curvatures"))
+                    .map(|p| u128::from(p.bytes))
+                    .sum::<u128>()
+            })
+            .sum();
+        // A curve's nested local has no Hermite table nor local samples in its parent (its
+        // level holds them), which the parent's terms above counted for every local.
+        let replaced: u128 = if surface {
+            0
+        } else {
+            let (rows, d1) = (
+                g.min(extent.degree[0] as u128) + 1,
+                extent.degree[0] as u128 + 1,
+            );
+            extent
+                .nested
+                .iter()
+                .map(|x| x.sample_count() * (rows * d1 * F64 + F64 + USIZE + stride * VEC3))
+                .sum()
+        };
+        let nested = nested.saturating_sub(replaced);
+        e.add(
+            "nested ERBS levels",
+            nested,
+            format!(
+                "{} ERBS locals at the samples in their supports",
+                extent.nested.len()
+            ),
+        );
     }
     if uses.gpu {
         // Per frame in flight a mirror of f32 vertices (surfaces: position + normal), plus the
@@ -604,22 +695,26 @@ mod tests {
             degree: vec![degree],
             rational: false,
             erbs_locals: None,
+            nested: Vec::new(),
         }
     }
 
     #[test]
     fn issue_example_is_dominated_by_the_hermite_tables() {
         // Degree 60, 5 000 000 samples, 20 derivatives: 5e6 × 21 × 61 f64 = 51.24e9 B of
-        // tables plus 5e6 × 21 × 24 B of samples.
+        // tables (plus each sample's parameter and span) and 5e6 × 21 × 24 B of samples.
         let e = estimate(
             &curve(60, 5_000_000),
             SampleMode::Derivatives(20),
             Uses::default(),
         );
         assert_eq!(e.parts[0].what, "Hermite tables");
-        assert_eq!(e.parts[0].bytes, 5_000_000 * 21 * 61 * 8);
+        assert_eq!(e.parts[0].bytes, 5_000_000 * (21 * 61 * 8 + 16));
         assert_eq!(e.parts[1].bytes, 5_000_000 * 21 * 24);
-        assert_eq!(e.bytes(), 5_000_000 * 21 * 61 * 8 + 5_000_000 * 21 * 24);
+        assert_eq!(
+            e.bytes(),
+            5_000_000 * (21 * 61 * 8 + 16) + 5_000_000 * 21 * 24
+        );
         assert!(
             e.describe()
                 .contains("5000000 samples × 21 derivative orders × 61 basis functions"),
@@ -636,7 +731,7 @@ mod tests {
             Uses::default(),
         );
         let tables = e.parts.iter().find(|p| p.what == "Hermite tables").unwrap();
-        assert_eq!(tables.bytes, 1000 * 4 * 4 * 8);
+        assert_eq!(tables.bytes, 1000 * (4 * 4 * 8 + 16));
     }
 
     #[test]
@@ -646,6 +741,7 @@ mod tests {
             degree: vec![3, 3],
             rational: true,
             erbs_locals: None,
+            nested: Vec::new(),
         };
         let e = estimate(
             &s,
@@ -670,6 +766,7 @@ mod tests {
             degree: vec![3, 3],
             rational: false,
             erbs_locals: None,
+            nested: Vec::new(),
         };
         let uses = Uses {
             gpu: true,
