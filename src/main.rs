@@ -22,6 +22,10 @@ use std::process::ExitCode;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Threads for pre-evaluating many objects (default: every core). Results are bit for
+    /// bit the same on any number.
+    #[arg(long, global = true, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
+    threads: Option<u16>,
 }
 
 #[derive(Subcommand)]
@@ -263,6 +267,9 @@ impl DisplayArgs {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Some(n) = cli.threads {
+        prespline::parallel::set_threads(usize::from(n));
+    }
     let result = match cli.command {
         Command::Sample {
             scene,

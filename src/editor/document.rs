@@ -90,14 +90,11 @@ impl Document {
         Self::with_mode(scene, SampleMode::Render)
     }
 
-    /// Pre-evaluates every object of `scene` in `mode` (surfaces and curves alike).
+    /// Pre-evaluates every object of `scene` in `mode` (surfaces and curves alike), the
+    /// objects spread over every core ([`crate::parallel`]; the same bits as on one thread).
     #[must_use]
     pub fn with_mode(scene: &Scene, mode: SampleMode) -> Self {
-        let objects = scene
-            .objects
-            .iter()
-            .map(|o| DocObject::new(o, mode))
-            .collect();
+        let objects = crate::parallel::map(&scene.objects, |o| DocObject::new(o, mode));
         Self { objects }
     }
 

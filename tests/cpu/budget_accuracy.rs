@@ -60,8 +60,12 @@ fn estimate_and_held(scene: &Scene, mode: SampleMode) -> (u64, i64) {
     let budget = MemoryBudget::from_flag(Some(u64::MAX / 2));
     let estimate = check_scene(scene, mode, uses, &budget).unwrap();
     let before = live();
-    let editor = Editor::new(scene, EditorOptions { mode, uses, budget }).unwrap();
-    let doc = editor.into_document();
+    // Pre-evaluation on this thread alone: the counter is per thread.
+    let doc = prespline::parallel::on_one_thread(|| {
+        Editor::new(scene, EditorOptions { mode, uses, budget })
+            .unwrap()
+            .into_document()
+    });
     let held = live() - before;
     drop(doc);
     (estimate, held)
@@ -175,4 +179,39 @@ fn the_comparison_fails_on_a_halved_estimate() {
     assert!(r.is_err());
     let nan = std::panic::catch_unwind(|| assert_close("nothing held", 0, 0, 0.15));
     assert!(nan.is_err(), "0/0 must not pass");
+}
+
+/// Issue 23: pre-evaluation on many threads gives the same bits as on one (each object is
+/// computed by the same code; only the order of work differs).
+#[test]
+fn pre_evaluation_on_n_threads_equals_one_thread_bit_for_bit() {
+    let teapot =
+        Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/teapot.json")).unwrap();
+    let mut scene = erbs_surface_scene(true);
+    scene.objects.extend(erbs_curve_scene(true).objects);
+    for k in 0..8 {
+        for o in &teapot.objects {
+            let mut o = o.clone();
+            o.name = format!("{k}_{}", o.name);
+            scene.objects.push(o);
+        }
+    }
+    let bits = || -> Vec<u64> {
+        let doc = prespline::editor::Document::with_mode(&scene, SampleMode::Analysis);
+        doc.objects
+            .iter()
+            .flat_map(|o| o.sampled.grid().data.iter().flat_map(|v| v.to_array()))
+            .map(f64::to_bits)
+            .collect()
+    };
+    let one = prespline::parallel::on_one_thread(bits);
+    prespline::parallel::set_threads(4);
+    let four = bits();
+    prespline::parallel::set_threads(0);
+    assert_eq!(one.len(), four.len());
+    assert!(one == four, "1 and 4 threads differ");
+    // Negative control: one flipped bit is seen.
+    let mut flipped = four.clone();
+    flipped[7] ^= 1;
+    assert!(one != flipped);
 }
