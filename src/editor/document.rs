@@ -11,6 +11,7 @@ use crate::model::{
     BezierSplineEdit, CatmullRomEdit, CurveEdit, Edit, ErbsCurveEdit, ErbsSurfaceEdit, Index2,
     KindEdit, LocalEdit, LocalPath, Model, ModelRef, ObjectEdit, PointEdit, SurfaceEdit,
 };
+use crate::profile::{LOAD_PROGRESS_AFTER, Progress};
 use crate::sampling::SampleMode;
 use crate::scene::{Scene, SceneObject};
 use glam::DVec3;
@@ -94,7 +95,27 @@ impl Document {
     /// objects spread over every core ([`crate::parallel`]; the same bits as on one thread).
     #[must_use]
     pub fn with_mode(scene: &Scene, mode: SampleMode) -> Self {
-        let objects = crate::parallel::map(&scene.objects, |o| DocObject::new(o, mode));
+        let samples: u64 = scene
+            .objects
+            .iter()
+            .map(|o| {
+                o.model
+                    .sample_dims()
+                    .iter()
+                    .map(|&m| m as u64)
+                    .product::<u64>()
+            })
+            .sum();
+        let progress =
+            Progress::delayed("pre-evaluating", Some(samples), LOAD_PROGRESS_AFTER).unit("samples");
+        let objects = crate::parallel::map(&scene.objects, |o| {
+            let d = DocObject::new(o, mode);
+            progress.inc(d.sampled.grid().data.len() as u64 / d.sampled.grid().stride() as u64);
+            d
+        });
+        // Cleared, not left: the load's progress is transient, and an error that follows
+        // must stand on its own line.
+        drop(progress);
         Self { objects }
     }
 
