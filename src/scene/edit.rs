@@ -471,7 +471,7 @@ fn affine(at: &At, v: &Value) -> Result<DMat4, SceneError> {
     }
     let mut m = [[0.0; 4]; 4];
     for (r, row) in rows.iter().enumerate() {
-        let vals = as_f64_list(at, "transform", &format!("row {r} entry"), row)?;
+        let vals = as_f64_list(at, "transform", format_args!("row {r} entry"), row)?;
         if vals.len() != 4 {
             return Err(at.err(
                 "transform",

@@ -220,7 +220,7 @@ pub(super) fn erbs_surface(
     })?;
     let mut knots = Vec::with_capacity(2);
     for (dir, name) in ["u", "v"].into_iter().enumerate() {
-        let k = as_f64_list(at, "knots", &format!("{name} knot"), &kv[dir])?;
+        let k = as_f64_list(at, "knots", format_args!("{name} knot"), &kv[dir])?;
         let k = if closed[dir] {
             ErbsKnots::closed(k, count[dir])
         } else {
