@@ -12,6 +12,7 @@ pub mod geom;
 #[allow(unsafe_code)]
 pub mod gpu;
 pub mod model;
+pub mod parallel;
 pub mod profile;
 pub mod render;
 pub mod sampling;

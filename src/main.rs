@@ -22,6 +22,10 @@ use std::process::ExitCode;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Threads for pre-evaluating many objects (default: every core). Results are bit for
+    /// bit the same on any number.
+    #[arg(long, global = true, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
+    threads: Option<u16>,
 }
 
 #[derive(Subcommand)]
@@ -185,6 +189,8 @@ enum Command {
         output: PathBuf,
         #[command(flatten)]
         samples: SamplesArgs,
+        #[command(flatten)]
+        memory: MemoryArgs,
     },
 }
 
@@ -213,8 +219,12 @@ struct MemoryArgs {
 }
 
 impl MemoryArgs {
+    /// The command's budget, which also becomes the one every count read from its files,
+    /// edits and flags is held to before anything is built from it (`budget::check_build`).
     fn budget(self) -> MemoryBudget {
-        MemoryBudget::from_flag(self.memory_limit)
+        let budget = MemoryBudget::from_flag(self.memory_limit);
+        budget::set_build_budget(budget);
+        budget
     }
 }
 
@@ -288,6 +298,9 @@ impl DisplayArgs {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Some(n) = cli.threads {
+        prespline::parallel::set_threads(usize::from(n));
+    }
     let result = match cli.command {
         Command::Sample {
             scene,
@@ -400,8 +413,12 @@ fn main() -> ExitCode {
             input,
             output,
             samples,
-        } => cli::files::convert(&input, &output, &samples.counts())
-            .map(|line| eprintln!("{}", escape_controls(&line))),
+            memory,
+        } => {
+            memory.budget();
+            cli::files::convert(&input, &output, &samples.counts())
+        }
+        .map(|line| eprintln!("{}", escape_controls(&line))),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

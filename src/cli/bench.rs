@@ -68,6 +68,14 @@ pub fn run(args: &BenchArgs) -> Result<String, CliError> {
     };
     super::render::check_drawable(&scene, Path::new(&scene_name), &args.memory)?;
     super::render::check_analysis(&scene, args.analysis, &args.memory)?;
+    // Every frame keeps a record (and a frame-time entry in the progress line) until the
+    // reports are written: the counts pass the budget before the recorder reserves them.
+    let frames = args.frames as u128 + args.warmup as u128;
+    crate::sampling::budget::check_build(
+        format_args!("--frames {} with --warmup {}", args.frames, args.warmup),
+        frames * (std::mem::size_of::<crate::profile::FrameRecord>() as u128 + 8),
+    )
+    .map_err(CliError)?;
     let modes: &[bool] = if args.naive { &[false, true] } else { &[false] };
     let mut summaries = Vec::new();
     let mut written = Vec::new();

@@ -8,6 +8,7 @@ use crate::model::{
     ControlDisplay, Edit, ErbsCurveEdit, ErbsSurfaceEdit, Grip, Index2, KindEdit, LocalEdit,
     LocalPath, Model, ModelRef, ObjectEdit, each_curve_leaf_of, each_patch_leaf_of,
 };
+use crate::profile::{LOAD_PROGRESS_AFTER, Progress};
 use crate::sampling::SampleMode;
 use crate::scene::{Scene, SceneObject};
 use glam::DVec3;
@@ -109,14 +110,31 @@ impl Document {
         Self::with_mode(scene, SampleMode::Render)
     }
 
-    /// Pre-evaluates every object of `scene` in `mode` (surfaces and curves alike).
+    /// Pre-evaluates every object of `scene` in `mode` (surfaces and curves alike), the
+    /// objects spread over every core ([`crate::parallel`]; the same bits as on one thread).
     #[must_use]
     pub fn with_mode(scene: &Scene, mode: SampleMode) -> Self {
-        let objects = scene
+        let samples: u64 = scene
             .objects
             .iter()
-            .map(|o| DocObject::new(o, mode))
-            .collect();
+            .map(|o| {
+                o.model
+                    .sample_dims()
+                    .iter()
+                    .map(|&m| m as u64)
+                    .product::<u64>()
+            })
+            .sum();
+        let progress =
+            Progress::delayed("pre-evaluating", Some(samples), LOAD_PROGRESS_AFTER).unit("samples");
+        let objects = crate::parallel::map(&scene.objects, |o| {
+            let d = DocObject::new(o, mode);
+            progress.inc(d.sampled.grid().data.len() as u64 / d.sampled.grid().stride() as u64);
+            d
+        });
+        // Cleared, not left: the load's progress is transient, and an error that follows
+        // must stand on its own line.
+        drop(progress);
         Self { objects }
     }
 

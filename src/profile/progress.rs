@@ -19,6 +19,9 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressState, ProgressStyle};
 /// a clock read.
 const REFRESH_HZ: u8 = 10;
 
+/// Loads (parsing, pre-evaluation) that take longer than this show progress on a terminal.
+pub const LOAD_PROGRESS_AFTER: std::time::Duration = std::time::Duration::from_secs(1);
+
 /// A progress line for one piece of work, e.g. `Progress::new("bench drag", Some(130))
 /// .unit("frames")`, drawn as
 /// `bench drag [=========>          ] 52/130 frames (40%), 113 frames/s, 1s left`.
@@ -28,6 +31,10 @@ const REFRESH_HZ: u8 = 10;
 pub struct Progress {
     bar: ProgressBar,
     finished: bool,
+    /// [`delayed`](Self::delayed): when it started, after how long it shows, and whether it
+    /// does yet.
+    reveal: Option<(std::time::Instant, std::time::Duration)>,
+    revealed: std::sync::atomic::AtomicBool,
 }
 
 impl Progress {
@@ -44,11 +51,37 @@ impl Progress {
         Self::with_target(label, total, ProgressDrawTarget::hidden())
     }
 
+    /// As [`new`](Self::new), but drawn only once the work has taken `after` (a load that
+    /// ends within a second prints nothing).
+    #[must_use]
+    pub fn delayed(label: &str, total: Option<u64>, after: std::time::Duration) -> Self {
+        let mut p = Self::with_target(label, total, ProgressDrawTarget::hidden());
+        p.reveal = Some((std::time::Instant::now(), after));
+        p
+    }
+
+    /// Shows a [`delayed`](Self::delayed) line once its time has come (on a terminal only).
+    fn maybe_reveal(&self) {
+        use std::sync::atomic::Ordering;
+        let Some((start, after)) = self.reveal else {
+            return;
+        };
+        if self.revealed.load(Ordering::Relaxed) || start.elapsed() < after {
+            return;
+        }
+        if !self.revealed.swap(true, Ordering::Relaxed) {
+            self.bar
+                .set_draw_target(ProgressDrawTarget::stderr_with_hz(REFRESH_HZ));
+        }
+    }
+
     fn with_target(label: &str, total: Option<u64>, target: ProgressDrawTarget) -> Self {
         let bar = ProgressBar::with_draw_target(total, target).with_prefix(label.to_string());
         let progress = Progress {
             bar,
             finished: false,
+            reveal: None,
+            revealed: std::sync::atomic::AtomicBool::new(false),
         };
         progress.set_style("items");
         progress
@@ -91,11 +124,13 @@ impl Progress {
     /// Adds `n` to the count done.
     pub fn inc(&self, n: u64) {
         self.bar.inc(n);
+        self.maybe_reveal();
     }
 
     /// Sets the count done.
     pub fn set(&self, done: u64) {
         self.bar.set_position(done);
+        self.maybe_reveal();
     }
 
     /// The count done so far.

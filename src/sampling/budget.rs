@@ -9,6 +9,7 @@
 //! [`MemoryBudget`] (by default half of physical memory; `--memory-limit` overrides).
 
 use super::object::SampleMode;
+use crate::geom::erbs::{ErbsCurve, ErbsSurface, LocalCurve, LocalPatch};
 use crate::model::{Model, ModelRef};
 use crate::scene::Scene;
 use std::fmt::Write;
@@ -18,6 +19,8 @@ const F64: u128 = 8;
 const VEC3: u128 = 24;
 const VEC4: u128 = 32;
 const F32: u128 = 4;
+/// A span index.
+const USIZE: u128 = std::mem::size_of::<usize>() as u128;
 /// Frames in flight, each with its own mirror (see `gpu::FRAMES_IN_FLIGHT`; `sampling` does not
 /// depend on `gpu`).
 const MIRROR_SLOTS: u128 = 2;
@@ -35,6 +38,9 @@ pub struct Extent {
     pub rational: bool,
     /// ERBS objects: local curves (patches) per direction; `None` for Bézier/B-spline/NURBS.
     pub erbs_locals: Option<Vec<usize>>,
+    /// ERBS locals that are ERBS themselves: each a level of its own, pre-evaluated at the
+    /// parent's samples inside its support (its `samples`).
+    pub nested: Vec<Extent>,
 }
 
 impl Extent {
@@ -57,53 +63,31 @@ impl Extent {
                 degree: vec![m.curve().degree()],
                 rational: m.curve().is_rational(),
                 erbs_locals: None,
+                nested: Vec::new(),
             },
             ModelRef::CatmullRom(_) => Extent {
                 samples,
                 degree: vec![3],
                 rational: false,
                 erbs_locals: None,
+                nested: Vec::new(),
             },
             ModelRef::BezierSpline(m) => Extent {
                 samples,
                 degree: vec![m.spline().degree()],
                 rational: false,
                 erbs_locals: None,
+                nested: Vec::new(),
             },
             ModelRef::Surface(m) => Extent {
                 samples,
                 degree: m.surface().degree().to_vec(),
                 rational: m.surface().is_rational(),
                 erbs_locals: None,
+                nested: Vec::new(),
             },
-            ModelRef::ErbsCurve(m) => {
-                let c = m.curve();
-                Extent {
-                    samples,
-                    degree: vec![
-                        c.local_curves()
-                            .iter()
-                            .map(|l| l.degree())
-                            .max()
-                            .unwrap_or(0),
-                    ],
-                    rational: false,
-                    erbs_locals: Some(vec![c.local_curves().len()]),
-                }
-            }
-            ModelRef::ErbsSurface(m) => {
-                let s = m.surface();
-                let degree = s.local_patches().iter().fold(vec![0, 0], |d, p| {
-                    let [a, b] = p.degree();
-                    vec![d[0].max(a), d[1].max(b)]
-                });
-                Extent {
-                    samples,
-                    degree,
-                    rational: false,
-                    erbs_locals: Some(s.count().to_vec()),
-                }
-            }
+            ModelRef::ErbsCurve(m) => erbs_curve_extent(m.curve(), samples[0]),
+            ModelRef::ErbsSurface(m) => erbs_surface_extent(m.surface(), [samples[0], samples[1]]),
         }
     }
 
@@ -114,6 +98,72 @@ impl Extent {
     /// Samples in the grid (product over the directions).
     fn sample_count(&self) -> u128 {
         self.samples.iter().map(|&m| m as u128).product()
+    }
+}
+
+/// Samples of a parent's `m` over `domain` that fall in `support` (both ends counted).
+fn samples_in(m: usize, domain: (f64, f64), support: (f64, f64)) -> usize {
+    let width = domain.1 - domain.0;
+    let part = if width > 0.0 {
+        ((support.1 - support.0) / width).clamp(0.0, 1.0)
+    } else {
+        1.0
+    };
+    ((part * (m.saturating_sub(1)) as f64).ceil() as usize + 1).min(m)
+}
+
+/// An ERBS curve's extent at `m` samples, its ERBS locals (to any depth) at the samples in
+/// their supports.
+fn erbs_curve_extent(c: &ErbsCurve, m: usize) -> Extent {
+    let locals = c.local_curves();
+    let nested = locals
+        .iter()
+        .enumerate()
+        .filter_map(|(l, local)| match local {
+            LocalCurve::Erbs(inner) => Some(erbs_curve_extent(
+                inner,
+                samples_in(m, c.domain(), c.knots().support(l)),
+            )),
+            LocalCurve::Spline { .. } => None,
+        })
+        .collect();
+    Extent {
+        samples: vec![m],
+        degree: vec![locals.iter().map(LocalCurve::degree).max().unwrap_or(0)],
+        rational: false,
+        erbs_locals: Some(vec![locals.len()]),
+        nested,
+    }
+}
+
+/// As [`erbs_curve_extent`] for a surface at `dims` samples.
+fn erbs_surface_extent(s: &ErbsSurface, dims: [usize; 2]) -> Extent {
+    let [_, nv] = s.count();
+    let domain = s.domain();
+    let nested = s
+        .local_patches()
+        .iter()
+        .enumerate()
+        .filter_map(|(idx, p)| match p {
+            LocalPatch::Erbs(inner) => {
+                let (k, l) = (idx / nv.max(1), idx % nv.max(1));
+                let support = [s.knots()[0].support(k), s.knots()[1].support(l)];
+                let sub = [0, 1].map(|d| samples_in(dims[d], domain[d], support[d]));
+                Some(erbs_surface_extent(inner, sub))
+            }
+            LocalPatch::Spline { .. } => None,
+        })
+        .collect();
+    let degree = s.local_patches().iter().fold(vec![0, 0], |d, p| {
+        let [a, b] = p.degree();
+        vec![d[0].max(a), d[1].max(b)]
+    });
+    Extent {
+        samples: dims.to_vec(),
+        degree,
+        rational: false,
+        erbs_locals: Some(s.count().to_vec()),
+        nested,
     }
 }
 
@@ -223,7 +273,8 @@ pub fn estimate(extent: &Extent, mode: SampleMode, uses: Uses) -> Estimate {
             Some(_) => 2,
             None => 1,
         };
-        table_bytes += copies * m * rows * (d + 1) * F64;
+        // Besides the basis values, every table keeps each sample's parameter and span.
+        table_bytes += copies * m * (rows * (d + 1) * F64 + F64 + USIZE);
         table_formula.push(format!(
             "{}{m} samples × {rows} derivative orders × {} basis functions",
             if copies > 1 {
@@ -297,6 +348,46 @@ pub fn estimate(extent: &Extent, mode: SampleMode, uses: Uses) -> Estimate {
             );
         }
     }
+    if !extent.nested.is_empty() {
+        // A nested level keeps what an ERBS object of its own would, less the normals and
+        // curvatures (only the top level has them).
+        let nested: u128 = extent
+            .nested
+            .iter()
+            .map(|x| {
+                let e = estimate(x, mode, Uses::default());
+                e.parts
+                    .iter()
+                    .filter(|p| !matches!(p.what, "normals" | "curvatures"))
+                    .map(|p| u128::from(p.bytes))
+                    .sum::<u128>()
+            })
+            .sum();
+        // A curve's nested local has no Hermite table nor local samples in its parent (its
+        // level holds them), which the parent's terms above counted for every local.
+        let replaced: u128 = if surface {
+            0
+        } else {
+            let (rows, d1) = (
+                g.min(extent.degree[0] as u128) + 1,
+                extent.degree[0] as u128 + 1,
+            );
+            extent
+                .nested
+                .iter()
+                .map(|x| x.sample_count() * (rows * d1 * F64 + F64 + USIZE + stride * VEC3))
+                .sum()
+        };
+        let nested = nested.saturating_sub(replaced);
+        e.add(
+            "nested ERBS levels",
+            nested,
+            format!(
+                "{} ERBS locals at the samples in their supports",
+                extent.nested.len()
+            ),
+        );
+    }
     if uses.gpu {
         // Per frame in flight a mirror of f32 vertices (surfaces: position + normal), plus the
         // CPU scratch that fills it; surfaces also get triangle and wireframe index buffers
@@ -346,8 +437,11 @@ fn samples_text(samples: &[usize]) -> String {
 /// Where a budget came from (said in the refusal so the user knows what to change).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BudgetSource {
-    /// Half of the machine's physical memory (or of the cgroup limit when lower).
+    /// Half of the machine's physical memory.
     HalfOfPhysical,
+    /// Half of the process's memory limit (cgroup `memory.max` or `ulimit -v`), lower than
+    /// physical memory.
+    HalfOfLimit,
     /// Physical memory could not be read: [`FALLBACK_BUDGET`].
     Fallback,
     /// `--memory-limit`.
@@ -374,8 +468,9 @@ impl MemoryBudget {
         }
     }
 
-    /// Half of physical memory (`MemTotal` in /proc/meminfo, lowered to a cgroup v2 limit when
-    /// there is one), or [`FALLBACK_BUDGET`] where neither can be read.
+    /// Half of physical memory (`MemTotal` in /proc/meminfo, lowered to a cgroup v2 limit or
+    /// an address-space limit when there is one), or [`FALLBACK_BUDGET`] where none can be
+    /// read.
     #[must_use]
     pub fn machine_default() -> Self {
         let physical = std::fs::read_to_string("/proc/meminfo")
@@ -384,13 +479,25 @@ impl MemoryBudget {
         let cgroup = std::fs::read_to_string("/sys/fs/cgroup/memory.max")
             .ok()
             .and_then(|t| t.trim().parse::<u64>().ok());
+        // An address-space limit (`ulimit -v`) is a ceiling too: allocating past it aborts.
+        let address_space = std::fs::read_to_string("/proc/self/limits")
+            .ok()
+            .and_then(|t| address_space_limit(&t));
+        let cgroup = match (cgroup, address_space) {
+            (Some(c), Some(a)) => Some(c.min(a)),
+            (c, a) => c.or(a),
+        };
         match (physical, cgroup) {
             (None, None) => MemoryBudget {
                 bytes: FALLBACK_BUDGET,
                 source: BudgetSource::Fallback,
             },
-            (p, c) => MemoryBudget {
-                bytes: p.unwrap_or(u64::MAX).min(c.unwrap_or(u64::MAX)) / 2,
+            (p, Some(c)) if p.is_none_or(|p| c < p) => MemoryBudget {
+                bytes: c / 2,
+                source: BudgetSource::HalfOfLimit,
+            },
+            (p, _) => MemoryBudget {
+                bytes: p.unwrap_or(u64::MAX) / 2,
                 source: BudgetSource::HalfOfPhysical,
             },
         }
@@ -399,6 +506,9 @@ impl MemoryBudget {
     fn describe(&self) -> String {
         let why = match self.source {
             BudgetSource::HalfOfPhysical => "half of physical memory; --memory-limit overrides",
+            BudgetSource::HalfOfLimit => {
+                "half of the process's memory limit (cgroup or ulimit -v); --memory-limit overrides"
+            }
             BudgetSource::Fallback => {
                 "physical memory unknown, fixed default; --memory-limit overrides"
             }
@@ -406,6 +516,64 @@ impl MemoryBudget {
         };
         format!("{} ({why})", format_bytes(self.bytes))
     }
+}
+
+thread_local! {
+    /// The budget counts read from files, edits and flags are held to on this thread before
+    /// anything is built from them ([`check_build`]); `None` until set or first asked.
+    static BUILD_BUDGET: std::cell::Cell<Option<MemoryBudget>> = const { std::cell::Cell::new(None) };
+}
+
+/// The budget [`check_build`] holds counts to on this thread: the one set by
+/// [`set_build_budget`] (each command sets its `--memory-limit`), else the machine's default.
+///
+/// It is kept per thread rather than passed down because the counts that must pass it sit deep
+/// in parsers and edit constructors (an ERBS `from` in a nested local, a `to_erbs` edit) that
+/// take no budget; one checkpoint per construction, reached from every entry, is what makes
+/// "nothing is built before the budget" hold for all of them.
+#[must_use]
+pub fn build_budget() -> MemoryBudget {
+    BUILD_BUDGET.with(|b| match b.get() {
+        Some(budget) => budget,
+        None => {
+            let budget = MemoryBudget::machine_default();
+            b.set(Some(budget));
+            budget
+        }
+    })
+}
+
+/// Sets the budget [`check_build`] uses on this thread; returns the previous one.
+pub fn set_build_budget(budget: MemoryBudget) -> Option<MemoryBudget> {
+    BUILD_BUDGET.with(|b| b.replace(Some(budget)))
+}
+
+/// Refuses, as one line, building `what` (e.g. "1000000000000 local curves of degree 3") when
+/// its `bytes` exceed the build budget. Called with counts from a file, an edit, a script or the
+/// command line before anything is allocated for them.
+pub fn check_build(what: impl std::fmt::Display, bytes: u128) -> Result<(), String> {
+    let budget = build_budget();
+    if bytes > u128::from(budget.bytes) {
+        return Err(format!(
+            "{what} need about {} to build, over the memory budget of {}",
+            format_bytes(u64::try_from(bytes).unwrap_or(u64::MAX)),
+            budget.describe()
+        ));
+    }
+    Ok(())
+}
+
+/// The soft "Max address space" limit in bytes from /proc/self/limits text; `None` when
+/// unlimited or unreadable.
+fn address_space_limit(limits: &str) -> Option<u64> {
+    let line = limits
+        .lines()
+        .find(|l| l.starts_with("Max address space"))?;
+    line["Max address space".len()..]
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()
 }
 
 /// `MemTotal` in bytes from /proc/meminfo text.
@@ -527,22 +695,26 @@ mod tests {
             degree: vec![degree],
             rational: false,
             erbs_locals: None,
+            nested: Vec::new(),
         }
     }
 
     #[test]
     fn issue_example_is_dominated_by_the_hermite_tables() {
         // Degree 60, 5 000 000 samples, 20 derivatives: 5e6 × 21 × 61 f64 = 51.24e9 B of
-        // tables plus 5e6 × 21 × 24 B of samples.
+        // tables (plus each sample's parameter and span) and 5e6 × 21 × 24 B of samples.
         let e = estimate(
             &curve(60, 5_000_000),
             SampleMode::Derivatives(20),
             Uses::default(),
         );
         assert_eq!(e.parts[0].what, "Hermite tables");
-        assert_eq!(e.parts[0].bytes, 5_000_000 * 21 * 61 * 8);
+        assert_eq!(e.parts[0].bytes, 5_000_000 * (21 * 61 * 8 + 16));
         assert_eq!(e.parts[1].bytes, 5_000_000 * 21 * 24);
-        assert_eq!(e.bytes(), 5_000_000 * 21 * 61 * 8 + 5_000_000 * 21 * 24);
+        assert_eq!(
+            e.bytes(),
+            5_000_000 * (21 * 61 * 8 + 16) + 5_000_000 * 21 * 24
+        );
         assert!(
             e.describe()
                 .contains("5000000 samples × 21 derivative orders × 61 basis functions"),
@@ -559,7 +731,7 @@ mod tests {
             Uses::default(),
         );
         let tables = e.parts.iter().find(|p| p.what == "Hermite tables").unwrap();
-        assert_eq!(tables.bytes, 1000 * 4 * 4 * 8);
+        assert_eq!(tables.bytes, 1000 * (4 * 4 * 8 + 16));
     }
 
     #[test]
@@ -569,6 +741,7 @@ mod tests {
             degree: vec![3, 3],
             rational: true,
             erbs_locals: None,
+            nested: Vec::new(),
         };
         let e = estimate(
             &s,
@@ -593,6 +766,7 @@ mod tests {
             degree: vec![3, 3],
             rational: false,
             erbs_locals: None,
+            nested: Vec::new(),
         };
         let uses = Uses {
             gpu: true,
@@ -625,6 +799,29 @@ mod tests {
         assert!(parse_size("G").is_err());
         assert!(parse_size("0").is_err());
         assert!(parse_size("-1G").is_err());
+    }
+
+    #[test]
+    fn address_space_limit_is_read_from_proc_limits() {
+        let limited = "Limit                     Soft Limit           Hard Limit           Units     \nMax address space         2147483648           unlimited            bytes     \n";
+        assert_eq!(address_space_limit(limited), Some(2 << 30));
+        let unlimited =
+            "Max address space         unlimited            unlimited            bytes     \n";
+        assert_eq!(address_space_limit(unlimited), None);
+    }
+
+    #[test]
+    fn builds_over_the_build_budget_are_refused_in_one_line() {
+        let before = set_build_budget(MemoryBudget::from_flag(Some(1 << 20)));
+        let refused = check_build("3 things", 2 << 20);
+        let fits = check_build("3 things", 1 << 20);
+        if let Some(b) = before {
+            set_build_budget(b);
+        }
+        let e = refused.unwrap_err();
+        assert!(e.starts_with("3 things need about 2.0 MiB"), "{e}");
+        assert!(!e.contains('\n'));
+        assert_eq!(fits, Ok(()));
     }
 
     #[test]

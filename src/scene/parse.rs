@@ -4,6 +4,7 @@ use super::json::*;
 use super::{Scene, SceneError, SceneObject};
 use crate::model::Model;
 use crate::model::file::opt;
+use crate::profile::{LOAD_PROGRESS_AFTER, Progress};
 use serde::Deserialize;
 use serde_json::Value;
 use std::collections::HashMap;
@@ -120,7 +121,9 @@ impl<'de> serde::de::Visitor<'de> for ObjectsSeed<'_> {
         // Name → index, so that uniqueness costs one hash per object, not a scan of all before
         // it.
         let mut names: HashMap<String, usize> = HashMap::new();
+        let progress = Progress::delayed("parsing", None, LOAD_PROGRESS_AFTER).unit("objects");
         while let Some(item) = seq.next_element::<Value>()? {
+            progress.inc(1);
             let i = objects.len();
             let obj = parse_object(i, &item).map_err(|e| fail(self.failed, e))?;
             if let Some(j) = names.insert(obj.name.clone(), i) {
@@ -134,6 +137,9 @@ impl<'de> serde::de::Visitor<'de> for ObjectsSeed<'_> {
             }
             objects.push(obj);
         }
+        // Cleared, not left: the load's progress is transient, and an error that follows
+        // must stand on its own line.
+        drop(progress);
         Ok(objects)
     }
 

@@ -7,6 +7,8 @@ mod common;
 #[path = "../oracle/mod.rs"]
 mod oracle;
 
+mod budget_accuracy;
+mod budget_counts;
 mod cli_errors;
 mod cli_spline_errors;
 mod curvature_maps;

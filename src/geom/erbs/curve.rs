@@ -250,6 +250,18 @@ impl ErbsCurve {
         Self::with_locals(knots, local, bfunction)
     }
 
+    /// Bytes [`ErbsCurve::from_curve`] allocates for `n` locals of degree `degree`, from the
+    /// types it builds: per local the enum, d + 1 points and 2(d + 1) knots, plus the ERBS knot
+    /// vector. Saturates; for the memory budget before anything is built.
+    #[must_use]
+    pub fn from_curve_bytes(n: usize, degree: usize) -> u128 {
+        let d1 = degree as u128 + 1;
+        let per_local = std::mem::size_of::<LocalCurve>() as u128
+            + d1 * std::mem::size_of::<DVec3>() as u128
+            + 2 * d1 * std::mem::size_of::<f64>() as u128;
+        n as u128 * (per_local + std::mem::size_of::<f64>() as u128)
+    }
+
     pub fn knots(&self) -> &ErbsKnots {
         &self.knots
     }

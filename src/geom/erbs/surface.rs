@@ -274,6 +274,21 @@ impl ErbsSurface {
         Self::with_locals(knots, local, bfunction)
     }
 
+    /// Bytes [`ErbsSurface::from_surface`] allocates for `count` patches of degree `degree`,
+    /// from the types it builds: per patch the enum, (du + 1)(dv + 1) points and 2(du + 1) +
+    /// 2(dv + 1) knots, plus the two ERBS knot vectors. Saturates; for the memory budget before
+    /// anything is built.
+    #[must_use]
+    pub fn from_surface_bytes(count: [usize; 2], degree: [usize; 2]) -> u128 {
+        let [d1u, d1v] = degree.map(|d| d as u128 + 1);
+        let f64_bytes = std::mem::size_of::<f64>() as u128;
+        let per_patch = std::mem::size_of::<LocalPatch>() as u128
+            + d1u * d1v * std::mem::size_of::<DVec3>() as u128
+            + 2 * (d1u + d1v) * f64_bytes;
+        let patches = count[0] as u128 * count[1] as u128;
+        patches.saturating_mul(per_patch) + (count[0] as u128 + count[1] as u128) * f64_bytes
+    }
+
     pub fn knots(&self) -> &[ErbsKnots; 2] {
         &self.knots
     }

@@ -13,6 +13,7 @@ use crate::model::controls::{ControlDisplay, Grip};
 use crate::model::edit::EditError;
 use crate::model::{MAX_CURVE_SAMPLES, check_samples};
 use crate::sampling::SampleMode;
+use crate::sampling::budget::check_build;
 use glam::{DMat4, DVec3};
 use serde_json::{Map, Value};
 use std::fmt::Debug;
@@ -199,7 +200,14 @@ impl ErbsNet for ErbsCurve {
         bf: BFunctionKind,
     ) -> Result<Self, GeomError> {
         match local {
-            LocalCurve::Spline { curve, .. } => ErbsCurve::from_curve(curve, n, degree, bf, false),
+            LocalCurve::Spline { curve, .. } => {
+                check_build(
+                    format_args!("{n} local curves of degree {degree}"),
+                    ErbsCurve::from_curve_bytes(n, degree),
+                )
+                .map_err(|e| GeomError::new("to_erbs", e))?;
+                ErbsCurve::from_curve(curve, n, degree, bf, false)
+            }
             LocalCurve::Erbs(_) => Err(GeomError::new("to_erbs", "already an ERBS local")),
         }
     }

@@ -16,6 +16,7 @@ use crate::model::file::{
     surface_samples, usize_pair, with,
 };
 use crate::model::spline::file::{point_grid_text, spline_curve, spline_surface};
+use crate::sampling::budget::check_build;
 use glam::DMat4;
 use serde_json::{Map, Value};
 use std::fmt::Write;
@@ -67,6 +68,11 @@ pub fn erbs_curve(
         )?;
         check_degree(at, "local_degree", d)?;
         check_count(at, "local_curves", "", n)?;
+        check_build(
+            format_args!("{n} local curves of degree {d}"),
+            ErbsCurve::from_curve_bytes(n, d),
+        )
+        .map_err(|e| at.err("local_curves", e))?;
         ErbsCurve::from_curve(&c, n, d, bf, closed).map_err(|e| geom(at, e))?
     } else {
         check_fields(at, obj, &with(outer, &CURVE_FIELDS))?;
@@ -196,6 +202,14 @@ pub fn erbs_surface(
         check_degree(at, "local_degree", degree[0].max(degree[1]))?;
         check_count(at, "local_patches", "u direction: ", count[0])?;
         check_count(at, "local_patches", "v direction: ", count[1])?;
+        check_build(
+            format_args!(
+                "{}×{} local patches of degree [{}, {}]",
+                count[0], count[1], degree[0], degree[1]
+            ),
+            ErbsSurface::from_surface_bytes(count, degree),
+        )
+        .map_err(|e| at.err("local_patches", e))?;
         return ErbsSurface::from_surface(&s, count, degree, bf, closed).map_err(|e| geom(at, e));
     }
     check_fields(at, obj, &with(outer, &CURVE_FIELDS))?;
@@ -214,7 +228,7 @@ pub fn erbs_surface(
     })?;
     let mut knots = Vec::with_capacity(2);
     for (dir, name) in ["u", "v"].into_iter().enumerate() {
-        let k = as_f64_list(at, "knots", format!("{name} knot"), &kv[dir])?;
+        let k = as_f64_list(at, "knots", format_args!("{name} knot"), &kv[dir])?;
         let k = if closed[dir] {
             ErbsKnots::closed(k, count[dir])
         } else {
@@ -633,7 +647,7 @@ fn affine(at: &At, v: &Value) -> Result<DMat4, SceneError> {
     }
     let mut m = [[0.0; 4]; 4];
     for (r, row) in rows.iter().enumerate() {
-        let vals = as_f64_list(at, "transform", format!("row {r} entry"), row)?;
+        let vals = as_f64_list(at, "transform", format_args!("row {r} entry"), row)?;
         if vals.len() != 4 {
             return Err(at.err(
                 "transform",

@@ -13,6 +13,7 @@ use crate::model::check_surface_samples;
 use crate::model::controls::{ControlDisplay, Grip};
 use crate::model::edit::EditError;
 use crate::sampling::SampleMode;
+use crate::sampling::budget::check_build;
 use glam::{DMat4, DVec3};
 use serde_json::{Map, Value};
 use std::fmt::Debug;
@@ -210,6 +211,14 @@ impl ErbsNet for ErbsSurface {
     ) -> Result<Self, GeomError> {
         match local {
             LocalPatch::Spline { surface, .. } => {
+                check_build(
+                    format_args!(
+                        "{}×{} local patches of degree [{}, {}]",
+                        count[0], count[1], degree[0], degree[1]
+                    ),
+                    ErbsSurface::from_surface_bytes(count, degree),
+                )
+                .map_err(|e| GeomError::new("to_erbs", e))?;
                 ErbsSurface::from_surface(surface, count, degree, bf, [false, false])
             }
             LocalPatch::Erbs(_) => Err(GeomError::new("to_erbs", "already an ERBS local")),

@@ -436,11 +436,11 @@ fn curve2_from_json(at: &At, k: usize, v: &Value) -> Result<Curve2, SceneError> 
             ));
         }
     };
-    let degree = as_usize(at, "obj", format!("{what} degree"), need("degree")?)?;
+    let degree = as_usize(at, "obj", format_args!("{what} degree"), need("degree")?)?;
     let vertices = as_array(at, "obj", need("vertices")?)?
         .iter()
         .enumerate()
-        .map(|(i, x)| as_usize(at, "obj", format!("{what} vertex {i}"), x))
+        .map(|(i, x)| as_usize(at, "obj", format_args!("{what} vertex {i}"), x))
         .collect::<Result<_, _>>()?;
     let parm = floats(at, &format!("{what} parm"), need("parm")?)?;
     let body = match c.get("body") {
@@ -493,7 +493,7 @@ fn body_from_json(at: &At, what: &str, items: &[Value]) -> Result<Vec<Body>, Sce
             let (mut curves, mut points) = (Vec::new(), Vec::new());
             if keyword == "sp" {
                 for (i, x) in args.iter().enumerate() {
-                    points.push(as_usize(at, "obj", format!("{what} sp {i}"), x)?);
+                    points.push(as_usize(at, "obj", format_args!("{what} sp {i}"), x)?);
                 }
             } else {
                 for (i, x) in args.iter().enumerate() {
@@ -547,10 +547,10 @@ fn curve_ref_from_json(at: &At, what: &str, v: &Value) -> Result<CurveRef, Scene
     match v.as_array().map(Vec::as_slice) {
         Some([u0, u1, k]) => Ok(CurveRef {
             range: [
-                as_f64(at, "obj", format!("{what} u0"), u0)?,
-                as_f64(at, "obj", format!("{what} u1"), u1)?,
+                as_f64(at, "obj", format_args!("{what} u0"), u0)?,
+                as_f64(at, "obj", format_args!("{what} u1"), u1)?,
             ],
-            curve: as_usize(at, "obj", format!("{what} curve"), k)?,
+            curve: as_usize(at, "obj", format_args!("{what} curve"), k)?,
         }),
         _ => Err(at.err(
             "obj",
@@ -563,6 +563,6 @@ fn floats(at: &At, what: &str, v: &Value) -> Result<Vec<f64>, SceneError> {
     as_array(at, "obj", v)?
         .iter()
         .enumerate()
-        .map(|(i, x)| as_f64(at, "obj", format!("{what} value {i}"), x))
+        .map(|(i, x)| as_f64(at, "obj", format_args!("{what} value {i}"), x))
         .collect()
 }

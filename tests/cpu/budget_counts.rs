@@ -1,0 +1,158 @@
+//! Issue 25.2: every count from a file, an edit or the command line passes the memory budget
+//! before anything is built from it. Each command runs under `ulimit -v` (so an allocation
+//! made before the check aborts the process, as it did: "memory allocation of … failed",
+//! SIGABRT) and must instead exit 1 with one line naming the object and field.
+
+use crate::common::Scratch;
+use std::process::Command;
+
+/// Address-space limit of the child (KiB): room for the program, far below the counts.
+const ULIMIT_KIB: u64 = 4 << 20;
+
+const ERBS_CURVE_FROM: &str = r#"{"objects":[{"name":"e","type":"erbs_curve","samples":50,"from":{"type":"bezier_curve","points":[[0,0,0],[1,1,0],[2,0,0]]},"local_curves":1000000000000,"local_degree":3}]}"#;
+const ERBS_SURFACE_FROM: &str = r#"{"objects":[{"name":"s","type":"erbs_surface","samples":[10,10],"from":{"type":"bezier_surface","points":[[[0,0,0],[1,0,0]],[[0,1,0],[1,1,1]]]},"local_patches":[1000000,1000000],"local_degree":[2,2]}]}"#;
+/// A `from` inside a local of an ERBS curve: the nested construction is held to the budget too.
+const NESTED_FROM: &str = r#"{"objects":[{"name":"n","type":"erbs_curve","samples":50,"knots":[0,1,2],"local":[{"points":[[0,0,0],[1,0,0]]},{"type":"erbs_curve","from":{"type":"bezier_curve","points":[[0,0,0],[1,1,0]]},"local_curves":1000000000000,"local_degree":2}]}]}"#;
+const SMALL_ERBS_SURFACE: &str = r#"{"objects":[{"name":"s","type":"erbs_surface","samples":[10,10],"from":{"type":"bezier_surface","points":[[[0,0,0],[1,0,0]],[[0,1,0],[1,1,1]]]},"local_patches":[3,3],"local_degree":[2,2]}]}"#;
+const TO_ERBS: &str = r#"[{"object":"s","local":[0,0],"to_erbs":{"local_patches":[100000,100000],"local_degree":[2,2]}}]"#;
+
+/// Runs `prespline ARGS` under the address-space limit; returns (exit code, stdout, stderr).
+fn run_limited(dir: &Scratch, args: &[&str]) -> (Option<i32>, String, String) {
+    let bin = env!("CARGO_BIN_EXE_prespline");
+    let out = Command::new("sh")
+        .arg("-c")
+        .arg(format!("ulimit -v {ULIMIT_KIB} && exec \"$0\" \"$@\""))
+        .arg(bin)
+        .args(args)
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn expect_one_line(dir: &Scratch, args: &[&str], parts: &[&str]) {
+    let (code, stdout, stderr) = run_limited(dir, args);
+    assert_eq!(
+        code,
+        Some(1),
+        "{args:?}: expected exit 1, got {code:?}: {stderr}"
+    );
+    assert!(stdout.is_empty(), "{args:?}: output on stdout: {stdout}");
+    assert_eq!(
+        stderr.lines().count(),
+        1,
+        "{args:?}: expected one line:\n{stderr}"
+    );
+    assert!(stderr.starts_with("error: "), "{stderr}");
+    for p in parts {
+        assert!(stderr.contains(p), "{args:?}: {stderr:?} lacks {p:?}");
+    }
+}
+
+/// sample, render and convert on one scene file, each refused in one line.
+fn every_command(scene: &str, parts: &[&str]) {
+    let dir = Scratch::new("budget-counts");
+    dir.file("scene.json", scene);
+    expect_one_line(&dir, &["sample", "scene.json"], parts);
+    expect_one_line(
+        &dir,
+        &["render", "scene.json", "--size", "8x8", "--out", "x.png"],
+        parts,
+    );
+    expect_one_line(&dir, &["convert", "scene.json", "out.obj"], parts);
+    assert!(!dir.path().join("x.png").exists() && !dir.path().join("out.obj").exists());
+}
+
+#[test]
+fn erbs_curve_from_with_huge_local_count_is_refused_before_building() {
+    every_command(
+        ERBS_CURVE_FROM,
+        &["object 'e'", "field 'local_curves'", "memory budget"],
+    );
+}
+
+#[test]
+fn erbs_surface_from_with_huge_local_count_is_refused_before_building() {
+    every_command(
+        ERBS_SURFACE_FROM,
+        &["object 's'", "field 'local_patches'", "memory budget"],
+    );
+}
+
+#[test]
+fn nested_erbs_from_with_huge_local_count_is_refused_before_building() {
+    every_command(
+        NESTED_FROM,
+        &[
+            "object 'n'",
+            "local[1]",
+            "field 'local_curves'",
+            "memory budget",
+        ],
+    );
+}
+
+#[test]
+fn to_erbs_edit_with_huge_local_count_is_refused_before_building() {
+    let dir = Scratch::new("budget-counts");
+    dir.file("scene.json", SMALL_ERBS_SURFACE);
+    dir.file("edits.json", TO_ERBS);
+    let parts = ["object 's'", "field 'to_erbs'", "memory budget"];
+    expect_one_line(
+        &dir,
+        &["sample", "scene.json", "--edits", "edits.json"],
+        &parts,
+    );
+    expect_one_line(
+        &dir,
+        &[
+            "render",
+            "scene.json",
+            "--edits",
+            "edits.json",
+            "--size",
+            "8x8",
+            "--out",
+            "x.png",
+        ],
+        &parts,
+    );
+}
+
+#[test]
+fn a_count_under_the_limit_but_over_the_memory_limit_flag_is_refused() {
+    // 3·10⁷ locals fit the address space of the test machine, not a 64 MiB budget: the flag,
+    // not only the machine, bounds what a file may build.
+    let dir = Scratch::new("budget-counts");
+    dir.file(
+        "scene.json",
+        &ERBS_CURVE_FROM.replace("1000000000000", "30000000"),
+    );
+    expect_one_line(
+        &dir,
+        &["sample", "scene.json", "--memory-limit", "64M"],
+        &["field 'local_curves'", "64.0 MiB (--memory-limit)"],
+    );
+    // Negative control: a modest count builds and samples.
+    dir.file(
+        "small.json",
+        &ERBS_CURVE_FROM.replace("1000000000000", "40"),
+    );
+    let (code, stdout, stderr) = run_limited(&dir, &["sample", "small.json"]);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(stdout.starts_with("{\"objects\""));
+}
+
+#[test]
+fn bench_frame_counts_pass_the_budget() {
+    let dir = Scratch::new("budget-counts");
+    expect_one_line(
+        &dir,
+        &["bench", "--frames", "1000000000000", "--out", "b"],
+        &["--frames 1000000000000", "memory budget"],
+    );
+}
