@@ -561,18 +561,17 @@ fn scene_writes_are_fsynced_before_the_rename() {
 fn structural_edits_over_the_memory_budget_are_refused() {
     use prespline::cli::render::DRAW_USES;
     use prespline::sampling::SampleMode;
-    use prespline::sampling::budget::check_scene;
 
     let scratch = common::Scratch::new("view-session");
     let mut v = Viewer::new(scratch.join("saved.json"));
     let before = v.scene();
-    let now = check_scene(
-        &before,
-        SampleMode::Render,
-        DRAW_USES,
-        &MemoryBudget::from_flag(Some(u64::MAX)),
-    )
-    .expect("an unlimited budget");
+    let now = before
+        .check_budget(
+            SampleMode::Render,
+            DRAW_USES,
+            &MemoryBudget::from_flag(Some(u64::MAX)),
+        )
+        .expect("an unlimited budget");
     // Exactly what the scene takes now: any growth is over it.
     v.session
         .set_memory_budget(MemoryBudget::from_flag(Some(now)));

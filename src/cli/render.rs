@@ -9,7 +9,7 @@ use crate::render::maps::SurfaceMap;
 use crate::render::offscreen::{Shot, render_document};
 use crate::render::{OrbitCamera, ViewOptions};
 use crate::sampling::SampleMode;
-use crate::sampling::budget::{MemoryBudget, check_scene};
+use crate::sampling::budget::MemoryBudget;
 use crate::scene::{EditList, Scene};
 use std::path::Path;
 use std::time::Instant;
@@ -38,7 +38,8 @@ pub use crate::render::{DRAW_USES, validation_mode};
 /// Refuses a scene whose pre-evaluation and GPU mirrors would not fit `budget` (one line naming
 /// the object and the estimate).
 pub fn check_drawable(scene: &Scene, path: &Path, budget: &MemoryBudget) -> Result<(), CliError> {
-    check_scene(scene, SampleMode::Render, DRAW_USES, budget)
+    scene
+        .check_budget(SampleMode::Render, DRAW_USES, budget)
         .map(|_| ())
         .map_err(|e| CliError::in_file(path, e))
 }
@@ -85,7 +86,8 @@ pub fn check_analysis(
     budget: &MemoryBudget,
 ) -> Result<(), CliError> {
     if let Some(m) = map.filter(|m| m.needs_curvature()) {
-        check_scene(scene, SampleMode::Analysis, DRAW_USES, budget)
+        scene
+            .check_budget(SampleMode::Analysis, DRAW_USES, budget)
             .map_err(|e| CliError(format!("--analysis {}: {e}", m.name())))?;
     }
     Ok(())

@@ -7,7 +7,7 @@ use super::applied::Applied;
 use super::document::Document;
 use super::undo::{UndoStack, UndoStep};
 use crate::model::{Edit, EditError, merge_edits};
-use crate::sampling::budget::{Extent, MemoryBudget, Uses, check_extents, check_scene};
+use crate::sampling::budget::{Extent, MemoryBudget, Uses, check_extents};
 use crate::sampling::{DirtyRegion, SampleMode};
 use crate::scene::{EditList, Scene, SceneError};
 use std::time::Instant;
@@ -63,7 +63,7 @@ impl Editor {
     /// Pre-evaluates `scene` after checking that it fits the budget (one line naming the
     /// object otherwise).
     pub fn new(scene: &Scene, options: EditorOptions) -> Result<Self, String> {
-        check_scene(scene, options.mode, options.uses, &options.budget)?;
+        scene.check_budget(options.mode, options.uses, &options.budget)?;
         Ok(Self {
             doc: Document::with_mode(scene, options.mode),
             undo: UndoStack::default(),
@@ -134,13 +134,8 @@ impl Editor {
         edit.edit.validate(model)?;
         let mut grown = model.to_model();
         grown.apply(&edit.edit)?;
-        let mut extents: Vec<(&str, Extent)> = self
-            .doc
-            .objects
-            .iter()
-            .map(|o| (o.name.as_str(), Extent::of_ref(o.sampled.model())))
-            .collect();
-        extents[edit.object].1 = Extent::of(&grown);
+        let mut extents = self.extents();
+        extents[edit.object].1 = grown.kind().extent();
         let o = &self.options;
         check_extents(&extents, o.mode, o.uses, &o.budget).map_err(Refused::OverBudget)?;
         self.undo.record(&self.doc, &edit);
@@ -228,6 +223,15 @@ impl Editor {
         self.applied.extend(report);
     }
 
+    /// Every object's name and budget extent, read from the models in place.
+    fn extents(&self) -> Vec<(&str, Extent)> {
+        self.doc
+            .objects
+            .iter()
+            .map(|o| (o.name.as_str(), o.sampled.model().kind().extent()))
+            .collect()
+    }
+
     /// Undoes the last step (exact prior values); its label, or `None` with nothing to undo.
     pub fn undo(&mut self) -> Option<String> {
         let (label, edits) = self.undo.undo()?;
@@ -257,8 +261,8 @@ impl Editor {
     pub fn set_surface_mode(&mut self, mode: SampleMode) -> Result<(), String> {
         self.flush();
         if mode == SampleMode::Analysis && self.options.mode != SampleMode::Analysis {
-            check_scene(
-                &self.doc.to_scene(),
+            check_extents(
+                &self.extents(),
                 mode,
                 self.options.uses,
                 &self.options.budget,

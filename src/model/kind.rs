@@ -7,6 +7,7 @@ use super::edit::{EditError, KindEdit, Target};
 use super::registry::{Model, ModelRef, ObjectEdit, SampledObject};
 use super::{Index2, LocalPath};
 use crate::format::{At, SceneError};
+use crate::sampling::budget::Extent;
 use crate::sampling::{DirtyRegion, PartialSet, SampleGrid, SampleMode, Sampler, Tracked};
 use glam::DVec3;
 use serde_json::{Map, Value};
@@ -15,7 +16,7 @@ use std::fmt::Debug;
 /// An object kind: its model type (this trait's implementor), its edits and its sampler.
 pub trait Kind: Clone + Debug + PartialEq + Sized + 'static {
     type Edit: KindEdit<Model = Self>;
-    type Sampler: Sampler<Model = Self, Edit = Self::Edit> + Clone + Debug;
+    type Sampler: Sampler<Model = Self, Edit = Self::Edit> + Support + Clone + Debug;
 
     /// Whether the samples form a surface grid (else a curve).
     const SURFACE: bool;
@@ -76,6 +77,10 @@ pub trait Kind: Clone + Debug + PartialEq + Sized + 'static {
         None
     }
 
+    /// What the memory budget needs to know of the object (samples, degrees, rational, ERBS
+    /// locals).
+    fn extent(&self) -> Extent;
+
     /// What is drawn and picked besides the samples: the control polygon or net, or the
     /// polynomial locals of an ERBS object.
     fn controls(&self) -> ControlDisplay;
@@ -123,6 +128,7 @@ pub trait DynKind {
     fn validate(&self, edit: &ObjectEdit) -> Result<(), EditError>;
     fn inverse(&self, edit: &ObjectEdit) -> Result<ObjectEdit, EditError>;
     fn controls(&self) -> ControlDisplay;
+    fn extent(&self) -> Extent;
     fn write(&self, out: &mut String);
     fn read_edit(&self, at: &At, obj: &Map<String, Value>) -> Result<ObjectEdit, SceneError>;
     fn derivatives_at(
@@ -203,6 +209,10 @@ where
 
     fn controls(&self) -> ControlDisplay {
         Kind::controls(self)
+    }
+
+    fn extent(&self) -> Extent {
+        Kind::extent(self)
     }
 
     fn write(&self, out: &mut String) {
@@ -292,9 +302,25 @@ pub trait DynSampler {
     fn support(&self, target: Target) -> Vec<DirtyRegion>;
 }
 
+/// The samples whose values edits of a target can change, known before any is applied: I_k
+/// (× I_l on surfaces) of a control point or its weight, an ERBS local's support at any depth,
+/// the segments a chain point reaches; the whole grid for a structural target or an index the
+/// object does not have. (A first weight that makes a polynomial object rational re-samples it
+/// whole once: its values outside the support stay the shape's.) The renderer keeps this out
+/// of its static layer for a gesture.
+pub trait Support {
+    fn support(&self, target: Target) -> Vec<DirtyRegion>;
+}
+
+impl<S: Support> Support for Tracked<S> {
+    fn support(&self, target: Target) -> Vec<DirtyRegion> {
+        self.inner().support(target)
+    }
+}
+
 impl<S> DynSampler for Tracked<S>
 where
-    S: Sampler,
+    S: Sampler + Support,
     S::Edit: KindEdit<Model = S::Model>,
     S::Model: Kind<Edit = S::Edit>,
     for<'a> ModelRef<'a>: From<&'a S::Model>,
@@ -336,7 +362,7 @@ where
     }
 
     fn support(&self, target: Target) -> Vec<DirtyRegion> {
-        Sampler::support(self, target)
+        Support::support(self, target)
     }
 }
 

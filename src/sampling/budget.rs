@@ -10,8 +10,6 @@
 
 use super::object::SampleMode;
 use crate::geom::erbs::{ErbsCurve, ErbsSurface, LocalCurve, LocalPatch};
-use crate::model::{Model, ModelRef};
-use crate::scene::Scene;
 use std::fmt::Write;
 
 /// Bytes of one f64 / `DVec3` / `DVec4` / f32.
@@ -44,51 +42,28 @@ pub struct Extent {
 }
 
 impl Extent {
-    /// The extent of an object's model.
+    /// A Bézier, B-spline or NURBS object (or one evaluated as such) of these degrees.
     #[must_use]
-    pub fn of(model: &Model) -> Self {
-        Self::of_ref(model.as_ref())
+    pub fn polynomial(samples: &[usize], degree: &[usize], rational: bool) -> Self {
+        Extent {
+            samples: samples.to_vec(),
+            degree: degree.to_vec(),
+            rational,
+            erbs_locals: None,
+            nested: Vec::new(),
+        }
     }
 
-    /// The extent of a borrowed model.
+    /// An ERBS curve sampled `m` times.
     #[must_use]
-    pub fn of_ref(model: ModelRef<'_>) -> Self {
-        let samples = match model.sample_dims() {
-            [m, 1] if !model.is_surface() => vec![m],
-            dims => dims.to_vec(),
-        };
-        match model {
-            ModelRef::Curve(m) => Extent {
-                samples,
-                degree: vec![m.curve().degree()],
-                rational: m.curve().is_rational(),
-                erbs_locals: None,
-                nested: Vec::new(),
-            },
-            ModelRef::CatmullRom(_) => Extent {
-                samples,
-                degree: vec![3],
-                rational: false,
-                erbs_locals: None,
-                nested: Vec::new(),
-            },
-            ModelRef::BezierSpline(m) => Extent {
-                samples,
-                degree: vec![m.spline().degree()],
-                rational: false,
-                erbs_locals: None,
-                nested: Vec::new(),
-            },
-            ModelRef::Surface(m) => Extent {
-                samples,
-                degree: m.surface().degree().to_vec(),
-                rational: m.surface().is_rational(),
-                erbs_locals: None,
-                nested: Vec::new(),
-            },
-            ModelRef::ErbsCurve(m) => erbs_curve_extent(m.curve(), samples[0]),
-            ModelRef::ErbsSurface(m) => erbs_surface_extent(m.surface(), [samples[0], samples[1]]),
-        }
+    pub fn erbs_curve(c: &ErbsCurve, m: usize) -> Self {
+        erbs_curve_extent(c, m)
+    }
+
+    /// An ERBS surface sampled `dims`.
+    #[must_use]
+    pub fn erbs_surface(s: &ErbsSurface, dims: [usize; 2]) -> Self {
+        erbs_surface_extent(s, dims)
     }
 
     fn is_surface(&self) -> bool {
@@ -583,23 +558,11 @@ fn mem_total(meminfo: &str) -> Option<u64> {
     kib.checked_mul(1024)
 }
 
-/// Refuses, as one line naming the object, a scene whose objects do not fit `budget`
-/// together; returns the estimated total otherwise.
-pub fn check_scene(
-    scene: &Scene,
-    mode: SampleMode,
-    uses: Uses,
-    budget: &MemoryBudget,
-) -> Result<u64, String> {
-    let extents: Vec<(&str, Extent)> = scene
-        .objects
-        .iter()
-        .map(|o| (o.name.as_str(), Extent::of(&o.model)))
-        .collect();
-    check_extents(&extents, mode, uses, budget)
-}
-
-/// As [`check_scene`] for objects given by name and extent (a document with one object about
+/// Refuses, as one line naming the object, objects given by name and extent that do not fit
+/// `budget` together (a scene's, or a document's with one object about to change, without
+/// copying any model); returns the estimated total otherwise.
+///
+/// Objects given by name and extent (a document with one object about
 /// to change, say, without copying any model).
 pub fn check_extents(
     objects: &[(&str, Extent)],

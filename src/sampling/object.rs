@@ -2,7 +2,6 @@
 
 use super::dirty::DirtyRegion;
 use super::grid::{PartialSet, SampleGrid};
-use crate::model::Target;
 
 /// What to keep per sample.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -54,14 +53,6 @@ pub trait Sampler {
 
     /// Full sampling from the pre-evaluated data.
     fn full(&mut self) -> DirtyRegion;
-
-    /// The samples whose values edits of `target` can change, known before any is applied:
-    /// I_k (× I_l on surfaces) of a control point or its weight, an ERBS local's support at
-    /// any depth, the segments a chain point reaches; the whole grid for a structural target
-    /// or an index the object does not have. (A first weight that makes a polynomial object
-    /// rational re-samples it whole once: its values outside the support stay the shape's.)
-    /// The renderer keeps this out of its static layer for a gesture.
-    fn support(&self, target: Target) -> Vec<DirtyRegion>;
 }
 
 /// Exact rebuild of the touched region after this many incremental edits, so rounding in the
@@ -77,6 +68,14 @@ pub struct Tracked<S> {
     pub interval: Option<usize>,
     edits_since_rebuild: usize,
     touched: DirtyRegion,
+}
+
+impl<S> Tracked<S> {
+    /// The sampler inside, for queries that do not change it.
+    #[must_use]
+    pub fn inner(&self) -> &S {
+        &self.sampler
+    }
 }
 
 impl<S: Sampler> Tracked<S> {
@@ -136,9 +135,5 @@ impl<S: Sampler> Sampler for Tracked<S> {
         self.touched = DirtyRegion::NOTHING;
         self.edits_since_rebuild = 0;
         self.sampler.full()
-    }
-
-    fn support(&self, target: Target) -> Vec<DirtyRegion> {
-        self.sampler.support(target)
     }
 }

@@ -70,6 +70,22 @@ impl Scene {
             .map_err(|e| SceneError(format!("cannot write {}: {e}", path.display())))
     }
 
+    /// Refuses, as one line naming the object, a scene whose objects do not fit `budget`
+    /// together; returns the estimated total otherwise.
+    pub fn check_budget(
+        &self,
+        mode: crate::sampling::SampleMode,
+        uses: crate::sampling::budget::Uses,
+        budget: &crate::sampling::budget::MemoryBudget,
+    ) -> Result<u64, String> {
+        let extents: Vec<(&str, crate::sampling::budget::Extent)> = self
+            .objects
+            .iter()
+            .map(|o| (o.name.as_str(), o.model.kind().extent()))
+            .collect();
+        crate::sampling::budget::check_extents(&extents, mode, uses, budget)
+    }
+
     pub fn find(&self, name: &str) -> Option<usize> {
         self.objects.iter().position(|o| o.name == name)
     }

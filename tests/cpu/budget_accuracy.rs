@@ -6,7 +6,7 @@
 
 use prespline::editor::{Editor, EditorOptions};
 use prespline::sampling::SampleMode;
-use prespline::sampling::budget::{MemoryBudget, Uses, check_scene};
+use prespline::sampling::budget::{MemoryBudget, Uses};
 use prespline::scene::{Scene, parse_scene};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
@@ -58,7 +58,7 @@ fn live() -> i64 {
 fn estimate_and_held(scene: &Scene, mode: SampleMode) -> (u64, i64) {
     let uses = Uses::default();
     let budget = MemoryBudget::from_flag(Some(u64::MAX / 2));
-    let estimate = check_scene(scene, mode, uses, &budget).unwrap();
+    let estimate = scene.check_budget(mode, uses, &budget).unwrap();
     let before = live();
     // Pre-evaluation on this thread alone: the counter is per thread.
     let doc = prespline::parallel::on_one_thread(|| {

@@ -16,6 +16,7 @@ use crate::model::points::{PointEdit, check_index, check_vector};
 use crate::model::registry::Model;
 use crate::model::{CurveModel, Index2, MAX_CURVE_SAMPLES, SplineForm, check_samples};
 use crate::sampling::SampleMode;
+use crate::sampling::budget::Extent;
 use glam::DVec3;
 use sampler::ChainCurveSampler;
 use serde_json::{Map, Value};
@@ -363,6 +364,11 @@ impl Kind for CatmullRomModel {
         Some((self.spline.breakpoints(), self.spline.closed()))
     }
 
+    /// Cubic segments.
+    fn extent(&self) -> Extent {
+        Extent::polynomial(&[self.samples], &[3], false)
+    }
+
     /// The interpolated points.
     fn controls(&self) -> ControlDisplay {
         ControlDisplay::polygon(self.spline.points().to_vec())
@@ -440,6 +446,10 @@ impl Kind for BezierSplineModel {
 
     fn junctions(&self) -> Option<(Vec<f64>, bool)> {
         Some((self.spline.knots().to_vec(), false))
+    }
+
+    fn extent(&self) -> Extent {
+        Extent::polynomial(&[self.samples], &[self.spline.degree()], false)
     }
 
     /// Bézier points, or the de Boor polygon of splines edited through it (their Bézier points

@@ -64,7 +64,9 @@ impl<E: ChainEdit> Sampler for ChainCurveSampler<E> {
     fn full(&mut self) -> DirtyRegion {
         self.chain.full()
     }
+}
 
+impl<E: ChainEdit> crate::model::kind::Support for ChainCurveSampler<E> {
     /// The segments around every chain point a move of the handle reaches, as disjoint runs
     /// (a closed Catmull–Rom spline's first point reaches both ends).
     fn support(&self, target: Target) -> Vec<DirtyRegion> {

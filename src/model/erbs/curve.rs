@@ -13,6 +13,7 @@ use crate::model::controls::{ControlDisplay, Grip};
 use crate::model::edit::EditError;
 use crate::model::{MAX_CURVE_SAMPLES, check_samples};
 use crate::sampling::SampleMode;
+use crate::sampling::budget::Extent;
 use crate::sampling::budget::check_build;
 use glam::{DMat4, DVec3};
 use serde_json::{Map, Value};
@@ -89,6 +90,10 @@ impl Kind for ErbsCurveModel {
         out: &mut [DVec3],
     ) {
         out.copy_from_slice(&self.curve.derivatives(u, order));
+    }
+
+    fn extent(&self) -> Extent {
+        Extent::erbs_curve(&self.curve, self.samples)
     }
 
     fn controls(&self) -> ControlDisplay {

@@ -409,7 +409,9 @@ impl Sampler for ErbsCurveSampler {
         self.level = Self::level(&self.model, self.level.order);
         DirtyRegion::curve(0..self.level.axis.len())
     }
+}
 
+impl crate::model::kind::Support for ErbsCurveSampler {
     fn support(&self, target: Target) -> Vec<DirtyRegion> {
         let path = match target {
             Target::Local(path) => path.to_curve(),

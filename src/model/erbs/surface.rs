@@ -13,6 +13,7 @@ use crate::model::check_surface_samples;
 use crate::model::controls::{ControlDisplay, Grip};
 use crate::model::edit::EditError;
 use crate::sampling::SampleMode;
+use crate::sampling::budget::Extent;
 use crate::sampling::budget::check_build;
 use glam::{DMat4, DVec3};
 use serde_json::{Map, Value};
@@ -93,6 +94,10 @@ impl Kind for ErbsSurfaceModel {
         for (slot, &(a, b)) in list.iter().enumerate() {
             out[slot] = p.get(a, b);
         }
+    }
+
+    fn extent(&self) -> Extent {
+        Extent::erbs_surface(&self.surface, self.samples)
     }
 
     fn controls(&self) -> ControlDisplay {

@@ -997,7 +997,9 @@ impl Sampler for ErbsSurfaceSampler {
             }
         }
     }
+}
 
+impl crate::model::kind::Support for ErbsSurfaceSampler {
     fn support(&self, target: EditTarget) -> Vec<DirtyRegion> {
         let path = match target {
             EditTarget::Local(path) => path.to_surface(),

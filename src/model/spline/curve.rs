@@ -11,6 +11,7 @@ use crate::model::edit::{EditError, KindEdit, Target, check_shape_kept};
 use crate::model::points::PointEdit;
 use crate::model::{MAX_CURVE_SAMPLES, MAX_DEGREE, SplineForm, check_samples};
 use crate::sampling::SampleMode;
+use crate::sampling::budget::Extent;
 use glam::DVec3;
 use serde_json::{Map, Value};
 
@@ -106,6 +107,11 @@ impl Kind for CurveModel {
         out: &mut [DVec3],
     ) {
         out.copy_from_slice(&self.curve.derivatives(u, order));
+    }
+
+    fn extent(&self) -> Extent {
+        let c = &self.curve;
+        Extent::polynomial(&[self.samples], &[c.degree()], c.is_rational())
     }
 
     fn controls(&self) -> ControlDisplay {

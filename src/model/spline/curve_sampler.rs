@@ -204,7 +204,9 @@ impl Sampler for SplineCurveSampler {
             .then(|| vec![DVec4::ZERO; self.grid.data.len()]);
         self.rebuild_range(0..self.table.len())
     }
+}
 
+impl crate::model::kind::Support for SplineCurveSampler {
     fn support(&self, target: Target) -> Vec<DirtyRegion> {
         let range = match target {
             Target::Point(Index2::One(k)) | Target::Weight(Index2::One(k)) => {

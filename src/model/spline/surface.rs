@@ -12,6 +12,7 @@ use crate::model::edit::{EditError, KindEdit, Target, check_shape_kept};
 use crate::model::points::PointEdit;
 use crate::model::{SplineForm, check_surface_samples};
 use crate::sampling::SampleMode;
+use crate::sampling::budget::Extent;
 use glam::DVec3;
 use serde_json::{Map, Value};
 
@@ -119,6 +120,11 @@ impl Kind for SurfaceModel {
         for (slot, &(a, b)) in list.iter().enumerate() {
             out[slot] = p.get(a, b);
         }
+    }
+
+    fn extent(&self) -> Extent {
+        let s = &self.surface;
+        Extent::polynomial(&self.samples, &s.degree(), s.is_rational())
     }
 
     fn controls(&self) -> ControlDisplay {

@@ -295,7 +295,9 @@ impl Sampler for SplineSurfaceSampler {
         let [mu, mv] = self.grid.dims;
         self.rebuild_rect(0..mu, 0..mv)
     }
+}
 
+impl crate::model::kind::Support for SplineSurfaceSampler {
     fn support(&self, target: Target) -> Vec<DirtyRegion> {
         let rect = match target {
             Target::Point(Index2::Two(k, l)) | Target::Weight(Index2::Two(k, l)) => {
