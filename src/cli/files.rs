@@ -57,6 +57,7 @@ impl SamplesArg {
 
 impl SampleOverride {
     /// The last `N` and the last `NxM` win.
+    #[must_use]
     pub fn from_args(args: &[SamplesArg]) -> Self {
         let mut o = Self::default();
         for a in args {

@@ -74,6 +74,7 @@ pub enum Handle {
 }
 
 impl Handle {
+    #[must_use]
     pub fn object(&self) -> usize {
         match *self {
             Handle::Point { object, .. } | Handle::LocalPoint { object, .. } => object,
@@ -165,6 +166,7 @@ impl Document {
 
     /// The weight of a control point (1 for polynomial objects), or `None` for handles that
     /// have no weight (ERBS local points, Catmull–Rom and Bézier spline handles).
+    #[must_use]
     pub fn weight_of(&self, handle: Handle) -> Option<f64> {
         let model = self.objects.get(handle.object())?.sampled.model();
         model.kind().weight(handle.grip())
@@ -198,6 +200,7 @@ impl Document {
     }
 
     /// Bounds of every sample and control point.
+    #[must_use]
     pub fn bounds(&self) -> Bounds {
         let mut b = Bounds::EMPTY;
         for (i, o) in self.objects.iter().enumerate() {
@@ -214,6 +217,7 @@ impl Document {
 
     /// Every pickable control point of object `i` with its position: the points its control
     /// display draws (no sampling: cheap).
+    #[must_use]
     pub fn handles(&self, i: usize) -> Vec<(Handle, DVec3)> {
         self.objects[i]
             .controls
@@ -224,6 +228,7 @@ impl Document {
     }
 
     /// Every pickable control point of the document.
+    #[must_use]
     pub fn all_handles(&self) -> Vec<(Handle, DVec3)> {
         (0..self.objects.len())
             .flat_map(|i| self.handles(i))
@@ -231,6 +236,7 @@ impl Document {
     }
 
     /// The edit that moves a handle by `delta` (`None` if the handle does not fit its object).
+    #[must_use]
     pub fn move_handle(&self, handle: Handle, delta: DVec3) -> Option<Edit> {
         let model = self.objects.get(handle.object())?.sampled.model();
         let edit = model.kind().move_edit(handle.grip(), delta)?;
@@ -241,6 +247,7 @@ impl Document {
     }
 
     /// Every control point of the ERBS local at `local`, at any depth.
+    #[must_use]
     pub fn local_points(&self, object: usize, local: LocalPath<Index2>) -> Option<Vec<DVec3>> {
         let points: Vec<DVec3> = match self.objects.get(object)?.sampled.model() {
             ModelRef::ErbsCurve(c) => {
@@ -264,6 +271,7 @@ impl Document {
 
     /// The edit that sets the ERBS local at `local` exactly to its state in `origin` mapped
     /// by `matrix` (a transform taken from a gesture's start rather than by increments).
+    #[must_use]
     pub fn set_local_transformed(
         object: usize,
         local: LocalPath<Index2>,
@@ -298,6 +306,7 @@ impl Document {
     }
 
     /// The edit that maps an ERBS local curve or patch by the affine `matrix`.
+    #[must_use]
     pub fn transform_local(
         &self,
         object: usize,

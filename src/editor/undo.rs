@@ -32,6 +32,7 @@ impl UndoStack {
         });
     }
 
+    #[must_use]
     pub fn is_open(&self) -> bool {
         self.open.is_some()
     }
@@ -95,6 +96,7 @@ impl UndoStack {
         Some((label, edits))
     }
 
+    #[must_use]
     pub fn depth(&self) -> (usize, usize) {
         (self.done.len(), self.undone.len())
     }

@@ -23,6 +23,7 @@ impl At {
 }
 
 /// Describes a JSON value's kind for messages.
+#[must_use]
 pub fn kind(v: &Value) -> &'static str {
     match v {
         Value::Null => "null",

@@ -19,6 +19,7 @@ pub struct HermiteMatrix {
 impl HermiteMatrix {
     /// M_{d,i}(t) for `span` i (as returned by FindSpan), built with the paper's factorisation
     /// c(t) = T_1(t)…T_d(t)·c and D^r = d!/(d−r)! · T_1…T_{d−r} T'_{d−r+1}…T'_d.
+    #[must_use]
     pub fn bspline(knots: &KnotVector, degree: usize, span: usize, t: f64) -> Self {
         let mut m = vec![0.0; (degree + 1) * (degree + 1)];
         hermite_into(knots, degree, span, t, &mut m);
@@ -26,33 +27,39 @@ impl HermiteMatrix {
     }
 
     /// Bernstein-Hermite matrix for a degree-d Bézier curve on [a, b] at t.
+    #[must_use]
     pub fn bernstein(degree: usize, a: f64, b: f64, t: f64) -> Self {
         let knots = KnotVector::bezier(degree, a, b);
         Self::bspline(&knots, degree, degree, t)
     }
 
+    #[must_use]
     pub fn degree(&self) -> usize {
         self.degree
     }
 
     /// The span index i this matrix was evaluated for; column k multiplies control point i−d+k.
+    #[must_use]
     pub fn span(&self) -> usize {
         self.span
     }
 
     /// Entry (r, k): r-th derivative of the k-th active basis function.
     #[inline]
+    #[must_use]
     pub fn get(&self, r: usize, k: usize) -> f64 {
         self.m[r * (self.degree + 1) + k]
     }
 
     /// Row r: r-th derivatives of the active basis functions.
+    #[must_use]
     pub fn row(&self, r: usize) -> &[f64] {
         let w = self.degree + 1;
         &self.m[r * w..(r + 1) * w]
     }
 
     /// Row-major storage, (d+1)² values.
+    #[must_use]
     pub fn as_slice(&self) -> &[f64] {
         &self.m
     }
@@ -142,6 +149,7 @@ pub fn hermite_rows_into(
 const STACK_SCRATCH: usize = 15 * 17;
 
 /// BasisFuns (NURBS Book A2.2): the d+1 non-vanishing basis functions N_{i−d..=i, d}(t).
+#[must_use]
 pub fn basis_funs(knots: &[f64], degree: usize, span: usize, t: f64) -> Vec<f64> {
     let d = degree;
     let mut n = vec![0.0; d + 1];
@@ -164,6 +172,7 @@ pub fn basis_funs(knots: &[f64], degree: usize, span: usize, t: f64) -> Vec<f64>
 
 /// DersBasisFuns (NURBS Book A2.3): `ders[k][j]` is the k-th derivative of N_{i−d+j, d} at t,
 /// for k = 0..=n_ders (rows above the degree are zero).
+#[must_use]
 pub fn ders_basis_funs(
     knots: &[f64],
     degree: usize,

@@ -52,22 +52,27 @@ impl BezierCurve {
         Ok(self)
     }
 
+    #[must_use]
     pub fn degree(&self) -> usize {
         self.points.len() - 1
     }
 
+    #[must_use]
     pub fn points(&self) -> &[DVec3] {
         &self.points
     }
 
+    #[must_use]
     pub fn weights(&self) -> Option<&[f64]> {
         self.weights.as_deref()
     }
 
+    #[must_use]
     pub fn interval(&self) -> (f64, f64) {
         self.interval
     }
 
+    #[must_use]
     pub fn is_rational(&self) -> bool {
         self.weights.is_some()
     }
@@ -95,6 +100,7 @@ impl BezierCurve {
     }
 
     /// Homogeneous control points (w_i C_i, w_i); weight 1 for polynomial curves.
+    #[must_use]
     pub fn homogeneous_points(&self) -> Vec<DVec4> {
         homogeneous(&self.points, self.weights.as_deref())
     }
@@ -105,6 +111,7 @@ impl BezierCurve {
     }
 
     /// C(t) by de Casteljau's algorithm (on homogeneous points when rational).
+    #[must_use]
     pub fn eval(&self, t: f64) -> DVec3 {
         let s = self.local(t);
         match &self.weights {
@@ -117,6 +124,7 @@ impl BezierCurve {
     }
 
     /// C(t), C'(t), …, C^(n)(t) through the Bernstein-Hermite matrix (quotient rule if rational).
+    #[must_use]
     pub fn derivatives(&self, t: f64, n: usize) -> Vec<DVec3> {
         let d = self.degree();
         let (a, b) = self.interval;
@@ -153,6 +161,7 @@ impl BezierCurve {
 
     /// Degree elevation by one: the same curve with one more control point,
     /// Q_i = i/(n+1) P_{i−1} + (1 − i/(n+1)) P_i (in homogeneous space when rational).
+    #[must_use]
     pub fn elevate_degree(&self) -> BezierCurve {
         let p = self.homogeneous_points();
         let n = p.len() - 1;
@@ -168,6 +177,7 @@ impl BezierCurve {
 
     /// The hodograph C'(t) as a Bézier curve of one degree less (polynomial curves only):
     /// n/(b−a) (P_{i+1} − P_i).
+    #[must_use]
     pub fn hodograph(&self) -> Option<BezierCurve> {
         if self.is_rational() || self.points.len() < 2 {
             return None;
@@ -187,6 +197,7 @@ impl BezierCurve {
     }
 
     /// The same curve as a B-spline with the Bézier knot vector {a^(n+1), b^(n+1)}.
+    #[must_use]
     pub fn to_bspline(&self) -> BSplineCurve {
         let (a, b) = self.interval;
         let knots = KnotVector::bezier(self.degree(), a, b);

@@ -45,6 +45,7 @@ impl BFunctionKind {
     ];
 
     /// The name used in scene files.
+    #[must_use]
     pub fn name(self) -> &'static str {
         match self {
             Self::ExpoRational => "expo",
@@ -56,6 +57,7 @@ impl BFunctionKind {
     }
 
     /// Parses a scene-file name.
+    #[must_use]
     pub fn from_name(name: &str) -> Option<Self> {
         Self::ALL.into_iter().find(|k| k.name() == name)
     }

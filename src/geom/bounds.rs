@@ -21,10 +21,12 @@ impl Bounds {
         self.max = self.max.max(p);
     }
 
+    #[must_use]
     pub fn is_empty(&self) -> bool {
         self.min.x > self.max.x
     }
 
+    #[must_use]
     pub fn centre(&self) -> DVec3 {
         if self.is_empty() {
             DVec3::ZERO
@@ -34,6 +36,7 @@ impl Bounds {
     }
 
     /// Radius of the bounding sphere around the centre (at least a tiny positive value).
+    #[must_use]
     pub fn radius(&self) -> f64 {
         if self.is_empty() {
             1.0

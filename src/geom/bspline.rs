@@ -56,32 +56,39 @@ impl BSplineCurve {
         }
     }
 
+    #[must_use]
     pub fn degree(&self) -> usize {
         self.degree
     }
 
+    #[must_use]
     pub fn knots(&self) -> &KnotVector {
         &self.knots
     }
 
+    #[must_use]
     pub fn points(&self) -> &[DVec3] {
         &self.points
     }
 
+    #[must_use]
     pub fn weights(&self) -> Option<&[f64]> {
         self.weights.as_deref()
     }
 
+    #[must_use]
     pub fn is_rational(&self) -> bool {
         self.weights.is_some()
     }
 
     /// [t_d, t_n].
+    #[must_use]
     pub fn domain(&self) -> (f64, f64) {
         self.knots.domain(self.degree, self.points.len())
     }
 
     /// FindSpan for this curve.
+    #[must_use]
     pub fn find_span(&self, t: f64) -> usize {
         self.knots.find_span(self.degree, self.points.len(), t)
     }
@@ -141,11 +148,13 @@ impl BSplineCurve {
     }
 
     /// Homogeneous control points (w_i c_i, w_i); weight 1 for polynomial curves.
+    #[must_use]
     pub fn homogeneous_points(&self) -> Vec<DVec4> {
         homogeneous(&self.points, self.weights.as_deref())
     }
 
     /// c(t) by de Boor's algorithm.
+    #[must_use]
     pub fn eval(&self, t: f64) -> DVec3 {
         match &self.weights {
             None => de_boor(&self.knots, self.degree, &self.points, t),
@@ -158,6 +167,7 @@ impl BSplineCurve {
 
     /// c(t), c'(t), …, c^(n)(t) through the B-spline-Hermite matrix M_{d,i}(t) (at a knot: the
     /// right limit, as FindSpan gives).
+    #[must_use]
     pub fn derivatives(&self, t: f64, n: usize) -> Vec<DVec3> {
         self.one_sided_derivatives(t, n, false)
     }
@@ -165,6 +175,7 @@ impl BSplineCurve {
     /// Limits of c, c', …, c^(n) as the parameter approaches t from the left (`from_left`) or
     /// the right: the polynomial of the span on that side evaluated at t. At an interior knot of
     /// multiplicity m the two differ from order d − m + 1 on in general; elsewhere they agree.
+    #[must_use]
     pub fn one_sided_derivatives(&self, t: f64, n: usize, from_left: bool) -> Vec<DVec3> {
         let d = self.degree;
         let (a, b) = self.domain();
@@ -193,6 +204,7 @@ impl BSplineCurve {
     /// The same derivatives by a second, independent route: derivative control points
     /// (CurveDerivCpts, NURBS Book A3.3) evaluated with de Boor's algorithm. Slower; used to
     /// cross-check the Hermite path.
+    #[must_use]
     pub fn derivatives_de_boor(&self, t: f64, n: usize) -> Vec<DVec3> {
         match &self.weights {
             None => derivs_by_control_points(&self.knots, self.degree, &self.points, t, n),

@@ -33,6 +33,7 @@ impl Parametrization {
     ];
 
     /// The scene-file name.
+    #[must_use]
     pub fn name(self) -> &'static str {
         match self {
             Parametrization::Uniform => "uniform",
@@ -41,6 +42,7 @@ impl Parametrization {
         }
     }
 
+    #[must_use]
     pub fn from_name(name: &str) -> Option<Self> {
         Self::ALL.into_iter().find(|p| p.name() == name)
     }
@@ -99,19 +101,23 @@ impl CatmullRom {
         Ok(c)
     }
 
+    #[must_use]
     pub fn points(&self) -> &[DVec3] {
         &self.points
     }
 
+    #[must_use]
     pub fn parametrization(&self) -> Parametrization {
         self.parametrization
     }
 
+    #[must_use]
     pub fn closed(&self) -> bool {
         self.closed
     }
 
     /// Number of cubic segments: one per pair of consecutive points (and the closing pair).
+    #[must_use]
     pub fn segments(&self) -> usize {
         if self.closed {
             self.points.len()
@@ -121,6 +127,7 @@ impl CatmullRom {
     }
 
     /// [0, segments].
+    #[must_use]
     pub fn domain(&self) -> (f64, f64) {
         (0.0, self.segments() as f64)
     }
@@ -210,6 +217,7 @@ impl CatmullRom {
 
     /// Bézier point q (0..=3) of segment s: C_0 = P_s, C_1 = P_s + T_s/3, C_2 = P_{s+1} −
     /// T_{s+1}/3, C_3 = P_{s+1} (T scaled by the segment's interval).
+    #[must_use]
     pub fn bezier_point(&self, s: usize, q: usize) -> DVec3 {
         let j = s as isize;
         match q {
@@ -221,6 +229,7 @@ impl CatmullRom {
     }
 
     /// All 3·segments + 1 Bézier points, junctions shared (closed: the last equals the first).
+    #[must_use]
     pub fn bezier_points(&self) -> Vec<DVec3> {
         let mut out = Vec::with_capacity(3 * self.segments() + 1);
         for s in 0..self.segments() {
@@ -233,6 +242,7 @@ impl CatmullRom {
     }
 
     /// Bézier point `i` of [`bezier_points`](Self::bezier_points).
+    #[must_use]
     pub fn bezier_point_at(&self, i: usize) -> DVec3 {
         let n = self.segments();
         if i == 3 * n {
@@ -245,6 +255,7 @@ impl CatmullRom {
     /// Indices of the Bézier points that moving point j can change: those of segments
     /// j−2 … j+1 (cyclically when closed), at most 4 segments; for a closed spline both copies
     /// of the first point.
+    #[must_use]
     pub fn bezier_points_of(&self, j: usize) -> Vec<usize> {
         let n = self.segments() as isize;
         let mut out = Vec::with_capacity(14);
@@ -272,11 +283,13 @@ impl CatmullRom {
     }
 
     /// The spline as a cubic B-spline with triple interior knots at 1, 2, … (its Bézier form).
+    #[must_use]
     pub fn to_bspline(&self) -> BSplineCurve {
         bezier_chain_bspline(3, &self.breakpoints(), self.bezier_points())
     }
 
     /// Segment boundaries 0, 1, …, segments.
+    #[must_use]
     pub fn breakpoints(&self) -> Vec<f64> {
         (0..=self.segments()).map(|s| s as f64).collect()
     }
@@ -284,6 +297,7 @@ impl CatmullRom {
 
 /// A chain of degree-d Bézier segments over `breaks` (strictly increasing) sharing their
 /// junction points, as a B-spline with knots of multiplicity d at the junctions.
+#[must_use]
 pub fn bezier_chain_bspline(degree: usize, breaks: &[f64], points: Vec<DVec3>) -> BSplineCurve {
     let k = breaks.len() - 1;
     debug_assert_eq!(points.len(), k * degree + 1);

@@ -24,6 +24,7 @@ pub struct JoinClass {
 impl JoinClass {
     /// The badge text: "C2", "C1", "C1 G2", "G2", "G1", "G0", or "gap" when the positions
     /// differ.
+    #[must_use]
     pub fn label(&self) -> &'static str {
         match (self.connected, self.parametric, self.geometric) {
             (false, _, _) => "gap",
@@ -40,6 +41,7 @@ impl JoinClass {
 /// Classifies a join from the left and right limits of c, c', c'' (`left[r]`, `right[r]`).
 /// `size` is a length scale of the curve (its extent): values below 1e-12·size count as zero,
 /// so exact zeros from cancellation do not decide a class.
+#[must_use]
 pub fn classify(left: [DVec3; 3], right: [DVec3; 3], size: f64) -> JoinClass {
     let tol = JOIN_TOLERANCE;
     let floor = 1e-12 * size.max(f64::MIN_POSITIVE);
@@ -70,6 +72,7 @@ pub fn classify(left: [DVec3; 3], right: [DVec3; 3], size: f64) -> JoinClass {
 }
 
 /// κ·n̂ = (c' × c'') × c' / |c'|⁴, independent of the parameterisation.
+#[must_use]
 pub fn curvature_vector(d1: DVec3, d2: DVec3) -> DVec3 {
     let s2 = d1.length_squared();
     if s2 == 0.0 {

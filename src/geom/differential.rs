@@ -15,6 +15,7 @@ pub struct FrenetFrame {
 /// Frame from C', C'', C''': t = C'/|C'|, b = C'×C''/|C'×C''|, n = b × t,
 /// κ = |C'×C''|/|C'|³, τ = (C'×C'')·C'''/|C'×C''|². `None` where C' vanishes or C' ∥ C''
 /// (straight pieces and inflections have no osculating plane).
+#[must_use]
 pub fn frenet_frame(d1: DVec3, d2: DVec3, d3: DVec3) -> Option<FrenetFrame> {
     let speed = d1.length();
     let c = d1.cross(d2);
@@ -34,6 +35,7 @@ pub fn frenet_frame(d1: DVec3, d2: DVec3, d3: DVec3) -> Option<FrenetFrame> {
 }
 
 /// Curvature κ = |C'×C''|/|C'|³ (0 where C' vanishes).
+#[must_use]
 pub fn curvature(d1: DVec3, d2: DVec3) -> f64 {
     let speed = d1.length();
     if speed == 0.0 {

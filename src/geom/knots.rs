@@ -97,6 +97,7 @@ impl KnotVector {
     }
 
     /// Clamped (open) knot vector with uniformly spaced interior knots over [a, b].
+    #[must_use]
     pub fn clamped_uniform(degree: usize, n: usize, a: f64, b: f64) -> Self {
         assert!(
             n > degree && a < b,
@@ -113,6 +114,7 @@ impl KnotVector {
     }
 
     /// Uniform (unclamped) knot vector t_i = a + i·(b−a)/(n+d), i = 0..=n+d.
+    #[must_use]
     pub fn uniform(degree: usize, n: usize, a: f64, b: f64) -> Self {
         assert!(n > degree && a < b, "uniform needs n > degree and a < b");
         let last = n + degree;
@@ -131,27 +133,32 @@ impl KnotVector {
 
     /// The Bézier knot vector {a^(d+1), b^(d+1)}: a single span on which the B-spline basis is
     /// the Bernstein basis on [a, b].
+    #[must_use]
     pub fn bezier(degree: usize, a: f64, b: f64) -> Self {
         let mut t = vec![a; degree + 1];
         t.extend(std::iter::repeat_n(b, degree + 1));
         Self(t)
     }
 
+    #[must_use]
     pub fn as_slice(&self) -> &[f64] {
         &self.0
     }
 
+    #[must_use]
     pub fn into_vec(self) -> Vec<f64> {
         self.0
     }
 
     /// Parameter domain [t_d, t_n] of a degree-d B-spline with n control points.
+    #[must_use]
     pub fn domain(&self, degree: usize, n: usize) -> (f64, f64) {
         (self.0[degree], self.0[n])
     }
 
     /// FindSpan (NURBS Book A2.1): the index i with t_i ≤ t < t_{i+1}, d ≤ i ≤ n−1. Parameters
     /// at or beyond t_n map to the last non-empty span, parameters below t_d to the first.
+    #[must_use]
     pub fn find_span(&self, degree: usize, n: usize, t: f64) -> usize {
         let k = &self.0;
         if t >= k[n] {
@@ -176,11 +183,13 @@ impl KnotVector {
     }
 
     /// Number of knots equal to `t`.
+    #[must_use]
     pub fn multiplicity(&self, t: f64) -> usize {
         self.0.iter().filter(|&&k| k == t).count()
     }
 
     /// Distinct knot values in the closed interval [a, b], in increasing order.
+    #[must_use]
     pub fn breakpoints(&self, a: f64, b: f64) -> Vec<f64> {
         let mut out: Vec<f64> = Vec::new();
         for &t in &self.0 {
@@ -194,6 +203,7 @@ impl KnotVector {
 
 /// `m` sample parameters uniformly over [a, b], both ends included exactly
 /// (docs/scene-format.md: samples).
+#[must_use]
 pub fn uniform_params(a: f64, b: f64, m: usize) -> Vec<f64> {
     assert!(
         m >= 2,

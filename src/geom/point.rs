@@ -60,11 +60,13 @@ impl Point for f64 {
 
 /// Lift a Euclidean point with weight `w` to homogeneous coordinates `(w·p, w)`.
 #[inline]
+#[must_use]
 pub fn to_homogeneous(p: DVec3, w: f64) -> DVec4 {
     (p * w).extend(w)
 }
 
 /// Homogeneous control points (w_i P_i, w_i); weight 1 for polynomial objects.
+#[must_use]
 pub fn homogeneous(points: &[DVec3], weights: Option<&[f64]>) -> Vec<DVec4> {
     match weights {
         Some(w) => points
@@ -77,6 +79,7 @@ pub fn homogeneous(points: &[DVec3], weights: Option<&[f64]>) -> Vec<DVec4> {
 }
 
 /// Binomial coefficient C(n, k) as f64 (exact for the small n used in derivative rules).
+#[must_use]
 pub fn binomial(n: usize, k: usize) -> f64 {
     if k > n {
         return 0.0;

@@ -36,6 +36,7 @@ pub struct ShapeChange {
 impl ShapeChange {
     /// The largest movement allowed: [`SHAPE_TOLERANCE`] of the size, or the rounding of the
     /// coordinates where that is larger.
+    #[must_use]
     pub fn tolerance(&self) -> f64 {
         (SHAPE_TOLERANCE * self.size).max(COORDINATE_ROUNDING * self.magnitude)
     }
@@ -50,6 +51,7 @@ impl ShapeChange {
     }
 
     /// Moved by at most [`ShapeChange::tolerance`]; a NaN anywhere counts as moved.
+    #[must_use]
     pub fn is_kept(&self) -> bool {
         self.moved <= self.tolerance()
     }

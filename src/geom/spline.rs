@@ -44,6 +44,7 @@ impl JoinContinuity {
         JoinContinuity::C2,
     ];
 
+    #[must_use]
     pub fn name(self) -> &'static str {
         match self {
             JoinContinuity::C0 => "C0",
@@ -53,6 +54,7 @@ impl JoinContinuity {
         }
     }
 
+    #[must_use]
     pub fn from_name(name: &str) -> Option<Self> {
         Self::ALL.into_iter().find(|c| c.name() == name)
     }
@@ -158,27 +160,33 @@ impl BezierSpline {
         Ok(s)
     }
 
+    #[must_use]
     pub fn degree(&self) -> usize {
         self.degree
     }
 
+    #[must_use]
     pub fn knots(&self) -> &[f64] {
         &self.knots
     }
 
+    #[must_use]
     pub fn points(&self) -> &[DVec3] {
         &self.points
     }
 
+    #[must_use]
     pub fn continuity(&self) -> JoinContinuity {
         self.continuity
     }
 
     /// Number of segments k.
+    #[must_use]
     pub fn segments(&self) -> usize {
         self.knots.len() - 1
     }
 
+    #[must_use]
     pub fn domain(&self) -> (f64, f64) {
         (self.knots[0], self.knots[self.segments()])
     }
@@ -194,11 +202,13 @@ impl BezierSpline {
     }
 
     /// The spline as a degree-d B-spline with knots of multiplicity d at the junctions.
+    #[must_use]
     pub fn to_bspline(&self) -> BSplineCurve {
         bezier_chain_bspline(self.degree, &self.knots, self.points.clone())
     }
 
     /// Why junction j (1 ≤ j < k) breaks the declared continuity, if it does.
+    #[must_use]
     pub fn junction_error(&self, j: usize) -> Option<String> {
         let d = self.degree;
         let jj = j * d;
@@ -258,6 +268,7 @@ impl BezierSpline {
     }
 
     /// Whether the handles are the Bézier points or de Boor points.
+    #[must_use]
     pub fn handle_kind(&self) -> Handles {
         match (self.continuity, self.degree) {
             (JoinContinuity::C1, 2) | (JoinContinuity::C2, 3) => Handles::DeBoor,
@@ -266,6 +277,7 @@ impl BezierSpline {
     }
 
     /// Number of handles.
+    #[must_use]
     pub fn handle_count(&self) -> usize {
         let k = self.segments();
         match (self.handle_kind(), self.degree) {
@@ -278,11 +290,13 @@ impl BezierSpline {
     /// The handle positions: Bézier points, or de Boor points (C1 quadratic: P_0, the inner
     /// points, P_2k; C2 cubic: the A-frame points D_0 = P_0, D_1 = P_1, D_{s+2} = P_{3s+2} +
     /// (h_{s+1}/h_s)(P_{3s+2} − P_{3s+1}), D_{k+2} = P_{3k}).
+    #[must_use]
     pub fn handles(&self) -> Vec<DVec3> {
         (0..self.handle_count()).map(|i| self.handle(i)).collect()
     }
 
     /// Handle i's position.
+    #[must_use]
     pub fn handle(&self, i: usize) -> DVec3 {
         let k = self.segments();
         let p = &self.points;

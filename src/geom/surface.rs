@@ -48,6 +48,7 @@ pub struct Partials {
 }
 
 impl Partials {
+    #[must_use]
     pub fn zeros(n: usize) -> Self {
         Self {
             n,
@@ -56,11 +57,13 @@ impl Partials {
     }
 
     /// Highest order per direction.
+    #[must_use]
     pub fn order(&self) -> usize {
         self.n
     }
 
     #[inline]
+    #[must_use]
     pub fn get(&self, a: usize, b: usize) -> DVec3 {
         self.values[a * (self.n + 1) + b]
     }
@@ -135,31 +138,38 @@ impl TensorSurface {
         Ok(self)
     }
 
+    #[must_use]
     pub fn degree(&self) -> [usize; 2] {
         self.degree
     }
 
+    #[must_use]
     pub fn knots(&self) -> &[KnotVector; 2] {
         &self.knots
     }
 
     /// [nu, nv].
+    #[must_use]
     pub fn count(&self) -> [usize; 2] {
         self.count
     }
 
+    #[must_use]
     pub fn points(&self) -> &[DVec3] {
         &self.points
     }
 
+    #[must_use]
     pub fn weights(&self) -> Option<&[f64]> {
         self.weights.as_deref()
     }
 
+    #[must_use]
     pub fn is_rational(&self) -> bool {
         self.weights.is_some()
     }
 
+    #[must_use]
     pub fn point(&self, i: usize, j: usize) -> DVec3 {
         self.points[i * self.count[1] + j]
     }
@@ -198,6 +208,7 @@ impl TensorSurface {
     }
 
     /// Homogeneous control points (w P, w), row-major.
+    #[must_use]
     pub fn homogeneous_points(&self) -> Vec<DVec4> {
         homogeneous(&self.points, self.weights.as_deref())
     }
@@ -374,6 +385,7 @@ impl TensorSurface {
     }
 
     /// Parameter domains [(u0, u1), (v0, v1)].
+    #[must_use]
     pub fn domain(&self) -> [(f64, f64); 2] {
         [
             self.knots[0].domain(self.degree[0], self.count[0]),
@@ -382,6 +394,7 @@ impl TensorSurface {
     }
 
     /// FindSpan in each direction.
+    #[must_use]
     pub fn find_spans(&self, u: f64, v: f64) -> [usize; 2] {
         [
             self.knots[0].find_span(self.degree[0], self.count[0], u),
@@ -391,6 +404,7 @@ impl TensorSurface {
 
     /// ∂^{a+b}S/∂u^a∂v^b for a, b ≤ n, as P = M_u · C · M_vᵀ with the two Hermite matrices
     /// (RatSurfaceDerivs, NURBS Book A4.4, for rational surfaces).
+    #[must_use]
     pub fn derivatives(&self, u: f64, v: f64, n: usize) -> Partials {
         let [du, dv] = self.degree;
         let [su, sv] = self.find_spans(u, v);
@@ -443,6 +457,7 @@ impl TensorSurface {
     }
 
     /// S(u, v) by de Boor's algorithm as a curve of curves (independent of the Hermite path).
+    #[must_use]
     pub fn eval(&self, u: f64, v: f64) -> DVec3 {
         let [du, dv] = self.degree;
         let [nu, nv] = self.count;
@@ -455,6 +470,7 @@ impl TensorSurface {
     }
 
     /// Unit normal at (u, v), defined everywhere; see [`normal_with_fallback`].
+    #[must_use]
     pub fn normal(&self, u: f64, v: f64) -> DVec3 {
         let p = self.derivatives(u, v, 1);
         normal_with_fallback(
@@ -473,6 +489,7 @@ impl TensorSurface {
 
     /// Gaussian and mean curvature (K, H) at (u, v) from the fundamental forms, with the normal
     /// orientation Su × Sv; `None` where the parameterisation is singular.
+    #[must_use]
     pub fn curvatures(&self, u: f64, v: f64) -> Option<(f64, f64)> {
         let p = self.derivatives(u, v, 2);
         curvatures_from_partials(&p)
@@ -481,6 +498,7 @@ impl TensorSurface {
 
 /// Gaussian and mean curvature from partials up to order (2, 2) (only Su, Sv, Suu, Suv, Svv
 /// are used).
+#[must_use]
 pub fn curvatures_from_partials(p: &Partials) -> Option<(f64, f64)> {
     let (su, sv) = (p.get(1, 0), p.get(0, 1));
     let n = regular_normal(su, sv)?;
@@ -495,6 +513,7 @@ pub fn curvatures_from_partials(p: &Partials) -> Option<(f64, f64)> {
 
 /// normalize(Su × Sv), or `None` where the cross product is negligible against |Su|·|Sv| scale
 /// (a collapsed edge, a cusp, or a vanishing derivative).
+#[must_use]
 pub fn regular_normal(su: DVec3, sv: DVec3) -> Option<DVec3> {
     let c = su.cross(sv);
     let scale = su.length_squared().max(sv.length_squared());

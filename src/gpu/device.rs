@@ -36,11 +36,13 @@ pub struct DeviceCaps {
 
 impl DeviceCaps {
     /// Whether GPU timestamps can be taken on the graphics queue.
+    #[must_use]
     pub fn timestamps(&self) -> bool {
         self.timestamp_valid_bits > 0
     }
 
     /// Whether `samples` (1, 2, 4, 8, ...) can be used for MSAA targets.
+    #[must_use]
     pub fn supports_samples(&self, samples: u32) -> bool {
         samples.is_power_of_two()
             && self
@@ -52,6 +54,7 @@ impl DeviceCaps {
     /// measurement (docs/performance.md, "Frames"): 1 on CPU rasterisers (lavapipe), where 4×
     /// multisampling multiplies the cost of every triangle's rasterisation and of the resolve,
     /// and 4 on GPUs, where it is cheap. Falls back to 1 where 4 is not supported.
+    #[must_use]
     pub fn default_samples(&self) -> u32 {
         let preferred = match self.device_type {
             vk::PhysicalDeviceType::CPU => 1,

@@ -84,6 +84,7 @@ impl Frame<'_> {
     }
 
     /// Draws and binds recorded so far in this frame.
+    #[must_use]
     pub fn stats(&self) -> DrawStats {
         self.stats
     }

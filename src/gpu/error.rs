@@ -79,6 +79,7 @@ pub enum GpuError {
 
 impl GpuError {
     /// Whether the error means the device is gone (every later call fails too).
+    #[must_use]
     pub fn is_device_lost(&self) -> bool {
         matches!(self, GpuError::DeviceLost { .. })
     }

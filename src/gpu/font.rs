@@ -173,21 +173,25 @@ impl Font {
     }
 
     /// The scale factor the atlas was built for.
+    #[must_use]
     pub fn scale_factor(&self) -> f32 {
         self.scale_factor
     }
 
     /// Metrics of `size`, in physical pixels.
+    #[must_use]
     pub fn metrics(&self, size: TextSize) -> SizeMetrics {
         self.sizes[size.index()]
     }
 
     /// The atlas: one coverage byte per texel, rows of [`Font::atlas_size`]`[0]` bytes.
+    #[must_use]
     pub fn atlas(&self) -> &[u8] {
         &self.atlas
     }
 
     /// Atlas width and height in texels.
+    #[must_use]
     pub fn atlas_size(&self) -> [u32; 2] {
         [self.width, self.height]
     }
@@ -202,6 +206,7 @@ impl Font {
 
     /// The coverage of `c` at `size`, a `cell[0] × cell[1]` bitmap, row-major: what a quad
     /// of [`Font::push_text`] shows for it.
+    #[must_use]
     pub fn glyph_cell(&self, c: char, size: TextSize) -> Vec<u8> {
         let m = self.metrics(size);
         let [cx, cy] = self.cell_origin(m, self.cell_index(c));
@@ -214,6 +219,7 @@ impl Font {
     }
 
     /// Size in pixels of `text` (which may contain `\n`) at `size`.
+    #[must_use]
     pub fn text_size(&self, text: &str, size: TextSize) -> [f32; 2] {
         let m = self.metrics(size);
         let mut widest = 0usize;
@@ -229,6 +235,7 @@ impl Font {
     }
 
     /// How many characters of `size` fit on a line `width` pixels wide.
+    #[must_use]
     pub fn chars_fitting(&self, width: f32, size: TextSize) -> usize {
         (width.max(0.0) / self.metrics(size).advance as f32).floor() as usize
     }

@@ -140,32 +140,38 @@ impl<'a> Frame<'a> {
 
     /// The frame slot this frame records into (`0..FRAMES_IN_FLIGHT`): the caller must bring
     /// this slot of each mirror up to date.
+    #[must_use]
     pub fn slot(&self) -> usize {
         self.slot
     }
 
     /// The overlay font whose atlas [`Frame::draw_overlay`] samples: lay text out with it.
+    #[must_use]
     pub fn font(&self) -> &'a Font {
         self.ctx.text
     }
 
     /// Sequential frame number (0 for the renderer's first frame).
+    #[must_use]
     pub fn number(&self) -> u64 {
         self.number
     }
 
     /// MSAA samples per pixel of the target.
+    #[must_use]
     pub fn samples(&self) -> u32 {
         self.view.samples.as_raw()
     }
 
     /// Target size in pixels.
+    #[must_use]
     pub fn extent(&self) -> [u32; 2] {
         [self.view.extent.width, self.view.extent.height]
     }
 
     /// GPU time in milliseconds of the previous frame recorded in this slot (`None` before
     /// the slot's first completion or without timestamp support).
+    #[must_use]
     pub fn gpu_time_ms(&self) -> Option<f64> {
         self.ctx.ring.slots[self.slot].gpu_ms
     }
@@ -220,16 +226,19 @@ impl<'a> Frame<'a> {
     }
 
     /// The camera of subsequent 3D draws.
+    #[must_use]
     pub fn camera(&self) -> Camera {
         self.camera
     }
 
     /// The clear colour (linear RGBA).
+    #[must_use]
     pub fn clear_color(&self) -> [f32; 4] {
         self.clear
     }
 
     /// The viewport, `[x, y, width, height]` in pixels.
+    #[must_use]
     pub fn viewport(&self) -> [u32; 4] {
         let r = self.viewport;
         [

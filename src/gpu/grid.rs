@@ -31,6 +31,7 @@ pub struct GridShape {
 
 impl GridShape {
     /// Number of vertices.
+    #[must_use]
     pub fn vertices(self) -> u64 {
         u64::from(self.rows) * u64::from(self.cols)
     }
@@ -70,6 +71,7 @@ impl GridStride {
     }
 
     /// Cells (quads) of the strided mesh over `shape`.
+    #[must_use]
     pub fn cells(self, shape: GridShape) -> u64 {
         let s = self.normalized();
         let n = |count: u32, step: u32| u64::from(count.saturating_sub(1).div_ceil(step));
@@ -84,11 +86,13 @@ impl Default for GridStride {
 }
 
 /// Triangle-list indices for all cells, two triangles per cell.
+#[must_use]
 pub fn grid_triangles(shape: GridShape) -> Vec<u32> {
     grid_triangles_strided(shape, GridStride::FULL)
 }
 
 /// Triangle-list indices for the cells of the strided mesh (see [`GridStride`]).
+#[must_use]
 pub fn grid_triangles_strided(shape: GridShape, stride: GridStride) -> Vec<u32> {
     let stride = stride.normalized();
     let cols = shape.cols;
@@ -117,6 +121,7 @@ fn iso_lines(n: u32, every: u32) -> impl Iterator<Item = u32> {
 }
 
 /// Line-list indices for isolines every `every` samples in both directions.
+#[must_use]
 pub fn grid_lines(shape: GridShape, every: u32) -> Vec<u32> {
     grid_lines_strided(shape, every, GridStride::FULL)
 }
@@ -124,6 +129,7 @@ pub fn grid_lines(shape: GridShape, every: u32) -> Vec<u32> {
 /// Isolines over the strided mesh: lines lie on rows and columns the mesh draws (the spacing
 /// `every` is rounded up to a multiple of the stride) and follow the mesh's edges, so they sit
 /// exactly on its triangles.
+#[must_use]
 pub fn grid_lines_strided(shape: GridShape, every: u32, stride: GridStride) -> Vec<u32> {
     let stride = stride.normalized();
     let (rows, cols) = (shape.rows, shape.cols);

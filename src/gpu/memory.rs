@@ -43,11 +43,13 @@ unsafe impl Send for Buffer {}
 
 impl Buffer {
     /// Requested size in bytes.
+    #[must_use]
     pub fn size(&self) -> u64 {
         self.size
     }
 
     /// GPU address (0 unless created with `SHADER_DEVICE_ADDRESS`).
+    #[must_use]
     pub fn address(&self) -> vk::DeviceAddress {
         self.address
     }

@@ -59,21 +59,25 @@ impl MirrorBuffer {
     }
 
     /// Length in f32 elements.
+    #[must_use]
     pub fn len(&self) -> usize {
         self.len
     }
 
     /// Whether the buffer holds no elements (never true: creation rejects length 0).
+    #[must_use]
     pub fn is_empty(&self) -> bool {
         self.len == 0
     }
 
     /// The Vulkan buffer handle.
+    #[must_use]
     pub fn raw(&self) -> vk::Buffer {
         self.buffer.raw
     }
 
     /// GPU address of element 0.
+    #[must_use]
     pub fn address(&self) -> vk::DeviceAddress {
         self.buffer.address()
     }
@@ -109,16 +113,19 @@ impl Mirror {
     }
 
     /// Length in f32 elements (the same for every slot).
+    #[must_use]
     pub fn len(&self) -> usize {
         self.len
     }
 
     /// Whether the mirror holds no elements (never true: creation rejects length 0).
+    #[must_use]
     pub fn is_empty(&self) -> bool {
         self.len == 0
     }
 
     /// The buffer of frame slot `slot`.
+    #[must_use]
     pub fn slot(&self, slot: usize) -> &MirrorBuffer {
         &self.slots[slot % FRAMES_IN_FLIGHT]
     }
@@ -182,11 +189,13 @@ pub struct MirrorWriter<'a> {
 
 impl MirrorWriter<'_> {
     /// Length of the slot in f32 elements.
+    #[must_use]
     pub fn len(&self) -> usize {
         self.len
     }
 
     /// Whether the slot holds no elements.
+    #[must_use]
     pub fn is_empty(&self) -> bool {
         self.len == 0
     }

@@ -137,11 +137,13 @@ impl OffscreenTarget {
     }
 
     /// Size in pixels.
+    #[must_use]
     pub fn extent(&self) -> [u32; 2] {
         [self.extent.width, self.extent.height]
     }
 
     /// MSAA sample count.
+    #[must_use]
     pub fn samples(&self) -> u32 {
         self.attachments.samples.as_raw()
     }
@@ -264,6 +266,7 @@ pub struct Pixels {
 
 impl Pixels {
     /// The RGBA value at `(x, y)`.
+    #[must_use]
     pub fn get(&self, x: u32, y: u32) -> [u8; 4] {
         let i = (y as usize * self.width as usize + x as usize) * 4;
         [

@@ -19,6 +19,7 @@ impl SurfaceGrid {
     pub const FLOATS_PER_VERTEX: usize = 6;
 
     /// Number of floats the grid occupies.
+    #[must_use]
     pub fn floats(&self) -> usize {
         self.shape.vertices() as usize * Self::FLOATS_PER_VERTEX
     }
@@ -98,6 +99,7 @@ pub struct PointRun {
 
 impl PointRun {
     /// `count` tightly packed xyz points starting at point index `first`.
+    #[must_use]
     pub fn packed(first: usize, count: usize) -> Self {
         Self {
             offset: first * 3,
@@ -108,6 +110,7 @@ impl PointRun {
 
     /// Row `row` of a row-major grid of `cols` points with `floats_per_point` floats each,
     /// starting at float `base`.
+    #[must_use]
     pub fn grid_row(base: usize, cols: usize, floats_per_point: usize, row: usize) -> Self {
         Self {
             offset: base + row * cols * floats_per_point,
@@ -117,6 +120,7 @@ impl PointRun {
     }
 
     /// Column `col` of a row-major grid of `rows × cols` points (no copy: strided access).
+    #[must_use]
     pub fn grid_column(
         base: usize,
         rows: usize,

@@ -89,16 +89,19 @@ impl Swapchain {
     }
 
     /// Current image size (0×0 before the first successful build).
+    #[must_use]
     pub fn extent(&self) -> [u32; 2] {
         [self.extent.width, self.extent.height]
     }
 
     /// Colour format of the swapchain images.
+    #[must_use]
     pub fn format(&self) -> vk::Format {
         self.format.format
     }
 
     /// Present mode in use.
+    #[must_use]
     pub fn present_mode(&self) -> vk::PresentModeKHR {
         self.present_mode
     }

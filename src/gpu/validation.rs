@@ -56,6 +56,7 @@ impl fmt::Debug for ValidationSink {
 
 impl ValidationSink {
     /// An empty sink.
+    #[must_use]
     pub fn new() -> Self {
         Self::default()
     }
@@ -66,11 +67,13 @@ impl ValidationSink {
     }
 
     /// Every message received so far.
+    #[must_use]
     pub fn messages(&self) -> Vec<ValidationMessage> {
         self.lock().clone()
     }
 
     /// The error-severity messages received so far.
+    #[must_use]
     pub fn errors(&self) -> Vec<ValidationMessage> {
         self.lock()
             .iter()
@@ -80,6 +83,7 @@ impl ValidationSink {
     }
 
     /// Removes and returns the error messages, keeping the others.
+    #[must_use]
     pub fn take_errors(&self) -> Vec<ValidationMessage> {
         let mut all = self.lock();
         let (errors, rest) = all.drain(..).partition(|m| m.severity == Severity::Error);

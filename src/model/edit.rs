@@ -104,6 +104,7 @@ pub trait KindEdit: Clone + Debug + PartialEq + Sized + IntoObject {
     }
 
     /// The edit if `e` is of this kind.
+    #[must_use]
     fn from_object(e: &ObjectEdit) -> Option<&Self> {
         Self::unwrap(e)
     }

@@ -6,6 +6,7 @@ use crate::model::ModelRef;
 use crate::sampling::{PartialSet, SampleGrid};
 
 /// Samples `model` point by point through the geometry layer's own evaluators.
+#[must_use]
 pub fn exact_grid(model: ModelRef<'_>, set: &PartialSet) -> SampleGrid {
     // Catmull–Rom and Bézier splines: the de Boor evaluation of their Bézier chain.
     if let Some(chain) = model.to_bspline_curve() {

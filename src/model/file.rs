@@ -21,18 +21,22 @@ pub fn usize_pair(at: &At, field: &str, form: &str, v: &Value) -> Result<[usize;
 }
 
 /// `outer` plus the body's own fields.
+#[must_use]
 pub fn with(outer: &[&'static str], own: &[&'static str]) -> Vec<&'static str> {
     outer.iter().chain(own).copied().collect()
 }
 
+#[must_use]
 pub fn edit(at: &At, e: EditError) -> SceneError {
     at.err(e.field, e.message)
 }
 
+#[must_use]
 pub fn opt<'a>(obj: &'a Map<String, Value>, field: &str) -> Option<&'a Value> {
     obj.get(field)
 }
 
+#[must_use]
 pub fn geom(at: &At, e: GeomError) -> SceneError {
     at.err(e.field, e.message)
 }

@@ -147,6 +147,7 @@ pub trait DynKind {
 }
 
 /// The error for an edit paired with a model of another kind.
+#[must_use]
 pub fn edit_kind_mismatch(e: &ObjectEdit, model_type: &str) -> EditError {
     EditError::new(
         "object",

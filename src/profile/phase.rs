@@ -34,6 +34,7 @@ impl Phase {
     ];
 
     /// Short lowercase name, as used in file columns and keys.
+    #[must_use]
     pub const fn name(self) -> &'static str {
         match self {
             Phase::Input => "input",
@@ -49,6 +50,7 @@ impl Phase {
 impl Phase {
     /// What the phase measures, in a few words, for the footnotes of `summary.txt` and the
     /// plots.
+    #[must_use]
     pub const fn meaning(self) -> &'static str {
         match self {
             Phase::Input => "events turned into edits",

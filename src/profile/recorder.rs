@@ -26,11 +26,13 @@ pub struct FrameRecord {
 
 impl FrameRecord {
     /// Sum of the CPU phases.
+    #[must_use]
     pub fn cpu_ms(&self) -> f64 {
         self.phase_ms.iter().map(|(_, ms)| ms).sum()
     }
 
     /// Frame time not covered by any phase (never negative).
+    #[must_use]
     pub fn other_ms(&self) -> f64 {
         (self.frame_ms - self.cpu_ms()).max(0.0)
     }
@@ -78,12 +80,14 @@ fn ms_between(from: Instant, to: Instant) -> f64 {
 
 impl Recorder {
     /// The first `warmup_frames` frames will be flagged as warm-up.
+    #[must_use]
     pub fn new(warmup_frames: usize) -> Self {
         Self::with_capacity(warmup_frames, 0)
     }
 
     /// Like [`new`](Self::new), with room for `frames` frames so that recording never
     /// reallocates when the run length is known.
+    #[must_use]
     pub fn with_capacity(warmup_frames: usize, frames: usize) -> Self {
         Recorder {
             warmup_frames,
@@ -192,20 +196,24 @@ impl Recorder {
     }
 
     /// Index of the open frame, if one is open.
+    #[must_use]
     pub fn current_frame(&self) -> Option<usize> {
         self.open.as_ref().map(|open| open.record.index)
     }
 
+    #[must_use]
     pub fn warmup_frames(&self) -> usize {
         self.warmup_frames
     }
 
     /// The ended frames, in order (`frames()[i].index == i`).
+    #[must_use]
     pub fn frames(&self) -> &[FrameRecord] {
         &self.frames
     }
 
     /// Ends the open frame, if any, and returns all frames.
+    #[must_use]
     pub fn into_frames(mut self) -> Vec<FrameRecord> {
         self.end_frame();
         self.frames

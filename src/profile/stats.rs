@@ -47,6 +47,7 @@ impl Stats {
     }
 
     /// Like [`from_values`](Self::from_values) for values already sorted ascending.
+    #[must_use]
     pub fn from_sorted(sorted: &[f64]) -> Option<Stats> {
         let (&min, &max) = (sorted.first()?, sorted.last()?);
         Some(Stats {
@@ -65,6 +66,7 @@ impl Stats {
 
 /// Nearest-rank percentile of ascending `sorted` values: the value at 1-based rank
 /// `ceil(p/100 · n)`, clamped to `1..=n`. `p` is in percent. NaN for an empty slice.
+#[must_use]
 pub fn percentile(sorted: &[f64], p: f64) -> f64 {
     if sorted.is_empty() {
         return f64::NAN;
@@ -78,6 +80,7 @@ pub fn percentile(sorted: &[f64], p: f64) -> f64 {
 
 /// Mean of the largest `ceil(fraction · n)` (at least one) of ascending `sorted` values.
 /// NaN for an empty slice.
+#[must_use]
 pub fn slowest_mean(sorted: &[f64], fraction: f64) -> f64 {
     if sorted.is_empty() {
         return f64::NAN;

@@ -68,6 +68,7 @@ pub struct Section {
 
 impl Section {
     /// `None` for no frames.
+    #[must_use]
     pub fn from_frames(frames: &[&FrameRecord]) -> Option<Section> {
         let n = frames.len();
         let frame_ms = Stats::from_values(frames.iter().map(|f| f.frame_ms))?;
@@ -115,6 +116,7 @@ pub struct Summary {
 }
 
 impl Summary {
+    #[must_use]
     pub fn from_frames(frames: &[FrameRecord]) -> Summary {
         let (warmup, measured): (Vec<&FrameRecord>, Vec<&FrameRecord>) =
             frames.iter().partition(|f| f.warmup);
@@ -145,6 +147,7 @@ impl SummaryFile {
     pub const FORMAT: &str = "prespline-profile-summary";
     pub const VERSION: u32 = 1;
 
+    #[must_use]
     pub fn new(run: &RunInfo, summary: &Summary) -> Self {
         SummaryFile {
             format: Self::FORMAT.into(),
@@ -157,6 +160,7 @@ impl SummaryFile {
 }
 
 /// `summary.json` as a pretty-printed string.
+#[must_use]
 pub fn summary_json(run: &RunInfo, summary: &Summary) -> String {
     // Serialising plain structs of strings, numbers and maps with string keys cannot fail.
     serde_json::to_string_pretty(&SummaryFile::new(run, summary))

@@ -92,6 +92,7 @@ pub(super) fn human_count(count: f64) -> String {
 impl Summary {
     /// Terminal table of the measured frames (times in ms): frame, each phase, "other" and
     /// GPU, then bytes and samples per frame and a warm-up line. Ends with a newline.
+    #[must_use]
     pub fn table(&self) -> String {
         let Some(m) = &self.measured else {
             let mut out = format!("no measured frames ({} frames, all warm-up)\n", self.frames);
@@ -145,6 +146,7 @@ impl Summary {
 impl Summary {
     /// The content of `summary.txt`: [`table`](Self::table), a blank line, then
     /// [`definitions`].
+    #[must_use]
     pub fn report(&self) -> String {
         format!("{}\n{}", self.table(), definitions())
     }
@@ -152,6 +154,7 @@ impl Summary {
 
 /// What the rows and columns of [`Summary::table`] mean, one name per line:
 /// `delta    edits applied to the samples`.
+#[must_use]
 pub fn definitions() -> String {
     let mut rows: Vec<(&str, &str)> = Phase::ALL.map(|p| (p.name(), p.meaning())).to_vec();
     rows.extend([

@@ -27,6 +27,7 @@ pub enum CurveEval<'a> {
 
 impl<'a> CurveEval<'a> {
     /// The curve of a curve model; `None` for surfaces.
+    #[must_use]
     pub fn of(model: ModelRef<'a>) -> Option<Self> {
         use std::borrow::Cow;
         Some(match model {
@@ -52,6 +53,7 @@ impl<'a> CurveEval<'a> {
         })
     }
 
+    #[must_use]
     pub fn domain(&self) -> (f64, f64) {
         match self {
             CurveEval::BSpline { curve, .. } => curve.domain(),
@@ -60,6 +62,7 @@ impl<'a> CurveEval<'a> {
     }
 
     /// c, c', …, c^(n) at t (the right limit at a knot).
+    #[must_use]
     pub fn derivatives(&self, t: f64, n: usize) -> Vec<DVec3> {
         match self {
             CurveEval::BSpline { curve, .. } => curve.derivatives(t, n),
@@ -71,6 +74,7 @@ impl<'a> CurveEval<'a> {
     /// splines (a closed chain's seam too, as the domain's start), the interior knots of
     /// multiplicity > 1 of B-spline curves (where their guaranteed continuity drops below
     /// C^(d−1)); none for ERBS curves (C^∞ blends).
+    #[must_use]
     pub fn join_params(&self) -> Vec<f64> {
         match self {
             CurveEval::BSpline {
@@ -96,6 +100,7 @@ impl<'a> CurveEval<'a> {
 
     /// Left and right limits of c, c', c'' at t. At a closed chain's seam (the domain's start)
     /// the left limit is the one at the domain's end.
+    #[must_use]
     pub fn limits(&self, t: f64) -> Option<([DVec3; 3], [DVec3; 3])> {
         let CurveEval::BSpline { curve, closed, .. } = self else {
             return None;
@@ -119,6 +124,7 @@ pub struct Join {
 }
 
 /// The badges of one curve model (none for surfaces and ERBS curves).
+#[must_use]
 pub fn curve_joins(model: ModelRef<'_>) -> Vec<Join> {
     let Some(curve) = CurveEval::of(model) else {
         return Vec::new();
@@ -200,6 +206,7 @@ pub struct Osculating {
 impl Osculating {
     /// At parameter t of `curve`; `None` where there is no osculating plane (straight pieces,
     /// inflections, a vanishing derivative).
+    #[must_use]
     pub fn at(curve: &CurveEval<'_>, t: f64) -> Option<Self> {
         let d = curve.derivatives(t, 3);
         let f = frenet_frame(d[1], d[2], d[3])?;
@@ -214,16 +221,19 @@ impl Osculating {
         })
     }
 
+    #[must_use]
     pub fn radius(&self) -> f64 {
         1.0 / self.curvature
     }
 
+    #[must_use]
     pub fn center(&self) -> DVec3 {
         self.point + self.normal * self.radius()
     }
 
     /// `segments` + 1 points around the circle in the osculating plane, starting at the curve
     /// point.
+    #[must_use]
     pub fn circle(&self, segments: usize) -> Vec<DVec3> {
         let (c, r) = (self.center(), self.radius());
         (0..=segments)
@@ -235,6 +245,7 @@ impl Osculating {
     }
 
     /// "t 1.250  curvature 0.8123  radius 1.231  torsion -0.04120" (plain ASCII).
+    #[must_use]
     pub fn describe(&self) -> String {
         format!(
             "t {}  curvature {}  radius {}  torsion {}",
@@ -264,6 +275,7 @@ pub fn nearest_sample(
 }
 
 /// Badge colours (sRGB): C2 green, C1 / G2 teal, G1 yellow, G0 orange, a gap red.
+#[must_use]
 pub fn badge_color(class: JoinClass) -> [u8; 4] {
     match class.label() {
         "C2" => [70, 200, 110, 255],
@@ -305,6 +317,7 @@ pub fn badge_overlay(
 }
 
 /// The osculating circle (magenta), the radius to its centre and the tangent (thin), as lines.
+#[must_use]
 pub fn osculating_lines(o: &Osculating) -> Vec<LineVertex> {
     let mut out = Vec::new();
     let mut line = |a: DVec3, b: DVec3, color: [u8; 4]| {
@@ -339,6 +352,7 @@ pub fn osculating_lines(o: &Osculating) -> Vec<LineVertex> {
 /// The osculating readout (curvature, radius, torsion) as a label next to the curve point,
 /// kept inside a `size` image, on an opaque panel: draw it after the badges, so none covers
 /// it.
+#[must_use]
 pub fn osculating_overlay(
     name: &str,
     o: &Osculating,

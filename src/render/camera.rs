@@ -32,22 +32,26 @@ impl OrbitCamera {
     /// Limit keeping the up vector well-defined.
     pub const MAX_PITCH: f64 = 1.55;
 
+    #[must_use]
     pub fn eye(&self) -> DVec3 {
         self.target + self.direction() * self.distance
     }
 
     /// Unit vector from the target to the eye.
+    #[must_use]
     pub fn direction(&self) -> DVec3 {
         let (sy, cy) = self.yaw.sin_cos();
         let (sp, cp) = self.pitch.sin_cos();
         DVec3::new(sy * cp, -cy * cp, sp)
     }
 
+    #[must_use]
     pub fn view(&self) -> DMat4 {
         DMat4::look_at_rh(self.eye(), self.target, DVec3::Z)
     }
 
     /// Near and far planes that contain a sphere of `radius` around `centre`.
+    #[must_use]
     pub fn clip_planes(&self, bounds: &Bounds) -> (f64, f64) {
         let d = (self.eye() - bounds.centre()).length();
         let r = bounds.radius();
@@ -57,12 +61,14 @@ impl OrbitCamera {
     }
 
     /// Projection × view for an image of `aspect` = width / height, depth in [0, 1], y up.
+    #[must_use]
     pub fn view_proj(&self, aspect: f64, bounds: &Bounds) -> DMat4 {
         let (near, far) = self.clip_planes(bounds);
         DMat4::perspective_rh(self.fov_y, aspect, near, far) * self.view()
     }
 
     /// The f32 camera the GPU layer takes.
+    #[must_use]
     pub fn gpu(&self, aspect: f64, bounds: &Bounds) -> crate::gpu::Camera {
         crate::gpu::Camera {
             view_proj: to_f32(&self.view_proj(aspect, bounds)),
@@ -202,6 +208,7 @@ impl OrbitCamera {
 
     /// The default viewing direction for a scene: oblique, or from above for flat (xy-planar)
     /// scenes where an oblique view would squash everything into a band.
+    #[must_use]
     pub fn default_for(bounds: &Bounds) -> Self {
         let size = bounds.max - bounds.min;
         let flat = !bounds.is_empty() && size.z <= 0.02 * size.x.max(size.y);
@@ -228,6 +235,7 @@ impl OrbitCamera {
     }
 
     /// Camera right and up vectors in world space.
+    #[must_use]
     pub fn basis(&self) -> (DVec3, DVec3) {
         let forward = -self.direction();
         let right = forward.cross(DVec3::Z).try_normalize().unwrap_or(DVec3::X);
@@ -235,6 +243,7 @@ impl OrbitCamera {
     }
 
     /// World-space ray through a pixel (origin top-left) of a `width × height` image.
+    #[must_use]
     pub fn ray(
         &self,
         px: f64,
@@ -254,6 +263,7 @@ impl OrbitCamera {
 
     /// Pixel position (origin top-left) and depth in [0, 1] of a world point; `None` behind the
     /// eye.
+    #[must_use]
     pub fn project(
         &self,
         p: DVec3,
@@ -331,6 +341,7 @@ fn to_f32(m: &DMat4) -> Mat4 {
 }
 
 /// Vec3 from f64 world coordinates.
+#[must_use]
 pub fn v32(p: DVec3) -> Vec3 {
     p.as_vec3()
 }

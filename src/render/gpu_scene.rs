@@ -103,6 +103,7 @@ pub struct Highlight {
 
 impl Highlight {
     /// Whether object `i` is selected or under the cursor.
+    #[must_use]
     pub fn focuses(&self, i: usize) -> bool {
         self.hovered.is_some_and(|h| h.object() == i)
             || self.selected.is_some_and(|h| h.object() == i)
@@ -269,6 +270,7 @@ impl GpuScene {
     }
 
     /// The map colouring the surfaces.
+    #[must_use]
     pub fn map(&self) -> Option<&MapView> {
         self.map.as_ref()
     }
@@ -372,6 +374,7 @@ impl GpuScene {
     }
 
     /// How gestures redraw.
+    #[must_use]
     pub fn redraw(&self) -> Redraw {
         self.redraw
     }

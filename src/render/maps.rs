@@ -39,6 +39,7 @@ impl SurfaceMap {
     ];
 
     /// The `render --analysis` name.
+    #[must_use]
     pub fn name(self) -> &'static str {
         match self {
             SurfaceMap::Gaussian => "gaussian",
@@ -50,6 +51,7 @@ impl SurfaceMap {
     }
 
     /// What the legend calls it.
+    #[must_use]
     pub fn title(self) -> &'static str {
         match self {
             SurfaceMap::Gaussian => "Gaussian curvature K",
@@ -75,6 +77,7 @@ impl SurfaceMap {
     }
 
     /// The next map for the viewer's key: Gaussian → mean → κ_max → κ_min → zebra → off.
+    #[must_use]
     pub fn next(current: Option<Self>) -> Option<Self> {
         match current {
             None => Some(SurfaceMap::Gaussian),
@@ -86,12 +89,14 @@ impl SurfaceMap {
     }
 
     /// Whether the map needs second partials (all but zebra, which needs only normals).
+    #[must_use]
     pub fn needs_curvature(self) -> bool {
         self != SurfaceMap::Zebra
     }
 
     /// The mapped value of a sample's [K, H] (NaN where undefined).
     #[inline]
+    #[must_use]
     pub fn value(self, kh: [f64; 2]) -> f64 {
         match self {
             SurfaceMap::Gaussian => kh[0],
@@ -244,6 +249,7 @@ pub const SCALE: [(f32, [f32; 3]); 5] = [
 ];
 
 /// Linear RGB of the scale at s; NaN (undefined) is mid grey.
+#[must_use]
 pub fn scale_color(s: f32) -> [f32; 3] {
     if s.is_nan() {
         return [0.3, 0.3, 0.3];
@@ -292,6 +298,7 @@ pub struct LegendPlace<'a> {
 
 /// The legend of `map` with colour scale `scale`: the title, a colour bar from its low to its
 /// high end with the end and middle values (zebra: a note instead).
+#[must_use]
 pub fn legend(
     map: SurfaceMap,
     scale: MapScale,

@@ -27,6 +27,7 @@ pub struct Shot {
 }
 
 /// The camera a shot uses: the given one, or the default direction framing the document.
+#[must_use]
 pub fn shot_camera(doc: &Document, shot: &Shot) -> OrbitCamera {
     shot.camera.unwrap_or_else(|| {
         let bounds = doc.bounds();

@@ -21,6 +21,7 @@ pub enum NetMode {
 
 impl NetMode {
     /// Next mode for the toggle key: All → Focused → Off → All.
+    #[must_use]
     pub fn next(self) -> Self {
         match self {
             NetMode::All => NetMode::Focused,
@@ -120,6 +121,7 @@ impl Default for Palette {
 
 impl Palette {
     /// Colour of object `i`: the scene's `color` if given, else a palette entry.
+    #[must_use]
     pub fn object(&self, i: usize, color: Option<[f64; 3]>) -> [f32; 4] {
         let c = color
             .map(|c| c.map(|x| x as f32))
@@ -129,6 +131,7 @@ impl Palette {
 
     /// Colour of a surface: the scene's `color` if given, else one neutral colour for every
     /// surface (models made of many patches, like the teapot, should not look like a quilt).
+    #[must_use]
     pub fn surface(&self, color: Option<[f64; 3]>) -> [f32; 4] {
         let c = color.map(|c| c.map(|x| x as f32)).unwrap_or(self.surface);
         [c[0], c[1], c[2], 1.0]
@@ -136,6 +139,7 @@ impl Palette {
 
     /// Back faces (the side Su × Sv points away from): a warmer, slightly darker version of the
     /// front, so orientation is visible without making one-sided models look garish.
+    #[must_use]
     pub fn back_of(&self, c: [f32; 4]) -> [f32; 4] {
         let warm = [0.85, 0.55, 0.35];
         [
@@ -148,6 +152,7 @@ impl Palette {
 }
 
 /// Four significant digits, plain ASCII (the overlay font).
+#[must_use]
 pub fn short(x: f64) -> String {
     if x == 0.0 {
         // log10(0) is −∞: a planar curve's torsion would overflow the digit count.

@@ -52,11 +52,13 @@ impl DirtyRegion {
         }
     }
 
+    #[must_use]
     pub fn is_empty(&self) -> bool {
         self.rows.is_empty()
     }
 
     /// Number of samples in the region.
+    #[must_use]
     pub fn samples(&self) -> usize {
         self.rows.len() * self.cols.len()
     }
@@ -86,6 +88,7 @@ pub struct DirtySet {
 
 impl DirtySet {
     /// Everything in 0..n (a fresh mirror).
+    #[must_use]
     pub fn all(n: usize) -> Self {
         Self {
             ranges: if n > 0 {
@@ -113,15 +116,18 @@ impl DirtySet {
         self.ranges.splice(lo..hi, std::iter::once(start..end));
     }
 
+    #[must_use]
     pub fn is_empty(&self) -> bool {
         self.ranges.is_empty()
     }
 
+    #[must_use]
     pub fn ranges(&self) -> &[Range<usize>] {
         &self.ranges
     }
 
     /// Rows in the set.
+    #[must_use]
     pub fn count(&self) -> usize {
         self.ranges.iter().map(|r| r.len()).sum()
     }

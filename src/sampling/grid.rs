@@ -20,6 +20,7 @@ pub enum PartialSet {
 
 impl PartialSet {
     /// The partials in storage order.
+    #[must_use]
     pub fn list(&self) -> Vec<(usize, usize)> {
         match *self {
             PartialSet::Curve(g) => (0..=g).map(|r| (r, 0)).collect(),
@@ -30,6 +31,7 @@ impl PartialSet {
     }
 
     /// Vectors stored per sample.
+    #[must_use]
     pub fn len(&self) -> usize {
         match *self {
             PartialSet::Curve(g) => g + 1,
@@ -39,11 +41,13 @@ impl PartialSet {
         }
     }
 
+    #[must_use]
     pub fn is_empty(&self) -> bool {
         false
     }
 
     /// Highest order per direction.
+    #[must_use]
     pub fn max_order(&self) -> usize {
         match *self {
             PartialSet::Curve(g) | PartialSet::Square(g) => g,
@@ -53,6 +57,7 @@ impl PartialSet {
     }
 
     /// Storage slot of partial (a, b).
+    #[must_use]
     pub fn index(&self, a: usize, b: usize) -> Option<usize> {
         self.list().iter().position(|&p| p == (a, b))
     }
@@ -75,6 +80,7 @@ pub struct SampleGrid {
 }
 
 impl SampleGrid {
+    #[must_use]
     pub fn new(dims: [usize; 2], partials: PartialSet, with_normals: bool) -> Self {
         let n = dims[0] * dims[1];
         let stride = partials.len();
@@ -89,12 +95,14 @@ impl SampleGrid {
     }
 
     #[inline]
+    #[must_use]
     pub fn stride(&self) -> usize {
         self.partials.len()
     }
 
     /// All partials of sample (i, j).
     #[inline]
+    #[must_use]
     pub fn sample(&self, i: usize, j: usize) -> &[DVec3] {
         let s = self.stride();
         let base = (i * self.dims[1] + j) * s;
@@ -110,12 +118,14 @@ impl SampleGrid {
 
     /// Position of sample (i, j).
     #[inline]
+    #[must_use]
     pub fn position(&self, i: usize, j: usize) -> DVec3 {
         self.data[(i * self.dims[1] + j) * self.stride()]
     }
 
     /// Largest |component| over every stored value of partial slot p (its magnitude, for
     /// relative tolerances); NaN when any of them is NaN.
+    #[must_use]
     pub fn scale(&self, p: usize) -> f64 {
         self.data
             .iter()
@@ -131,6 +141,7 @@ impl SampleGrid {
     /// normals — gives +∞, so that no comparison with a tolerance can pass it.
     ///
     /// [`scale`]: SampleGrid::scale
+    #[must_use]
     pub fn relative_differences(&self, other: &SampleGrid) -> Vec<f64> {
         assert_eq!(self.dims, other.dims);
         assert_eq!(self.partials, other.partials);
@@ -159,6 +170,7 @@ impl SampleGrid {
 
     /// Largest distance between the unit normals of two grids (0 when neither keeps normals,
     /// +∞ when only one does or on NaN).
+    #[must_use]
     pub fn max_normal_difference(&self, other: &SampleGrid) -> f64 {
         match (&self.normals, &other.normals) {
             (None, None) => 0.0,

@@ -18,6 +18,7 @@ pub enum SampleMode {
 impl SampleMode {
     /// Highest curve derivative order, the surface partial set, and whether surfaces keep unit
     /// normals.
+    #[must_use]
     pub fn layout(self) -> (usize, PartialSet, bool) {
         match self {
             SampleMode::Derivatives(g) => (g, PartialSet::Square(g), false),

@@ -13,6 +13,7 @@ pub struct QuotientRule {
 }
 
 impl QuotientRule {
+    #[must_use]
     pub fn new(set: &PartialSet) -> Self {
         let list = set.list();
         let slot = |a: usize, b: usize| {

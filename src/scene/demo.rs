@@ -13,6 +13,7 @@ use glam::DVec3;
 pub const TEAPOT_JSON: &str = include_str!("../../examples/teapot.json");
 
 /// Builds the demo scene. Objects are laid out side by side along x, z up.
+#[must_use]
 pub fn demo_scene() -> Scene {
     let object = |name: &str, model, color| SceneObject {
         name: name.into(),
@@ -159,6 +160,7 @@ fn erbs_torus() -> ErbsSurface {
 /// The exact NURBS torus around the z axis through `centre`: the circle of radius `minor` in
 /// the (radius, z) half-plane at `major`, revolved by the nine-point circle (biquadratic,
 /// weights the products of the circles' 1 and √2/2).
+#[must_use]
 pub fn nurbs_torus(centre: DVec3, major: f64, minor: f64) -> TensorSurface {
     let around = nurbs_circle(DVec3::ZERO, 1.0);
     let tube = nurbs_circle(DVec3::ZERO, 1.0);
@@ -178,6 +180,7 @@ pub fn nurbs_torus(centre: DVec3, major: f64, minor: f64) -> TensorSurface {
 }
 
 /// The exact NURBS circle: degree 2, nine control points on a square, weights 1 and √2/2.
+#[must_use]
 pub fn nurbs_circle(centre: DVec3, radius: f64) -> BSplineCurve {
     let w = std::f64::consts::FRAC_1_SQRT_2;
     let corners = [

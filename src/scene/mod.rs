@@ -86,6 +86,7 @@ impl Scene {
         crate::sampling::budget::check_extents(&extents, mode, uses, budget)
     }
 
+    #[must_use]
     pub fn find(&self, name: &str) -> Option<usize> {
         self.objects.iter().position(|o| o.name == name)
     }

@@ -6,6 +6,7 @@ use crate::format::write::{field, json_string, numbers};
 use std::fmt::Write;
 
 /// Serialises a scene in the format of docs/scene-format.md, one object per line.
+#[must_use]
 pub fn scene_to_json(scene: &Scene) -> String {
     let mut s = String::from("{\"objects\": [\n");
     for (i, o) in scene.objects.iter().enumerate() {

@@ -120,6 +120,7 @@ fn fault_from_env() -> Option<u64> {
 
 /// Whether an X11 display is reachable (this build's winit backend is X11; Wayland sessions
 /// run it through XWayland).
+#[must_use]
 pub fn display_available() -> bool {
     std::env::var_os("DISPLAY").is_some_and(|d| !d.is_empty())
 }

@@ -497,16 +497,19 @@ impl Autosave {
         }
     }
 
+    #[must_use]
     pub fn places(&self) -> &Places {
         &self.places
     }
 
     /// Whether the model differs from the last save (or what was opened).
+    #[must_use]
     pub fn unsaved(&self) -> bool {
         self.revision != self.saved
     }
 
     /// Writes in a row that failed everywhere (0 once one succeeds).
+    #[must_use]
     pub fn failures(&self) -> u32 {
         self.failures
     }
@@ -534,6 +537,7 @@ impl Autosave {
 
     /// When the autosave must be written: [`AUTOSAVE_DELAY`] after the oldest edit it lacks,
     /// and not before the retry after a failure.
+    #[must_use]
     pub fn deadline(&self) -> Option<Instant> {
         let due = self
             .pending_since

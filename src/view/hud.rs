@@ -33,6 +33,7 @@ pub struct Hud {
 }
 
 impl Hud {
+    #[must_use]
     pub fn new() -> Self {
         Self {
             visible: true,
@@ -85,6 +86,7 @@ impl Hud {
     /// Overlay vertices of the performance panel (when visible and the help is not shown)
     /// and the status line, for a `width × height` image. The help comes separately
     /// ([`help_overlay`]), to be drawn last.
+    #[must_use]
     pub fn build(
         &self,
         font: &Font,

@@ -28,6 +28,7 @@ pub enum Key {
 impl Key {
     /// Parses a key name as used in scripts: a single character, or one of `enter`, `escape`,
     /// `backspace`, `home`, `f1`.
+    #[must_use]
     pub fn parse(name: &str) -> Option<Key> {
         let lower = name.to_ascii_lowercase();
         Some(match lower.as_str() {

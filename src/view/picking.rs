@@ -19,6 +19,7 @@ pub struct Projected {
 }
 
 /// Projects handles into a `size` image (those behind the eye are dropped).
+#[must_use]
 pub fn project_all(
     handles: &[(Handle, DVec3)],
     camera: &OrbitCamera,

@@ -33,6 +33,7 @@ pub struct Refine {
 }
 
 impl Refine {
+    #[must_use]
     pub fn new(object: usize) -> Self {
         Self {
             object,
@@ -45,6 +46,7 @@ impl Refine {
     /// Refines the ERBS level that owns `selected` (a local of `object`): the local itself when
     /// it is an ERBS local (a detail made with X), else the level it belongs to — its parent
     /// ERBS local, or the object for a top-level local.
+    #[must_use]
     pub fn for_local(object: usize, selected: LocalPath<Index2>, doc: &Document) -> Self {
         let is_erbs = match doc.objects[object].sampled.model() {
             ModelRef::ErbsCurve(m) => selected
@@ -225,6 +227,7 @@ impl Refine {
     }
 
     /// "t" on curves, "u" or "v" on surfaces.
+    #[must_use]
     pub fn axis_name(&self, doc: &Document) -> &'static str {
         if doc.objects[self.object].sampled.model().is_surface() {
             ["u", "v"][self.dir]
@@ -234,6 +237,7 @@ impl Refine {
     }
 
     /// Which local the refinement adds, for the status line after it: "local 3" of the level.
+    #[must_use]
     pub fn new_local(&self, doc: &Document) -> Option<String> {
         let t = self.level_parameter(doc, self.at?).ok()?;
         let i = self.level_knots(doc)?.locate(t) + 1;
@@ -252,6 +256,7 @@ impl Refine {
     }
 
     /// Whether the object is an ERBS object (refinement) rather than a B-spline (knot insertion).
+    #[must_use]
     pub fn is_erbs(&self, doc: &Document) -> bool {
         matches!(
             doc.objects[self.object].sampled.model(),
@@ -260,6 +265,7 @@ impl Refine {
     }
 
     /// The status line while aiming.
+    #[must_use]
     pub fn describe(&self, doc: &Document) -> String {
         let o = &doc.objects[self.object];
         let surface = o.sampled.model().is_surface();
@@ -295,6 +301,7 @@ impl Refine {
 
     /// The preview: the isoline at the parameter (surfaces; across a nested ERBS level only its
     /// support) or a marker on the curve.
+    #[must_use]
     pub fn preview(&self, doc: &Document, scale: f64) -> Vec<LineVertex> {
         let Some(t) = self.at else {
             return Vec::new();

@@ -37,6 +37,7 @@ impl Scenario {
         }
     }
 
+    #[must_use]
     pub fn name(self) -> &'static str {
         match self {
             Scenario::Drag => "drag",
@@ -94,6 +95,7 @@ impl ScenarioDriver {
     }
 
     /// The control point the scenario works on.
+    #[must_use]
     pub fn target(&self) -> Option<Handle> {
         self.target
     }

@@ -258,6 +258,7 @@ pub struct ScriptPlayer {
 }
 
 impl ScriptPlayer {
+    #[must_use]
     pub fn new(events: Vec<ScriptEvent>) -> Self {
         Self { events, next: 0 }
     }
@@ -279,11 +280,13 @@ impl ScriptPlayer {
         out
     }
 
+    #[must_use]
     pub fn finished(&self) -> bool {
         self.next >= self.events.len()
     }
 
     /// When the next event is due (`None` once all have run).
+    #[must_use]
     pub fn next_when(&self) -> Option<When> {
         self.events.get(self.next).map(|e| e.when)
     }

@@ -120,6 +120,7 @@ impl Session {
         self.show_autosave_notes();
     }
 
+    #[must_use]
     pub fn autosave(&self) -> Option<&Autosave> {
         self.autosave.as_ref()
     }
@@ -191,6 +192,7 @@ impl Session {
         self.gpu.destroy(renderer);
     }
 
+    #[must_use]
     pub fn size(&self) -> [f64; 2] {
         self.stage.size
     }
@@ -199,26 +201,32 @@ impl Session {
         self.stage.resize(width, height);
     }
 
+    #[must_use]
     pub fn cursor(&self) -> (f64, f64) {
         self.stage.cursor
     }
 
+    #[must_use]
     pub fn bounds(&self) -> &Bounds {
         &self.stage.bounds
     }
 
+    #[must_use]
     pub fn camera(&self) -> &OrbitCamera {
         &self.stage.camera
     }
 
+    #[must_use]
     pub fn selected(&self) -> Option<Handle> {
         self.stage.selection.selected
     }
 
+    #[must_use]
     pub fn selected_local(&self) -> Option<(usize, LocalPath<Index2>)> {
         self.stage.selection.selected_local
     }
 
+    #[must_use]
     pub fn undo_depth(&self) -> (usize, usize) {
         self.stage.editor.undo_depth()
     }
@@ -262,6 +270,7 @@ impl Session {
     }
 
     /// The status line's message (what the last action did or why it could not).
+    #[must_use]
     pub fn status(&self) -> &str {
         &self.stage.status.text
     }
@@ -271,6 +280,7 @@ impl Session {
     }
 
     /// Screen position of a handle (for scripts that aim at a control point).
+    #[must_use]
     pub fn handle_position(&self, handle: Handle) -> Option<(f64, f64)> {
         self.stage.view().project(self.stage.handle_world(handle)?)
     }

@@ -89,6 +89,7 @@ pub struct Stage {
 
 impl Stage {
     /// The editor's document framed for a `size` image.
+    #[must_use]
     pub fn new(editor: Editor, size: [u32; 2]) -> Self {
         let bounds = editor.doc().bounds();
         let size = [size[0].max(1) as f64, size[1].max(1) as f64];

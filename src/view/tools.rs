@@ -17,6 +17,7 @@ pub enum Axis {
 }
 
 impl Axis {
+    #[must_use]
     pub fn vector(self) -> Option<DVec3> {
         match self {
             Axis::Free => None,
@@ -27,10 +28,12 @@ impl Axis {
     }
 
     /// Pressing the same axis key twice returns to free movement.
+    #[must_use]
     pub fn toggle(self, other: Axis) -> Axis {
         if self == other { Axis::Free } else { other }
     }
 
+    #[must_use]
     pub fn name(self) -> &'static str {
         match self {
             Axis::Free => "",
@@ -50,16 +53,19 @@ pub struct View<'a> {
 }
 
 impl View<'_> {
+    #[must_use]
     pub fn ray(&self, cursor: (f64, f64)) -> (DVec3, DVec3) {
         self.camera
             .ray(cursor.0, cursor.1, self.size[0], self.size[1], self.bounds)
     }
 
+    #[must_use]
     pub fn project(&self, p: DVec3) -> Option<(f64, f64)> {
         self.project_depth(p).map(|(x, y, _)| (x, y))
     }
 
     /// Pixel position and depth in [0, 1] of a world point; `None` behind the eye.
+    #[must_use]
     pub fn project_depth(&self, p: DVec3) -> Option<(f64, f64, f64)> {
         self.camera
             .project(p, self.size[0], self.size[1], self.bounds)
@@ -68,6 +74,7 @@ impl View<'_> {
 
 /// Where the cursor ray meets the plane through `anchor` facing the camera, or the point of
 /// the axis line through `anchor` closest to the ray.
+#[must_use]
 pub fn cursor_point(view: &View, cursor: (f64, f64), anchor: DVec3, axis: Axis) -> Option<DVec3> {
     let (o, d) = view.ray(cursor);
     match axis.vector() {
@@ -105,6 +112,7 @@ pub struct Drag {
 }
 
 impl Drag {
+    #[must_use]
     pub fn new(anchor: DVec3) -> Self {
         Self {
             anchor,
@@ -143,6 +151,7 @@ pub enum TransformKind {
 }
 
 impl TransformKind {
+    #[must_use]
     pub fn name(self) -> &'static str {
         match self {
             TransformKind::Grab => "Grab",
@@ -168,6 +177,7 @@ pub struct Transform {
 }
 
 impl Transform {
+    #[must_use]
     pub fn new(kind: TransformKind, pivot: DVec3, view: &View, cursor: (f64, f64)) -> Self {
         let mut drag = Drag::new(pivot);
         drag.grab(view, cursor);
@@ -195,6 +205,7 @@ impl Transform {
     }
 
     /// The value typed so far, if it parses.
+    #[must_use]
     pub fn typed(&self) -> Option<f64> {
         self.numeric.parse::<f64>().ok().filter(|v| v.is_finite())
     }
@@ -267,6 +278,7 @@ impl Transform {
     }
 
     /// HUD text: "Rotate Z 30°" and the like.
+    #[must_use]
     pub fn describe(&self) -> String {
         let value = if self.numeric.is_empty() {
             String::new()

@@ -27,6 +27,7 @@ impl LocalCurve {
     }
 
     /// The parameter interval the local covers (its support once placed).
+    #[must_use]
     pub fn domain(&self) -> (f64, f64) {
         match self {
             LocalCurve::Spline { curve, .. } => curve.domain(),
@@ -35,6 +36,7 @@ impl LocalCurve {
     }
 
     /// c(t), c'(t), …, c^(n)(t) in the parent's parameter.
+    #[must_use]
     pub fn derivatives(&self, t: f64, n: usize) -> Vec<DVec3> {
         match self {
             LocalCurve::Spline { curve, .. } => curve.derivatives(t, n),
@@ -42,11 +44,13 @@ impl LocalCurve {
         }
     }
 
+    #[must_use]
     pub fn eval(&self, t: f64) -> DVec3 {
         self.derivatives(t, 0)[0]
     }
 
     /// Its own control points (none for an ERBS local: those live in its locals).
+    #[must_use]
     pub fn points(&self) -> Option<&[DVec3]> {
         match self {
             LocalCurve::Spline { curve, .. } => Some(curve.points()),
@@ -63,6 +67,7 @@ impl LocalCurve {
     }
 
     /// ERBS levels below this local (0 for a polynomial one).
+    #[must_use]
     pub fn depth(&self) -> usize {
         match self {
             LocalCurve::Spline { .. } => 0,
@@ -262,22 +267,27 @@ impl ErbsCurve {
         n as u128 * (per_local + std::mem::size_of::<f64>() as u128)
     }
 
+    #[must_use]
     pub fn knots(&self) -> &ErbsKnots {
         &self.knots
     }
 
+    #[must_use]
     pub fn local_curves(&self) -> &[LocalCurve] {
         &self.local
     }
 
+    #[must_use]
     pub fn bfunction(&self) -> BFunctionKind {
         self.bfunction
     }
 
+    #[must_use]
     pub fn domain(&self) -> (f64, f64) {
         self.knots.domain()
     }
 
+    #[must_use]
     pub fn is_closed(&self) -> bool {
         self.knots.is_closed()
     }
@@ -288,6 +298,7 @@ impl ErbsCurve {
     }
 
     /// The local at `path` (indices descending through ERBS locals).
+    #[must_use]
     pub fn local_at(&self, path: &[usize]) -> Option<&LocalCurve> {
         let (&first, rest) = path.split_first()?;
         let l = self.local.get(first)?;
@@ -362,6 +373,7 @@ impl ErbsCurve {
     }
 
     /// c(t), c'(t), …, c^(n)(t).
+    #[must_use]
     pub fn derivatives(&self, t: f64, n: usize) -> Vec<DVec3> {
         let (a, b) = self.domain();
         let t = t.clamp(a, b);
@@ -380,6 +392,7 @@ impl ErbsCurve {
         out
     }
 
+    #[must_use]
     pub fn eval(&self, t: f64) -> DVec3 {
         self.derivatives(t, 0)[0]
     }

@@ -146,15 +146,18 @@ impl ErbsKnots {
         self.domain = (f(self.domain.0), f(self.domain.1));
     }
 
+    #[must_use]
     pub fn as_slice(&self) -> &[f64] {
         &self.knots
     }
 
+    #[must_use]
     pub fn is_closed(&self) -> bool {
         self.closed
     }
 
     /// Number of local curves.
+    #[must_use]
     pub fn locals(&self) -> usize {
         if self.closed {
             self.knots.len() - 1
@@ -163,11 +166,13 @@ impl ErbsKnots {
         }
     }
 
+    #[must_use]
     pub fn domain(&self) -> (f64, f64) {
         self.domain
     }
 
     /// The domain without a window: [c_0, c_{n−1}] or [k_0, k_n].
+    #[must_use]
     pub fn full_domain(&self) -> (f64, f64) {
         let n = self.locals();
         if self.closed {
@@ -178,12 +183,14 @@ impl ErbsKnots {
     }
 
     /// The period T of a closed direction.
+    #[must_use]
     pub fn period(&self) -> Option<f64> {
         self.closed
             .then(|| self.knots[self.knots.len() - 1] - self.knots[0])
     }
 
     /// Centre c_i of local i; for closed knots c_n = k_n (the period's end).
+    #[must_use]
     pub fn centre(&self, i: usize) -> f64 {
         if self.closed {
             self.knots[i]
@@ -193,6 +200,7 @@ impl ErbsKnots {
     }
 
     /// Number of intervals: n − 1 open, n closed.
+    #[must_use]
     pub fn intervals(&self) -> usize {
         if self.closed {
             self.locals()
@@ -202,12 +210,14 @@ impl ErbsKnots {
     }
 
     /// Interval i = [c_i, c_{i+1}].
+    #[must_use]
     pub fn interval(&self, i: usize) -> (f64, f64) {
         (self.centre(i), self.centre(i + 1))
     }
 
     /// The local blended in with weight B on interval i, and the shift its parameter takes there
     /// (T where a closed direction wraps to local 0).
+    #[must_use]
     pub fn right(&self, i: usize) -> (usize, f64) {
         let n = self.locals();
         match self.period() {
@@ -218,6 +228,7 @@ impl ErbsKnots {
 
     /// The interval holding t (clamped to the domain); an interior knot belongs to the interval
     /// to its right, the domain's end to the last interval.
+    #[must_use]
     pub fn locate(&self, t: f64) -> usize {
         let t = t.clamp(self.domain.0, self.domain.1);
         let last = self.intervals() - 1;
@@ -236,6 +247,7 @@ impl ErbsKnots {
     }
 
     /// Support of local l, unwrapped: [c_{l−1}, c_{l+1}] (open ends at t_0 and t_{n+1}).
+    #[must_use]
     pub fn support(&self, l: usize) -> (f64, f64) {
         let n = self.locals();
         if self.closed {

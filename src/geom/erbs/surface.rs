@@ -30,6 +30,7 @@ impl LocalPatch {
         })
     }
 
+    #[must_use]
     pub fn domain(&self) -> [(f64, f64); 2] {
         match self {
             LocalPatch::Spline { surface, .. } => surface.domain(),
@@ -38,6 +39,7 @@ impl LocalPatch {
     }
 
     /// ∂^{a+b}/∂u^a∂v^b for a, b ≤ n in the parent's parameters.
+    #[must_use]
     pub fn derivatives(&self, u: f64, v: f64, n: usize) -> Partials {
         match self {
             LocalPatch::Spline { surface, .. } => surface.derivatives(u, v, n),
@@ -45,11 +47,13 @@ impl LocalPatch {
         }
     }
 
+    #[must_use]
     pub fn eval(&self, u: f64, v: f64) -> DVec3 {
         self.derivatives(u, v, 0).get(0, 0)
     }
 
     /// Its own control net, row-major, and its size (none for an ERBS patch).
+    #[must_use]
     pub fn net(&self) -> Option<([usize; 2], &[DVec3])> {
         match self {
             LocalPatch::Spline { surface, .. } => Some((surface.count(), surface.points())),
@@ -69,6 +73,7 @@ impl LocalPatch {
         }
     }
 
+    #[must_use]
     pub fn depth(&self) -> usize {
         match self {
             LocalPatch::Spline { .. } => 0,
@@ -289,31 +294,38 @@ impl ErbsSurface {
         patches.saturating_mul(per_patch) + (count[0] as u128 + count[1] as u128) * f64_bytes
     }
 
+    #[must_use]
     pub fn knots(&self) -> &[ErbsKnots; 2] {
         &self.knots
     }
 
     /// [nu, nv] local patches.
+    #[must_use]
     pub fn count(&self) -> [usize; 2] {
         [self.knots[0].locals(), self.knots[1].locals()]
     }
 
+    #[must_use]
     pub fn local_patch(&self, k: usize, l: usize) -> &LocalPatch {
         &self.local[k * self.count()[1] + l]
     }
 
+    #[must_use]
     pub fn local_patches(&self) -> &[LocalPatch] {
         &self.local
     }
 
+    #[must_use]
     pub fn bfunction(&self) -> BFunctionKind {
         self.bfunction
     }
 
+    #[must_use]
     pub fn domain(&self) -> [(f64, f64); 2] {
         [self.knots[0].domain(), self.knots[1].domain()]
     }
 
+    #[must_use]
     pub fn closed(&self) -> [bool; 2] {
         [self.knots[0].is_closed(), self.knots[1].is_closed()]
     }
@@ -323,6 +335,7 @@ impl ErbsSurface {
     }
 
     /// The patch at `path` (index pairs descending through ERBS patches).
+    #[must_use]
     pub fn local_at(&self, path: &[[usize; 2]]) -> Option<&LocalPatch> {
         let (&[k, l], rest) = path.split_first()?;
         let [nu, nv] = self.count();
@@ -447,6 +460,7 @@ impl ErbsSurface {
     }
 
     /// ∂^{a+b}s/∂u^a∂v^b for a, b ≤ n by the Leibniz rule in both directions.
+    #[must_use]
     pub fn derivatives(&self, u: f64, v: f64, n: usize) -> Partials {
         let [(u0, u1), (v0, v1)] = self.domain();
         let (u, v) = (u.clamp(u0, u1), v.clamp(v0, v1));
@@ -479,6 +493,7 @@ impl ErbsSurface {
         out
     }
 
+    #[must_use]
     pub fn eval(&self, u: f64, v: f64) -> DVec3 {
         self.derivatives(u, v, 0).get(0, 0)
     }

@@ -11,6 +11,7 @@ use glam::DVec3;
 ///
 /// With t = a + h·s: P = Σ_j m_j s^j, m_j = h^j Σ_{r≥j} D_r/r! C(r, j) (a − c)^{r−j}; then
 /// Bernstein b_i = Σ_{j≤i} C(i, j)/C(d, j) m_j (NURBS Book eq. 6.x, power to Bernstein).
+#[must_use]
 pub fn taylor_bezier(derivs: &[DVec3], c: f64, (a, b): (f64, f64)) -> Vec<DVec3> {
     let coeffs: Vec<DVec3> = derivs
         .iter()
@@ -45,6 +46,7 @@ fn bernstein_from_taylor(coeffs: &[DVec3], c: f64, (a, b): (f64, f64)) -> Vec<DV
 
 /// The (du+1)×(dv+1) Bézier patch (row-major, i along u) on [a, b] × [c, d] whose partials
 /// ∂^{a+b} with a ≤ du, b ≤ dv at `centre` equal `partials`' (which must hold those orders).
+#[must_use]
 pub fn taylor_patch(
     partials: &Partials,
     [du, dv]: [usize; 2],

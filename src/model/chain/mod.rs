@@ -57,10 +57,12 @@ impl CatmullRomModel {
         Ok(Self { spline, samples })
     }
 
+    #[must_use]
     pub fn spline(&self) -> &CatmullRom {
         &self.spline
     }
 
+    #[must_use]
     pub fn samples(&self) -> usize {
         self.samples
     }
@@ -171,10 +173,12 @@ impl BezierSplineModel {
         Ok(Self { spline, samples })
     }
 
+    #[must_use]
     pub fn spline(&self) -> &BezierSpline {
         &self.spline
     }
 
+    #[must_use]
     pub fn samples(&self) -> usize {
         self.samples
     }
@@ -206,6 +210,7 @@ pub enum BezierSplineEdit {
 }
 
 impl BezierSplineEdit {
+    #[must_use]
     pub fn point(&self) -> usize {
         match *self {
             BezierSplineEdit::Move { point, .. } | BezierSplineEdit::Set { point, .. } => point,

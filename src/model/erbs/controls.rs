@@ -89,6 +89,7 @@ pub fn each_curve_leaf(
     out
 }
 
+#[must_use]
 pub fn each_curve_leaf_of(
     root: &GeomLocalCurve,
     path: LocalPath<Index2>,
@@ -133,6 +134,7 @@ pub fn each_patch_leaf(
     out
 }
 
+#[must_use]
 pub fn each_patch_leaf_of(
     root: &GeomLocalPatch,
     path: LocalPath<Index2>,

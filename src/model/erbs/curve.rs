@@ -32,10 +32,12 @@ impl ErbsCurveModel {
         Ok(Self { curve, samples })
     }
 
+    #[must_use]
     pub fn curve(&self) -> &ErbsCurve {
         &self.curve
     }
 
+    #[must_use]
     pub fn samples(&self) -> usize {
         self.samples
     }

@@ -314,6 +314,7 @@ pub struct ErbsCurveSampler {
 }
 
 impl ErbsCurveSampler {
+    #[must_use]
     pub fn new(model: ErbsCurveModel, order: usize) -> Self {
         let level = Self::level(&model, order);
         Self { model, level }

@@ -78,6 +78,7 @@ impl<I: Copy + Default> LocalPath<I> {
 
 impl LocalPath<Index2> {
     /// The curve form of a path of single indices.
+    #[must_use]
     pub fn to_curve(&self) -> Option<LocalPath<usize>> {
         let steps: Option<Vec<usize>> = self
             .steps()
@@ -91,6 +92,7 @@ impl LocalPath<Index2> {
     }
 
     /// The surface form of a path of index pairs.
+    #[must_use]
     pub fn to_surface(&self) -> Option<LocalPath<[usize; 2]>> {
         let steps: Option<Vec<[usize; 2]>> = self
             .steps()

@@ -32,10 +32,12 @@ impl ErbsSurfaceModel {
         Ok(Self { surface, samples })
     }
 
+    #[must_use]
     pub fn surface(&self) -> &ErbsSurface {
         &self.surface
     }
 
+    #[must_use]
     pub fn samples(&self) -> [usize; 2] {
         self.samples
     }

@@ -843,6 +843,7 @@ pub struct ErbsSurfaceSampler {
 }
 
 impl ErbsSurfaceSampler {
+    #[must_use]
     pub fn new(model: ErbsSurfaceModel, set: PartialSet, normals: bool) -> Self {
         let level = Self::tabulated(&model, set, normals);
         let mut s = Self { model, level };

@@ -42,14 +42,17 @@ impl CurveModel {
         })
     }
 
+    #[must_use]
     pub fn form(&self) -> SplineForm {
         self.form
     }
 
+    #[must_use]
     pub fn curve(&self) -> &BSplineCurve {
         &self.curve
     }
 
+    #[must_use]
     pub fn samples(&self) -> usize {
         self.samples
     }

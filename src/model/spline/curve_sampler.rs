@@ -24,6 +24,7 @@ pub struct SplineCurveSampler {
 }
 
 impl SplineCurveSampler {
+    #[must_use]
     pub fn new(model: CurveModel, order: usize) -> Self {
         let curve = model.curve();
         let n = curve.points().len();

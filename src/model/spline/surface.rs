@@ -45,14 +45,17 @@ impl SurfaceModel {
         })
     }
 
+    #[must_use]
     pub fn form(&self) -> SplineForm {
         self.form
     }
 
+    #[must_use]
     pub fn surface(&self) -> &TensorSurface {
         &self.surface
     }
 
+    #[must_use]
     pub fn samples(&self) -> [usize; 2] {
         self.samples
     }

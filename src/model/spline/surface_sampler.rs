@@ -30,6 +30,7 @@ pub struct SplineSurfaceSampler {
 impl SplineSurfaceSampler {
     /// Samples `samples = [mu, mv]` over the domain; `normals` adds unit normals (needs a set with
     /// first partials).
+    #[must_use]
     pub fn new(model: SurfaceModel, set: PartialSet, normals: bool) -> Self {
         let g = set.max_order();
         let samples = model.samples();

@@ -47,6 +47,7 @@ pub enum Body {
 pub const BODY_KEYWORDS: [&str; 4] = ["trim", "hole", "scrv", "sp"];
 
 impl Body {
+    #[must_use]
     pub fn keyword(&self) -> &'static str {
         match self {
             Body::Trim(_) => "trim",
@@ -57,6 +58,7 @@ impl Body {
     }
 
     /// The curve references of `trim`/`hole`/`scrv` (none for `sp`).
+    #[must_use]
     pub fn curves(&self) -> &[CurveRef] {
         match self {
             Body::Trim(c) | Body::Hole(c) | Body::Scrv(c) => c,
@@ -65,6 +67,7 @@ impl Body {
     }
 
     /// The parameter vertex numbers of `sp` (none otherwise).
+    #[must_use]
     pub fn points(&self) -> &[usize] {
         match self {
             Body::Sp(p) => p,
@@ -73,6 +76,7 @@ impl Body {
     }
 
     /// The statement of `keyword` with curve references or points.
+    #[must_use]
     pub fn new(keyword: &str, curves: Vec<CurveRef>, points: Vec<usize>) -> Option<Body> {
         match keyword {
             "trim" => Some(Body::Trim(curves)),
@@ -106,6 +110,7 @@ const SURFACE_TECHNIQUES: [(&str, usize); 4] =
 
 impl Technique {
     /// `ctech` for curves and `curv2`, `stech` for surfaces.
+    #[must_use]
     pub fn keyword(surface: bool) -> &'static str {
         if surface { "stech" } else { "ctech" }
     }
@@ -160,6 +165,7 @@ pub const CSTYPES: [&str; 5] = ["bezier", "bspline", "bmatrix", "cardinal", "tay
 
 impl Curve2 {
     /// `[rat ]basis`, as the `cstype` line writes it.
+    #[must_use]
     pub fn cstype(&self) -> String {
         format!("{}{}", if self.rational { "rat " } else { "" }, self.basis)
     }
@@ -177,6 +183,7 @@ pub struct Connection {
 }
 
 impl Carried {
+    #[must_use]
     pub fn is_empty(&self) -> bool {
         *self == Carried::default()
     }

@@ -99,12 +99,14 @@ pub fn object_to_element(o: &SceneObject) -> Result<FreeForm, SceneError> {
 
 /// Samples of an imported curve without `# prespline samples`: 32 per knot span, 129 to 4097
 /// in all.
+#[must_use]
 pub fn default_curve_samples(c: &BSplineCurve) -> usize {
     (32 * spans(c.knots(), c.domain()) + 1).clamp(129, 4097)
 }
 
 /// Samples of an imported surface without `# prespline samples`: 8 per knot span in each
 /// direction, 17 to 257, so a Bézier patch gets 17 × 17 and dense nets stay responsive.
+#[must_use]
 pub fn default_surface_samples(s: &TensorSurface) -> [usize; 2] {
     let dom = s.domain();
     [0, 1].map(|d| (8 * spans(&s.knots()[d], dom[d]) + 1).clamp(17, 257))

@@ -40,6 +40,7 @@ impl ObjError {
     }
 
     /// `FILE:LINE: message`, the form compilers use, so editors can jump to it.
+    #[must_use]
     pub fn in_file(&self, path: &Path) -> String {
         format!("{}:{}: {}", path.display(), self.line, self.message)
     }
@@ -54,6 +55,7 @@ pub struct ObjWarning {
 
 impl ObjWarning {
     /// `FILE:LINE: warning: message`.
+    #[must_use]
     pub fn in_file(&self, path: &Path) -> String {
         format!(
             "{}:{}: warning: {}",
@@ -150,6 +152,7 @@ pub enum Format {
 
 impl Format {
     /// `.obj` and `.json` (any case); `None` for anything else.
+    #[must_use]
     pub fn of(path: &Path) -> Option<Format> {
         let ext = path.extension()?.to_str()?;
         if ext.eq_ignore_ascii_case("obj") {

@@ -17,6 +17,7 @@ pub enum Basis {
 
 impl Basis {
     /// The `cstype` word.
+    #[must_use]
     pub fn word(self) -> &'static str {
         match self {
             Basis::Bezier => "bezier",
@@ -62,6 +63,7 @@ impl Direction {
 
     /// The parameter domain the `parm` vector defines: [t_d, t_n] of the knots, or the first
     /// and last Bézier breakpoint.
+    #[must_use]
     pub fn domain(&self, basis: Basis) -> [f64; 2] {
         match basis {
             Basis::BSpline => [self.parm[self.degree], self.parm[self.count]],
@@ -70,6 +72,7 @@ impl Direction {
     }
 
     /// Whether the element's range is a proper part of the domain (it is cut on import).
+    #[must_use]
     pub fn is_restricted(&self, basis: Basis) -> bool {
         self.range != self.domain(basis)
     }
@@ -100,11 +103,13 @@ pub struct FreeForm {
 }
 
 impl FreeForm {
+    #[must_use]
     pub fn is_surface(&self) -> bool {
         self.dirs.len() == 2
     }
 
     /// `curv` or `surf`, for messages.
+    #[must_use]
     pub fn keyword(&self) -> &'static str {
         if self.is_surface() { "surf" } else { "curv" }
     }
