@@ -465,7 +465,8 @@ fn an_error_exit_keeps_the_unsaved_edits() {
     }
 }
 
-/// Insert a knot at the cursor, drag one of the new control points, save: the net is refined and
+/// Insert a knot at the cursor (aimed at u = 0.45 on the surface), drag one of the new control
+/// points, save: the net is refined and
 /// the point moved. The same session with two undos before saving gives back the original
 /// scene bit for bit (the file text is the exact, shortest round-trip serialisation).
 #[test]
@@ -479,7 +480,7 @@ fn knot_insertion_drag_and_two_undos_restore_the_scene_exactly() {
  {"frame": 4, "press": "left"},
  {"frame": 5, "release": "left"},
  {"frame": 6, "key": "i"},
- {"frame": 7, "move_by": [12, 6]},
+ {"frame": 7, "move_to": {"object": "bspline_surface", "at": [0.45, 0.55]}},
  {"frame": 8, "press": "left"},
  {"frame": 9, "release": "left"},
  {"frame": 10, "move_to": {"object": "bspline_surface", "point": [4, 4]}},
@@ -528,6 +529,8 @@ fn knot_insertion_drag_and_two_undos_restore_the_scene_exactly() {
         .copied()
         .find(|&t| s0.knots()[0].multiplicity(t) < s1.knots()[0].multiplicity(t))
         .unwrap();
+    // Where the script aimed: the drawn sample nearest u = 0.45 (96 samples on [0, 1]).
+    assert!((t - 0.45).abs() <= 0.5 / 95.0, "inserted u = {t}");
     let fresh = s0.insert_knot(0, t, 1).unwrap();
     let moved: Vec<(usize, usize)> = (0..s1.count()[0])
         .flat_map(|i| (0..s1.count()[1]).map(move |j| (i, j)))
