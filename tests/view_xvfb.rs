@@ -653,6 +653,9 @@ fn screenshots_show_the_bytes_their_frame_copied() {
         nonzero += usize::from(bytes[f] > 0);
     }
     assert_eq!(nonzero, 1, "frame 7 copies frame 6's rows: {bytes:?}");
+    // The one with a figure is the screenshot taken during the drag (never "0.0 KB").
+    assert!(bytes[7] > 0, "the drag's frame copied rows: {bytes:?}");
+    eprintln!("frame 7: {:?}", kb_to_gpu(&dir.join("shot7.png")).0);
 }
 
 /// A status message the window can only show with its middle elided (saving an expo ERBS
