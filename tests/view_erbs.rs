@@ -19,12 +19,15 @@ use std::time::Duration;
 /// The example's 3 × 3 biquadratic domes (knots 0, 1, 2 in u and v).
 const SCENE: &str = include_str!("../examples/erbs_surface.json");
 
-/// `UNDO` becomes the undos, `SHOT` the screenshot's path.
+/// `UNDO` becomes the undos, `SHOT` the screenshot's path. Refinements aim at the surface by
+/// parameter, off every knot (u, v = 0, 1, 2 and the refinements' new ones): first at
+/// (0.5, 1.5) on the object (a new u knot 0.5 makes local [1, 1] the one on [0, 1] × [0, 2]),
+/// then at (0.75, 1.5), inside that local once X has made it a detail.
 const SCRIPT: &str = r#"[
  {"frame": 3, "move_to": {"object": "domes", "local": [1, 1], "point": [1, 1]}},
  {"frame": 4, "press": "left"},
  {"frame": 5, "release": "left"},
- {"frame": 6, "move_by": [14, 9]},
+ {"frame": 6, "move_to": {"object": "domes", "at": [0.5, 1.5]}},
  {"frame": 7, "key": "i"},
  {"frame": 8, "key": "enter"},
  {"frame": 10, "move_to": {"object": "domes", "local": [1, 1], "point": [1, 1]}},
@@ -38,8 +41,7 @@ const SCRIPT: &str = r#"[
  {"frame": 19, "key": "z"},
  {"frame": 20, "type": "0.8"},
  {"frame": 21, "key": "enter"},
- {"frame": 23, "move_to": {"object": "domes", "local": [[1, 1], [1, 1]], "point": [1, 1]}},
- {"frame": 24, "move_by": [4, 90]},
+ {"frame": 24, "move_to": {"object": "domes", "at": [0.75, 1.5]}},
  {"frame": 25, "key": "i"},
  {"frame": 26, "key": "v"},
  {"frame": 27, "key": "enter"},
@@ -280,11 +282,15 @@ fn refining_on_a_knot_is_refused_and_refinement_and_x_undo_exactly() {
     assert_eq!(v.curve(), original, "nothing changed");
     assert_eq!(v.session.undo_depth().0, 0, "no undo step");
 
-    // Off the knot: a new local curve between knots 0 and 1 or 1 and 2.
-    v.session.perform(Action::MoveBy(30.0, 0.0));
+    // Off the knot, on the curve's sample at t = 1.25 (121 samples on [0, 2]): a new local
+    // curve there, between knots 1 and 2.
+    v.session.perform(Action::MoveOnto {
+        object: 0,
+        at: [1.25, 0.0],
+    });
     v.refine();
     assert!(
-        v.session.status().starts_with("refined erbs at t = "),
+        v.session.status().starts_with("refined erbs at t = 1.2500"),
         "{}",
         v.session.status()
     );

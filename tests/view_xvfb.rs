@@ -465,7 +465,8 @@ fn an_error_exit_keeps_the_unsaved_edits() {
     }
 }
 
-/// Insert a knot at the cursor, drag one of the new control points, save: the net is refined and
+/// Insert a knot at the cursor (aimed at u = 0.45 on the surface), drag one of the new control
+/// points, save: the net is refined and
 /// the point moved. The same session with two undos before saving gives back the original
 /// scene bit for bit (the file text is the exact, shortest round-trip serialisation).
 #[test]
@@ -479,7 +480,7 @@ fn knot_insertion_drag_and_two_undos_restore_the_scene_exactly() {
  {"frame": 4, "press": "left"},
  {"frame": 5, "release": "left"},
  {"frame": 6, "key": "i"},
- {"frame": 7, "move_by": [12, 6]},
+ {"frame": 7, "move_to": {"object": "bspline_surface", "at": [0.45, 0.55]}},
  {"frame": 8, "press": "left"},
  {"frame": 9, "release": "left"},
  {"frame": 10, "move_to": {"object": "bspline_surface", "point": [4, 4]}},
@@ -528,6 +529,8 @@ fn knot_insertion_drag_and_two_undos_restore_the_scene_exactly() {
         .copied()
         .find(|&t| s0.knots()[0].multiplicity(t) < s1.knots()[0].multiplicity(t))
         .unwrap();
+    // Where the script aimed: the drawn sample nearest u = 0.45 (96 samples on [0, 1]).
+    assert!((t - 0.45).abs() <= 0.5 / 95.0, "inserted u = {t}");
     let fresh = s0.insert_knot(0, t, 1).unwrap();
     let moved: Vec<(usize, usize)> = (0..s1.count()[0])
         .flat_map(|i| (0..s1.count()[1]).map(move |j| (i, j)))
@@ -650,6 +653,9 @@ fn screenshots_show_the_bytes_their_frame_copied() {
         nonzero += usize::from(bytes[f] > 0);
     }
     assert_eq!(nonzero, 1, "frame 7 copies frame 6's rows: {bytes:?}");
+    // The one with a figure is the screenshot taken during the drag (never "0.0 KB").
+    assert!(bytes[7] > 0, "the drag's frame copied rows: {bytes:?}");
+    eprintln!("frame 7: {:?}", kb_to_gpu(&dir.join("shot7.png")).0);
 }
 
 /// A status message the window can only show with its middle elided (saving an expo ERBS
@@ -742,4 +748,70 @@ fn a_retained_drag_looks_exactly_like_a_full_redraw() {
     // The negative control of the comparison: the mid-drag and last images differ.
     let moved = common::compare_images(&shots[0][0], &shots[0][1], 0).unwrap();
     assert!(moved.differing > 0, "the drag moved nothing");
+}
+
+/// A flat 6 × 4 Bézier patch in z = 0 (the viewer looks at flat scenes from above, tilted).
+const FLAT: &str = r#"{"objects": [{"name": "plate", "type": "bezier_surface", "samples": [24, 24],
+  "points": [[[-3, -2, 0], [-3, -0.7, 0], [-3, 0.7, 0], [-3, 2, 0]],
+             [[-1, -2, 0], [-1, -0.7, 0], [-1, 0.7, 0], [-1, 2, 0]],
+             [[1, -2, 0], [1, -0.7, 0], [1, 0.7, 0], [1, 2, 0]],
+             [[3, -2, 0], [3, -0.7, 0], [3, 0.7, 0], [3, 2, 0]]]}]}"#;
+
+/// Empty rows above and below what is drawn: a row is empty when every pixel is within 24
+/// levels of the row's first pixel (the background, whatever its gradient).
+fn vertical_margins(px: &Pixels) -> (u32, u32) {
+    let at = |x: u32, y: u32| {
+        let i = 4 * (y * px.width + x) as usize;
+        &px.rgba[i..i + 3]
+    };
+    let drawn = |y: u32| {
+        let bg = at(0, y);
+        (1..px.width).any(|x| at(x, y).iter().zip(bg).any(|(a, b)| a.abs_diff(*b) > 24))
+    };
+    let rows: Vec<u32> = (0..px.height).filter(|&y| drawn(y)).collect();
+    let (Some(first), Some(last)) = (rows.first(), rows.last()) else {
+        panic!("nothing drawn in the {}×{} screenshot", px.width, px.height)
+    };
+    (*first, px.height - 1 - last)
+}
+
+/// Whether the empty bands above and below differ by at most `px` pixels.
+fn balanced(margins: (u32, u32), px: u32) -> bool {
+    margins.0.abs_diff(margins.1) <= px
+}
+
+/// Issue 24 (8): a flat object opened in the viewer is framed by what is drawn, with equal
+/// empty bands above and below (the bounding-box framing left about 340 px above and 35 below).
+/// The same measure on the view panned down by 20 px finds them about 40 px apart.
+#[test]
+fn a_flat_object_opens_with_balanced_margins() {
+    if !common::display() {
+        return;
+    }
+    let dir = Scratch::new("view-margins");
+    let scene = dir.file("flat.json", FLAT);
+    let script = dir.file(
+        "script.json",
+        r#"[{"frame": 2, "screenshot": "opened.png"},
+            {"frame": 3, "move": [4, 4]}, {"frame": 4, "press": "right"},
+            {"frame": 5, "move_by": [0, 20]}, {"frame": 6, "release": "right"},
+            {"frame": 8, "screenshot": "panned.png"}, {"frame": 9, "quit": true}]"#,
+    );
+    let out = run(prespline(&dir)
+        .args(["view", "--size", "960x600", "--script"])
+        .arg(&script)
+        .arg(&scene));
+    assert!(
+        out.status.success(),
+        "viewer failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let opened = vertical_margins(&Pixels::read_png(&dir.join("opened.png")).unwrap());
+    let panned = vertical_margins(&Pixels::read_png(&dir.join("panned.png")).unwrap());
+    eprintln!("margins (top, bottom): opened {opened:?}, panned {panned:?}");
+    assert!(balanced(opened, 3), "opened with margins {opened:?}");
+    assert!(opened.0 >= 20, "a margin is kept: {opened:?}");
+    // Negative control: the measure sees a real imbalance in a viewer screenshot.
+    assert!(!balanced(panned, 3), "panned by 20 px: {panned:?}");
+    assert!(panned.0 > panned.1 + 30, "panned down by 20 px: {panned:?}");
 }

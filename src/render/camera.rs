@@ -76,60 +76,6 @@ impl OrbitCamera {
         }
     }
 
-    /// Places the target at the bounds' centre and picks the smallest distance at which all
-    /// eight corners of the box project inside 90 % of the image (bisection; the sphere-fit
-    /// distance is the safe upper bound). The viewer's framing; `render` frames the projected
-    /// drawing instead ([`OrbitCamera::frame_points`]).
-    pub fn frame(&mut self, bounds: &Bounds, aspect: f64) {
-        self.target = bounds.centre();
-        let half = 0.5 * self.fov_y;
-        let half_h = (half.tan() * aspect.min(1.0)).atan();
-        let safe = bounds.radius() / half_h.min(half).sin() * 1.05;
-        if bounds.is_empty() {
-            self.distance = safe;
-            return;
-        }
-        let corners: Vec<DVec3> = (0..8)
-            .map(|i| {
-                DVec3::new(
-                    if i & 1 == 0 {
-                        bounds.min.x
-                    } else {
-                        bounds.max.x
-                    },
-                    if i & 2 == 0 {
-                        bounds.min.y
-                    } else {
-                        bounds.max.y
-                    },
-                    if i & 4 == 0 {
-                        bounds.min.z
-                    } else {
-                        bounds.max.z
-                    },
-                )
-            })
-            .collect();
-        let fits = |cam: &OrbitCamera| {
-            let (near, far) = cam.clip_planes(bounds);
-            let vp = DMat4::perspective_rh(cam.fov_y, aspect, near, far) * cam.view();
-            corners.iter().all(|&p| {
-                let c = vp * p.extend(1.0);
-                c.w > 0.0 && (c.x / c.w).abs() <= 0.9 && (c.y / c.w).abs() <= 0.9
-            })
-        };
-        let (mut lo, mut hi) = (0.0, safe);
-        for _ in 0..40 {
-            let mid = 0.5 * (lo + hi);
-            let probe = OrbitCamera {
-                distance: mid,
-                ..*self
-            };
-            if fits(&probe) { hi = mid } else { lo = mid }
-        }
-        self.distance = hi;
-    }
-
     /// Frames the projected bounds of `points` (inside `bounds`): from the current direction
     /// their projections are centred in the image and fill 90 % of it in the tighter
     /// direction, so a flat object seen at an angle gets equal margins above and below

@@ -34,7 +34,7 @@ pub fn shot_camera(doc: &Document, shot: &Shot) -> OrbitCamera {
         let mut c = OrbitCamera::default_for(&bounds);
         let nets = shot.options.control_nets != super::style::NetMode::Off;
         c.frame_points(
-            &framing_points(doc, nets),
+            &framing_points(doc, |_| nets),
             &bounds,
             shot.width as f64 / shot.height as f64,
         );
@@ -42,11 +42,12 @@ pub fn shot_camera(doc: &Document, shot: &Shot) -> OrbitCamera {
     })
 }
 
-/// What the default framing fits: the drawn samples, and the control points when `nets` are
-/// drawn (hidden ones, such as ERBS local patches' points above a surface, would leave an
-/// empty band), every k-th of them so that at most about 8192 are projected per fitting step.
+/// What the default framing fits: the drawn samples, and the control points of the objects
+/// whose nets are drawn (`nets(i)`; hidden ones, such as ERBS local patches' points above a
+/// surface, would leave an empty band), every k-th of them so that at most about 8192 are
+/// projected per fitting step.
 #[must_use]
-pub fn framing_points(doc: &Document, nets: bool) -> Vec<DVec3> {
+pub fn framing_points(doc: &Document, nets: impl Fn(usize) -> bool) -> Vec<DVec3> {
     const MAX: usize = 8192;
     let count = |i: usize| {
         let g = doc.objects[i].sampled.grid();
@@ -54,7 +55,7 @@ pub fn framing_points(doc: &Document, nets: bool) -> Vec<DVec3> {
     };
     let samples: usize = (0..doc.objects.len()).map(count).sum();
     let handles: Vec<DVec3> = (0..doc.objects.len())
-        .filter(|_| nets)
+        .filter(|&i| nets(i))
         .flat_map(|i| doc.handles(i).into_iter().map(|(_, p)| p))
         .collect();
     let every = (samples + handles.len()).div_ceil(MAX).max(1);

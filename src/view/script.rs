@@ -54,6 +54,12 @@ pub enum Action {
         mods: Modifiers,
     },
     MoveTo(Handle),
+    /// The cursor onto object `object`'s drawn sample nearest the parameter `at` (a curve's t
+    /// in `at[0]`, a surface's (u, v)), wherever the camera puts it.
+    MoveOnto {
+        object: usize,
+        at: [f64; 2],
+    },
     MoveBy(f64, f64),
     Type(String),
     /// A PNG of the view (with the HUD when the flag is set).
@@ -110,7 +116,7 @@ fn parse_event(v: &Value, doc: &Document) -> Result<ScriptEvent, String> {
         alt: flag("alt"),
     };
     let known = [
-        "frame", "t", "ctrl", "shift", "alt", "object", "local", "point", "hud",
+        "frame", "t", "ctrl", "shift", "alt", "object", "local", "point", "at", "hud",
     ];
     let actions: Vec<&String> = obj
         .keys()
@@ -142,6 +148,7 @@ fn parse_event(v: &Value, doc: &Document) -> Result<ScriptEvent, String> {
             let (x, y) = pair(arg)?;
             Action::MoveBy(x, y)
         }
+        "move_to" if arg.get("at").is_some() => onto(arg, doc)?,
         "move_to" => Action::MoveTo(handle(arg, doc)?),
         "press" => Action::Input(InputEvent::Button {
             button: button(arg)?,
@@ -199,7 +206,8 @@ fn parse_event(v: &Value, doc: &Document) -> Result<ScriptEvent, String> {
 }
 
 /// `{"object": name, "point": i | [i, j]}` or with `"local"` for ERBS objects.
-fn handle(v: &Value, doc: &Document) -> Result<Handle, String> {
+/// The object a `move_to` names, by index, and its name.
+fn target<'a>(v: &'a Value, doc: &Document) -> Result<(usize, &'a str), String> {
     let name = v
         .get("object")
         .and_then(Value::as_str)
@@ -209,6 +217,42 @@ fn handle(v: &Value, doc: &Document) -> Result<Handle, String> {
         .iter()
         .position(|o| o.name == name)
         .ok_or(format!("unknown object '{name}'"))?;
+    Ok((object, name))
+}
+
+/// `{"object": NAME, "at": t}` (curves) or `"at": [u, v]` (surfaces): a parameter inside the
+/// object's domain, which no edit changes, so it is checked here.
+fn onto(v: &Value, doc: &Document) -> Result<Action, String> {
+    let (object, name) = target(v, doc)?;
+    if v.get("point").is_some() || v.get("local").is_some() {
+        return Err("'move_to' takes either \"at\" or \"point\", not both".into());
+    }
+    let params = doc.objects[object].sampled.params();
+    let at: Vec<f64> = match &v["at"] {
+        Value::Number(n) => n.as_f64().into_iter().collect(),
+        Value::Array(a) => a.iter().map(|x| x.as_f64().unwrap_or(f64::NAN)).collect(),
+        _ => Vec::new(),
+    };
+    if at.len() != params.len() {
+        let want = if params.len() == 1 { "t" } else { "[u, v]" };
+        return Err(format!("object '{name}': 'at' expects {want}"));
+    }
+    for (x, p) in at.iter().zip(&params) {
+        let (lo, hi) = (p[0], p[p.len() - 1]);
+        if !(lo..=hi).contains(x) {
+            return Err(format!(
+                "object '{name}': 'at' {x} is outside the domain [{lo}, {hi}]"
+            ));
+        }
+    }
+    Ok(Action::MoveOnto {
+        object,
+        at: [at[0], at.get(1).copied().unwrap_or(0.0)],
+    })
+}
+
+fn handle(v: &Value, doc: &Document) -> Result<Handle, String> {
+    let (object, name) = target(v, doc)?;
     let index = |k: &str| -> Result<Option<Index2>, String> {
         match v.get(k) {
             None => Ok(None),
@@ -346,6 +390,36 @@ mod tests {
                 "{text}: {e}"
             );
             assert!(!e.contains('\n'), "{text}: one line, got {e:?}");
+        }
+    }
+
+    #[test]
+    fn move_to_a_parameter_is_checked_against_the_object() {
+        let events =
+            parse(r#"[{"frame": 1, "move_to": {"object": "bspline_surface", "at": [0.25, 0.5]}}]"#)
+                .unwrap();
+        assert!(matches!(
+            events[0].action,
+            Action::MoveOnto {
+                at: [0.25, 0.5],
+                ..
+            }
+        ));
+        for (at, needle) in [
+            ("0.5", "expects [u, v]"),
+            ("[0.5]", "expects [u, v]"),
+            ("[0.5, 7]", "outside the domain"),
+            ("[0.5, \"x\"]", "outside the domain"),
+            ("[0.5, 0.5], \"point\": [1, 1]", "not both"),
+        ] {
+            let text = format!(
+                r#"[{{"frame": 1, "move_to": {{"object": "bspline_surface", "at": {at}}}}}]"#
+            );
+            let e = parse(&text).expect_err(&text);
+            assert!(
+                e.starts_with("event 0: ") && e.contains(needle),
+                "{text}: {e}"
+            );
         }
     }
 

@@ -94,7 +94,7 @@ impl Session {
         let nets = default_nets(editor.doc());
         let gpu = GpuScene::new(renderer, editor.doc())?;
         Ok(Self {
-            stage: Stage::new(editor, size),
+            stage: Stage::new(editor, size, nets),
             mode: Mode::Idle,
             gpu,
             options: ViewOptions {
@@ -349,6 +349,12 @@ impl Session {
                 }
                 None => {}
             },
+            Action::MoveOnto { object, at } => {
+                let p = self.stage.sample_near(object, at);
+                if let Some((x, y)) = p.and_then(|p| self.stage.view().project(p)) {
+                    self.handle(InputEvent::CursorMoved { x, y });
+                }
+            }
             Action::MoveBy(dx, dy) => {
                 let (x, y) = self.stage.cursor;
                 self.handle(InputEvent::CursorMoved {
@@ -548,8 +554,8 @@ impl Session {
             }
             Command::ToggleHud => toggle(&mut self.hud.visible),
             Command::ToggleHelp => toggle(&mut self.show_help),
-            Command::FrameSelection => s.frame_selection(),
-            Command::FrameAll => s.frame_all(),
+            Command::FrameSelection => s.frame_selection(self.options.control_nets),
+            Command::FrameAll => s.frame_all(self.options.control_nets),
             Command::Home => s.go_home(),
             Command::Escape => {
                 s.selection.clear();
@@ -684,7 +690,7 @@ impl Session {
     }
 
     pub fn frame_all(&mut self) {
-        self.stage.frame_all();
+        self.stage.frame_all(self.options.control_nets);
     }
 }
 

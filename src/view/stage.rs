@@ -8,6 +8,8 @@ use super::picking::{PICK_RADIUS, Projected, pick, project_all};
 use super::tools::View;
 use crate::editor::{Document, Editor, Handle, Refused};
 use crate::model::{Edit, Index2, LocalPath};
+use crate::render::offscreen::framing_points;
+use crate::render::style::NetMode;
 use crate::render::{Bounds, OrbitCamera};
 use glam::DVec3;
 use std::time::Instant;
@@ -88,13 +90,17 @@ pub struct Stage {
 }
 
 impl Stage {
-    /// The editor's document framed for a `size` image.
+    /// The editor's document framed for a `size` image as [`Stage::frame_all`] frames it.
     #[must_use]
-    pub fn new(editor: Editor, size: [u32; 2]) -> Self {
+    pub fn new(editor: Editor, size: [u32; 2], nets: NetMode) -> Self {
         let bounds = editor.doc().bounds();
         let size = [size[0].max(1) as f64, size[1].max(1) as f64];
         let mut camera = OrbitCamera::default_for(&bounds);
-        camera.frame(&bounds, size[0] / size[1]);
+        camera.frame_points(
+            &framing_points(editor.doc(), |_| nets == NetMode::All),
+            &bounds,
+            size[0] / size[1],
+        );
         Self {
             editor,
             camera,
@@ -343,14 +349,26 @@ impl Stage {
         self.moved();
     }
 
-    pub fn frame_all(&mut self) {
+    /// Frames what is drawn, as `prespline render` does: the projected samples, and the
+    /// control points of the objects whose nets `nets` shows (all, or the selected object's),
+    /// centred with balanced margins (fitting the bounding box left a flat object seen from
+    /// above crowded at the bottom and empty on top).
+    pub fn frame_all(&mut self, nets: NetMode) {
         self.refresh_bounds();
-        self.camera.frame(&self.bounds, self.size[0] / self.size[1]);
+        let focused = self.selection.focused_object();
+        let shown = |i: usize| match nets {
+            NetMode::All => true,
+            NetMode::Focused => focused == Some(i),
+            NetMode::Off => false,
+        };
+        let points = framing_points(self.editor.doc(), shown);
+        self.camera
+            .frame_points(&points, &self.bounds, self.size[0] / self.size[1]);
         self.moved();
     }
 
     /// Frames the selected local, or the selected point's object, or everything.
-    pub fn frame_selection(&mut self) {
+    pub fn frame_selection(&mut self, nets: NetMode) {
         let doc = self.editor.doc();
         let points: Vec<DVec3> = match (self.selection.selected_local, self.selection.selected) {
             (Some((o, l)), _) => doc.local_points(o, l).unwrap_or_default(),
@@ -359,12 +377,31 @@ impl Stage {
                 .into_iter()
                 .map(|(_, p)| p)
                 .collect(),
-            (None, None) => return self.frame_all(),
+            (None, None) => return self.frame_all(nets),
         };
         let mut b = Bounds::EMPTY;
         points.iter().for_each(|&p| b.include(p));
-        self.camera.frame(&b, self.size[0] / self.size[1]);
+        self.camera
+            .frame_points(&points, &b, self.size[0] / self.size[1]);
         self.moved();
+    }
+
+    /// Object `object`'s sample nearest the parameter `at` (t in `at[0]` on curves): a point
+    /// of the object as drawn.
+    #[must_use]
+    pub fn sample_near(&self, object: usize, at: [f64; 2]) -> Option<DVec3> {
+        let o = self.doc().objects.get(object)?;
+        let nearest = |params: &[f64], x: f64| {
+            (0..params.len())
+                .min_by(|&a, &b| (params[a] - x).abs().total_cmp(&(params[b] - x).abs()))
+        };
+        let params = o.sampled.params();
+        let i = nearest(params[0], at[0])?;
+        let j = match params.get(1) {
+            Some(v) => nearest(v, at[1])?,
+            None => 0,
+        };
+        Some(o.sampled.grid().position(i, j))
     }
 
     /// Back to the camera the session opened with.

@@ -303,7 +303,13 @@ mod tests {
         b.include(DVec3::splat(-1.0));
         b.include(DVec3::splat(1.0));
         let mut c = OrbitCamera::default();
-        c.frame(&b, 4.0 / 3.0);
+        let corners: Vec<DVec3> = (0..8)
+            .map(|i| {
+                let s = |bit: usize| if i & bit == 0 { -1.0 } else { 1.0 };
+                DVec3::new(s(1), s(2), s(4))
+            })
+            .collect();
+        c.frame_points(&corners, &b, 4.0 / 3.0);
         (c, b)
     }
 
