@@ -2,7 +2,7 @@
 //! (continuity badges) and the osculating circle with curvature and torsion at a parameter.
 //! Pure f64 computations from the model; drawing them is the overlays' business.
 
-pub use super::style::short;
+pub use super::numbers::short;
 use crate::editor::Document;
 use crate::geom::continuity::{JoinClass, classify};
 use crate::geom::differential::frenet_frame;

@@ -342,7 +342,7 @@ pub fn legend(
     }
     let ly = by + bar_h + 4.0;
     let number = |x: f64| {
-        let t = super::style::short(x.abs());
+        let t = super::numbers::short(x.abs());
         if x < 0.0 { format!("-{t}") } else { t }
     };
     let lo = number(scale.low);

@@ -9,6 +9,7 @@ pub mod image_file;
 pub mod lod;
 pub mod map_mirror;
 pub mod maps;
+pub mod numbers;
 pub mod offscreen;
 pub mod overlays;
 pub mod retained;
