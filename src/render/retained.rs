@@ -22,9 +22,10 @@
 use super::lod::Lod;
 use super::map_mirror::MapView;
 use super::style::ViewOptions;
+use crate::editor::{ControlLayout, LOCAL_CURVE_SAMPLES, LOCAL_PATCH_SAMPLES};
 use crate::gpu::{Camera, GridShape, GridStride};
-use crate::model::Target;
-use crate::sampling::{DirtyRegion, SampleGrid};
+use crate::model::{Index2, Target};
+use crate::sampling::{DirtyRegion, DirtySet, SampleGrid};
 use glam::{DVec3, Vec4};
 use std::ops::Range;
 
@@ -82,9 +83,11 @@ pub(crate) struct LayerKey {
     /// Whether the curvature map's scalars were built (before, plain shading stands in).
     pub scalars: bool,
     pub objects: usize,
-    /// The gesture the layer leaves out (highlights are not part of the key: they only
-    /// change control points and nets, which are drawn every frame).
+    /// The gesture the layer leaves out.
     pub gesture: Gesture,
+    /// Hovered and selected handles and locals: they colour and size points and nets drawn
+    /// in the layer.
+    pub highlight: super::gpu_scene::Highlight,
     /// The stride the dragged surface is drawn at (frozen for the gesture).
     pub stride: Option<GridStride>,
 }
@@ -208,6 +211,18 @@ pub fn sample_bounds(grid: &SampleGrid, rects: Option<&[[Range<usize>; 2]]>) -> 
 /// eye or is not finite.
 #[must_use]
 pub fn screen_rect(camera: &Camera, bounds: [DVec3; 2], viewport: [u32; 4]) -> [u32; 4] {
+    screen_rect_with(camera, bounds, viewport, 2.0)
+}
+
+/// [`screen_rect`] with a margin of `margin` pixels (for lines and points drawn wider than a
+/// pixel around their vertices).
+#[must_use]
+pub fn screen_rect_with(
+    camera: &Camera,
+    bounds: [DVec3; 2],
+    viewport: [u32; 4],
+    margin: f32,
+) -> [u32; 4] {
     let [lo, hi] = bounds;
     let mut ndc_lo = [f32::INFINITY; 2];
     let mut ndc_hi = [f32::NEG_INFINITY; 2];
@@ -231,12 +246,12 @@ pub fn screen_rect(camera: &Camera, bounds: [DVec3; 2], viewport: [u32; 4]) -> [
     }
     let [vx, vy, vw, vh] = viewport;
     let (w, h) = (vw as f32, vh as f32);
-    const MARGIN: f32 = 2.0;
+    let margin = margin.max(2.0);
     // y grows downwards on screen: NDC y = 1 is the top row.
-    let x0 = (ndc_lo[0] + 1.0) * 0.5 * w - MARGIN;
-    let x1 = (ndc_hi[0] + 1.0) * 0.5 * w + MARGIN;
-    let y0 = (1.0 - ndc_hi[1]) * 0.5 * h - MARGIN;
-    let y1 = (1.0 - ndc_lo[1]) * 0.5 * h + MARGIN;
+    let x0 = (ndc_lo[0] + 1.0) * 0.5 * w - margin;
+    let x1 = (ndc_hi[0] + 1.0) * 0.5 * w + margin;
+    let y0 = (1.0 - ndc_hi[1]) * 0.5 * h - margin;
+    let y1 = (1.0 - ndc_lo[1]) * 0.5 * h + margin;
     let clamp = |v: f32, max: u32| v.floor().clamp(0.0, max as f32) as u32;
     let (x0, x1) = (clamp(x0, vw), clamp(x1.ceil(), vw));
     let (y0, y1) = (clamp(y0, vh), clamp(y1.ceil(), vh));
@@ -247,6 +262,133 @@ pub fn screen_rect(camera: &Camera, bounds: [DVec3; 2], viewport: [u32; 4]) -> [
 #[must_use]
 pub fn overlaps(a: [u32; 4], b: [u32; 4]) -> bool {
     a[0] < b[0] + b[2] && b[0] < a[0] + a[2] && a[1] < b[1] + b[3] && b[1] < a[1] + a[3]
+}
+
+/// The smallest pixel rectangle holding both (an empty one adds nothing).
+#[must_use]
+pub fn union_rect(a: [u32; 4], b: [u32; 4]) -> [u32; 4] {
+    if a[2] == 0 || a[3] == 0 {
+        return b;
+    }
+    if b[2] == 0 || b[3] == 0 {
+        return a;
+    }
+    let (x0, y0) = (a[0].min(b[0]), a[1].min(b[1]));
+    let x1 = (a[0] + a[2]).max(b[0] + b[2]);
+    let y1 = (a[1] + a[3]).max(b[1] + b[3]);
+    [x0, y0, x1 - x0, y1 - y0]
+}
+
+/// The control display vertices a gesture on `target` rewrites, as far as the layout tells
+/// before it does (an edit that rewrites others makes the layer stale; see
+/// [`super::GpuScene::consume`]).
+#[must_use]
+pub fn moving_vertices(layout: &ControlLayout, target: Target) -> DirtySet {
+    let mut set = DirtySet::default();
+    match (layout, target) {
+        (ControlLayout::Polygon { count }, Target::Point(Index2::One(k))) if k < *count => {
+            set.insert(k..k + 1);
+        }
+        (ControlLayout::Net { rows, cols }, Target::Point(Index2::Two(i, j)))
+            if i < *rows && j < *cols =>
+        {
+            set.insert(i * cols + j..i * cols + j + 1);
+        }
+        (
+            ControlLayout::LocalCurves(entries) | ControlLayout::LocalPatches(entries),
+            Target::Local(local),
+        ) => {
+            for e in entries.iter().filter(|e| e.path.starts_with(&local)) {
+                set.insert(e.samples..e.samples + entry_samples(layout));
+                set.insert(e.points..e.points + e.rows * e.cols);
+            }
+        }
+        _ => {}
+    }
+    set
+}
+
+/// Display sample vertices of one ERBS local (patches store a normal after each position).
+fn entry_samples(layout: &ControlLayout) -> usize {
+    match layout {
+        ControlLayout::LocalPatches(_) => 2 * LOCAL_PATCH_SAMPLES * LOCAL_PATCH_SAMPLES,
+        _ => LOCAL_CURVE_SAMPLES,
+    }
+}
+
+/// The vertices of every line and point drawn through a vertex of `moving`: its neighbours
+/// in the polygon or net, the whole local for ERBS locals (their wires, nets and points).
+#[must_use]
+pub fn touched_vertices(layout: &ControlLayout, moving: &DirtySet) -> DirtySet {
+    let mut set = DirtySet::default();
+    let hit = |r: &Range<usize>| {
+        moving
+            .ranges()
+            .iter()
+            .any(|m| m.start < r.end && r.start < m.end)
+    };
+    match layout {
+        ControlLayout::Polygon { count } => {
+            for m in moving.ranges() {
+                set.insert(m.start.saturating_sub(1)..(m.end + 1).min(*count));
+            }
+        }
+        ControlLayout::Net { rows, cols } => {
+            for k in moving.ranges().iter().flat_map(|m| m.clone()) {
+                let (i, j) = (k / cols, k % cols);
+                set.insert(k..k + 1);
+                if i > 0 {
+                    set.insert(k - cols..k - cols + 1);
+                }
+                if i + 1 < *rows {
+                    set.insert(k + cols..k + cols + 1);
+                }
+                if j > 0 {
+                    set.insert(k - 1..k);
+                }
+                if j + 1 < *cols {
+                    set.insert(k + 1..k + 2);
+                }
+            }
+        }
+        ControlLayout::LocalCurves(entries) | ControlLayout::LocalPatches(entries) => {
+            for e in entries {
+                let samples = e.samples..e.samples + entry_samples(layout);
+                let points = e.points..e.points + e.rows * e.cols;
+                if hit(&samples) || hit(&points) {
+                    set.insert(samples);
+                    set.insert(points);
+                }
+            }
+        }
+    }
+    set
+}
+
+/// Whether `set` holds every index of `r`.
+#[must_use]
+pub fn covers(set: &DirtySet, r: &Range<usize>) -> bool {
+    r.is_empty()
+        || set
+            .ranges()
+            .iter()
+            .any(|s| s.start <= r.start && r.end <= s.end)
+}
+
+/// World-space bounds of `vertices` at the indices of `set` (patch normals among them only
+/// make the box larger).
+#[must_use]
+pub fn vertex_bounds(vertices: &[DVec3], set: &DirtySet) -> Option<[DVec3; 2]> {
+    let mut b: Option<[DVec3; 2]> = None;
+    for r in set.ranges() {
+        for &p in vertices.get(r.clone()).unwrap_or(&[]) {
+            b = Some(match b {
+                Some([lo, hi]) => [lo.min(p), hi.max(p)],
+                None => [p, p],
+            });
+        }
+    }
+    b
 }
 
 #[cfg(test)]
