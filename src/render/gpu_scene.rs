@@ -483,7 +483,7 @@ impl GpuScene {
             for b in &order {
                 self.draw_batch(frame, doc, opts, b, &b.members)?;
             }
-            self.draw_lines(frame, doc, opts, hl, &|_| true)?;
+            self.draw_lines(frame, doc, opts, hl, &|_| true, None)?;
         }
         Ok(report)
     }
@@ -497,6 +497,7 @@ impl GpuScene {
         opts: &ViewOptions,
         hl: &Highlight,
         only: &dyn Fn(usize) -> bool,
+        clip: Option<&NetClip>,
     ) -> GpuResult<()> {
         let palette = Palette::default();
         for (i, o) in self.objects.iter().enumerate().filter(|(i, _)| only(*i)) {
@@ -518,8 +519,15 @@ impl GpuScene {
                     polyline(frame, &self.arenas[o.samples.arena], run, &style)?;
                 }
             }
-            let layout = &doc.objects[i].controls.layout;
-            self.draw_controls(frame, i, o, layout, opts, hl, &palette)?;
+            let controls = &doc.objects[i].controls;
+            if let (Some(c), ControlLayout::Net { rows, cols }) = (clip, &controls.layout)
+                && c.object == i
+                && net_shown(opts, hl, i)
+            {
+                clipped_net(frame, o, &controls.vertices, [*rows, *cols], opts, hl, c)?;
+                continue;
+            }
+            self.draw_controls(frame, i, o, &controls.layout, opts, hl, &palette)?;
         }
         Ok(())
     }
@@ -717,9 +725,9 @@ impl GpuScene {
             if let (Some((pb, _)), Some(c)) = (place, &cells) {
                 self.draw_cells(frame, doc, &order[pb], g.object, &c.dynamic)?;
             }
-            return self.draw_lines(frame, doc, opts, hl, &|_| true);
+            return self.draw_lines(frame, doc, opts, hl, &|_| true, None);
         };
-        self.draw_lines(frame, doc, opts, hl, &|_| true)?;
+        self.draw_lines(frame, doc, opts, hl, &|_| true, None)?;
         // Saves need the same as the first one did: this one cannot fail where it succeeded.
         let lines = frame
             .save_static_layer(LayerPart::Lines)?
@@ -832,7 +840,13 @@ impl GpuScene {
         frame.set_scissor(Some(r));
         let reaches =
             |i: usize| i == g.object || layer.line_rects[i].is_some_and(|lr| overlaps(lr, r));
-        self.draw_lines(frame, doc, opts, hl, &reaches)?;
+        let clip = NetClip {
+            object: g.object,
+            rect: r,
+            camera,
+            viewport,
+        };
+        self.draw_lines(frame, doc, opts, hl, &reaches, Some(&clip))?;
         frame.set_scissor(None);
         Ok(())
     }
@@ -930,11 +944,7 @@ impl GpuScene {
             width: 1.0,
             depth_test: true,
         };
-        let nets = match opts.control_nets {
-            NetMode::All => true,
-            NetMode::Focused => hl.focuses(i),
-            NetMode::Off => false,
-        };
+        let nets = net_shown(opts, hl, i);
         let index_in = |h: Option<Handle>, f: &dyn Fn(Handle) -> Option<u32>| {
             h.filter(|h| h.object() == i).and_then(f)
         };
@@ -1101,6 +1111,92 @@ impl GpuScene {
             renderer.destroy_mirror(o.controls);
         }
     }
+}
+
+/// Whether object `i`'s control net or polygon is shown.
+fn net_shown(opts: &ViewOptions, hl: &Highlight, i: usize) -> bool {
+    match opts.control_nets {
+        NetMode::All => true,
+        NetMode::Focused => hl.focuses(i),
+        NetMode::Off => false,
+    }
+}
+
+/// A pixel rectangle that draws are clipped to, so the gesture's control net need only draw
+/// its rows and columns that reach it.
+struct NetClip {
+    object: usize,
+    rect: [u32; 4],
+    camera: crate::gpu::Camera,
+    viewport: [u32; 4],
+}
+
+/// The rows, then the columns, then the points (row by row) of a `rows × cols` control net
+/// whose screen rectangles reach `clip`'s. Within the clip this is the full net's image: net
+/// lines are one colour, so their order among themselves changes no pixel, points follow all
+/// lines as in the full draw and keep their order, and what is left out has no pixel there.
+fn clipped_net(
+    frame: &mut Frame<'_>,
+    o: &ObjectGpu,
+    vertices: &[DVec3],
+    [rows, cols]: [usize; 2],
+    opts: &ViewOptions,
+    hl: &Highlight,
+    clip: &NetClip,
+) -> GpuResult<()> {
+    let palette = Palette::default();
+    let margin = line_margin(opts);
+    let reaches = |points: &mut dyn Iterator<Item = DVec3>| {
+        let b = points.fold(None, |b: Option<[DVec3; 2]>, p| {
+            Some(b.map_or([p, p], |[lo, hi]| [lo.min(p), hi.max(p)]))
+        });
+        b.is_some_and(|b| {
+            overlaps(
+                screen_rect_with(&clip.camera, b, clip.viewport, margin),
+                clip.rect,
+            )
+        })
+    };
+    let row_hit: Vec<bool> = (0..rows)
+        .map(|r| reaches(&mut vertices[r * cols..(r + 1) * cols].iter().copied()))
+        .collect();
+    let col_hit: Vec<bool> = (0..cols)
+        .map(|c| reaches(&mut (0..rows).map(|r| vertices[r * cols + c])))
+        .collect();
+    let net = PolylineStyle {
+        color: palette.net,
+        width: 1.0,
+        depth_test: true,
+    };
+    let run = |offset: usize, stride: usize, count: usize| PointRun {
+        offset: offset * 3,
+        stride: stride * 3,
+        count,
+    };
+    for r in (0..rows).filter(|&r| row_hit[r]) {
+        polyline(frame, &o.controls, run(r * cols, 1, cols), &net)?;
+    }
+    for c in (0..cols).filter(|&c| col_hit[c]) {
+        polyline(frame, &o.controls, run(c, cols, rows), &net)?;
+    }
+    let index_of = |h: Option<Handle>, r: usize| match h {
+        Some(Handle::Point {
+            object,
+            point: Index2::Two(a, b),
+        }) if object == clip.object && a == r => Some(b as u32),
+        _ => None,
+    };
+    for r in (0..rows).filter(|&r| row_hit[r]) {
+        let style = PointStyle {
+            color: palette.point,
+            size: opts.point_size,
+            hovered: index_of(hl.hovered, r),
+            selected: index_of(hl.selected, r),
+            ..PointStyle::default()
+        };
+        frame.draw_points(&o.controls, run(r * cols, 1, cols), &style)?;
+    }
+    Ok(())
 }
 
 /// Pixels that lines and points reach beyond their vertices' projections: half the largest
