@@ -4,8 +4,8 @@
 //! Why a retained frame equals a full redraw bit for bit (MSAA 1): surfaces are opaque and
 //! drawn with depth test LESS_OR_EQUAL, so a pixel ends up with the *last* of the fragments of
 //! least depth, in draw order. The full order is P (surfaces before the dragged one), O (the
-//! dragged surface, its cells row by row), Q (surfaces after it); lines, points and overlays
-//! follow and are drawn in every frame in both modes, on the same surface image.
+//! dragged surface, its cells row by row), Q (surfaces after it); then lines and points (L),
+//! then overlays, drawn in every frame in both modes.
 //! - The layer holds P, O's static cells and Q in that order; the dynamic cells D are drawn
 //!   after it. Against P, D comes later in both orders, so ties go to D in both.
 //! - Against Q, D comes *earlier* in the full order: a Q fragment tying D must win. So every
@@ -18,6 +18,17 @@
 //!   fill rule gives each pixel of a shared edge to one triangle only: they meet at a tie
 //!   only where the surface folds onto itself with equal depth, the one case this leaves to
 //!   draw order within O.
+//!
+//! Lines and points: the layer has two saves, the surfaces above (S) and S with all of L drawn
+//! over it (SL). Let R be a pixel rectangle holding the dynamic cells' fragments and those of
+//! every line or point through a control vertex that moves, both as drawn now and as SL holds
+//! them. Outside R no fragment differs from the full redraw's, so SL is its image there. Inside
+//! R a frame copies S back and draws the surfaces as above, then every line and point draw that
+//! reaches R in full order, clipped to R: a full redraw of R. (A draw left out has no fragment
+//! in R; of the dragged surface's net only rows and columns that reach R are drawn, which
+//! changes no pixel because its segments are one colour and its points still follow them in
+//! order.) Points are drawn without depth test, so order matters between every line and point
+//! draw: that is why R is redrawn in full order and not only the moving parts.
 
 use super::lod::Lod;
 use super::map_mirror::MapView;
