@@ -456,4 +456,32 @@ mod tests {
         assert!(overlaps(r, [50, 50, 10, 10]));
         assert!(!overlaps(r, [52, 0, 10, 100]));
     }
+
+    #[test]
+    fn a_moving_net_point_touches_its_four_neighbours_only() {
+        let layout = ControlLayout::Net { rows: 3, cols: 4 };
+        let moving = moving_vertices(&layout, Target::Point(Index2::Two(1, 0)));
+        assert_eq!(moving.ranges(), &[4..5]);
+        let touched = touched_vertices(&layout, &moving);
+        // (0,0), (1,0), (1,1), (2,0): no left neighbour on column 0.
+        assert_eq!(touched.ranges(), &[0..1, 4..6, 8..9]);
+        assert!(covers(&touched, &(4..6)));
+        assert!(!covers(&touched, &(3..5)));
+        let polygon = ControlLayout::Polygon { count: 5 };
+        let m = moving_vertices(&polygon, Target::Point(Index2::One(4)));
+        assert_eq!(touched_vertices(&polygon, &m).ranges(), &[3..5]);
+        // A weight moves no control point.
+        assert!(moving_vertices(&polygon, Target::Weight(Index2::One(4))).is_empty());
+    }
+
+    #[test]
+    fn rectangles_join_and_an_empty_one_adds_nothing() {
+        assert_eq!(union_rect([0, 0, 0, 0], [5, 6, 7, 8]), [5, 6, 7, 8]);
+        assert_eq!(union_rect([1, 2, 3, 4], [5, 6, 7, 8]), [1, 2, 11, 12]);
+        let bounds = vertex_bounds(
+            &[DVec3::ZERO, DVec3::ONE, DVec3::splat(-3.0)],
+            &DirtySet::all(2),
+        );
+        assert_eq!(bounds, Some([DVec3::ZERO, DVec3::ONE]));
+    }
 }
