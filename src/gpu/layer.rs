@@ -17,7 +17,7 @@ use ash::vk;
 
 use super::barrier::{self, image_barrier};
 use super::device::Device;
-use super::error::{GpuError, GpuResult};
+use super::error::GpuResult;
 use super::frame::{Frame, FrameTarget};
 use super::image::{Image, ImageDesc};
 use super::pipeline::DEPTH_FORMAT;
@@ -25,20 +25,24 @@ use super::pipeline::DEPTH_FORMAT;
 /// Distinct for every save of every layer in the process, so a stale token never matches.
 static NEXT_TOKEN: AtomicU64 = AtomicU64::new(1);
 
-/// A target's static layer: its images and which save they hold.
-pub(crate) struct StaticLayer {
+/// Which of a target's two saves: the surfaces alone, or the surfaces with the lines and
+/// points drawn over them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LayerPart {
+    Surfaces,
+    Lines,
+}
+
+/// One saved colour and depth image pair and which save it holds.
+pub(crate) struct LayerImages {
     pub color: Image,
     pub depth: Image,
     /// The token of the save the images hold (`None`: never saved).
     pub saved: Option<u64>,
 }
 
-impl StaticLayer {
-    pub(crate) fn new(
-        device: &Device,
-        extent: vk::Extent2D,
-        format: vk::Format,
-    ) -> GpuResult<Self> {
+impl LayerImages {
+    fn new(device: &Device, extent: vk::Extent2D, format: vk::Format) -> GpuResult<Self> {
         // Only copied, but every image gets a view, which needs an attachment usage.
         let copies = vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST;
         let desc = |name, format, usage| ImageDesc {
@@ -77,11 +81,51 @@ impl StaticLayer {
 
     /// # Safety
     /// No submitted GPU work that uses the images may still be pending.
-    pub(crate) unsafe fn destroy(self, device: &Device) {
+    unsafe fn destroy(self, device: &Device) {
         // SAFETY: the caller's guarantee.
         unsafe {
             self.color.destroy(device);
             self.depth.destroy(device);
+        }
+    }
+}
+
+/// A target's static layer: a save of the surfaces and one of the surfaces with the lines.
+pub(crate) struct StaticLayer {
+    parts: [LayerImages; 2],
+}
+
+impl StaticLayer {
+    pub(crate) fn new(
+        device: &Device,
+        extent: vk::Extent2D,
+        format: vk::Format,
+    ) -> GpuResult<Self> {
+        let surfaces = LayerImages::new(device, extent, format)?;
+        match LayerImages::new(device, extent, format) {
+            Ok(lines) => Ok(Self {
+                parts: [surfaces, lines],
+            }),
+            Err(e) => {
+                // SAFETY: created just above and never used by the GPU.
+                unsafe { surfaces.destroy(device) };
+                Err(e)
+            }
+        }
+    }
+
+    fn part(&mut self, part: LayerPart) -> &mut LayerImages {
+        &mut self.parts[part as usize]
+    }
+
+    /// # Safety
+    /// No submitted GPU work that uses the images may still be pending.
+    pub(crate) unsafe fn destroy(self, device: &Device) {
+        let [a, b] = self.parts;
+        // SAFETY: the caller's guarantee.
+        unsafe {
+            a.destroy(device);
+            b.destroy(device);
         }
     }
 }
@@ -98,40 +142,58 @@ const DEPTH_ACCESS: A = A::from_raw(
 const COLOR_ACCESS: A =
     A::from_raw(A::COLOR_ATTACHMENT_READ.as_raw() | A::COLOR_ATTACHMENT_WRITE.as_raw());
 
-/// Copy of a whole single-level image of `extent`.
-fn whole_copy(aspect: vk::ImageAspectFlags, extent: vk::Extent2D) -> vk::ImageCopy {
+/// Copy of the pixel rectangle `[x, y, width, height]` of a single-level image.
+fn rect_copy(aspect: vk::ImageAspectFlags, [x, y, w, h]: [u32; 4]) -> vk::ImageCopy {
     let layers = vk::ImageSubresourceLayers {
         aspect_mask: aspect,
         mip_level: 0,
         base_array_layer: 0,
         layer_count: 1,
     };
+    let offset = vk::Offset3D {
+        x: x as i32,
+        y: y as i32,
+        z: 0,
+    };
     vk::ImageCopy {
         src_subresource: layers,
-        src_offset: vk::Offset3D::default(),
+        src_offset: offset,
         dst_subresource: layers,
-        dst_offset: vk::Offset3D::default(),
+        dst_offset: offset,
         extent: vk::Extent3D {
-            width: extent.width,
-            height: extent.height,
+            width: w,
+            height: h,
             depth: 1,
         },
     }
 }
 
+/// `rect` within an image of `extent` (`None`: the whole image).
+fn clamp_rect(rect: Option<[u32; 4]>, extent: vk::Extent2D) -> [u32; 4] {
+    let (ew, eh) = (extent.width, extent.height);
+    let [x, y, w, h] = rect.unwrap_or([0, 0, ew, eh]);
+    let (x0, y0) = (x.min(ew), y.min(eh));
+    let (x1, y1) = (x.saturating_add(w).min(ew), y.saturating_add(h).min(eh));
+    [x0, y0, x1 - x0, y1 - y0]
+}
+
 impl Frame<'_> {
     /// The layer of this frame's target (`None` for multisampled targets and swapchains whose
     /// images cannot be copied).
-    fn layer(&mut self) -> Option<&mut StaticLayer> {
+    fn static_layer(&mut self) -> Option<&mut StaticLayer> {
         match &mut self.target {
             FrameTarget::Offscreen(t) => t.attachments.layer.as_mut(),
             FrameTarget::Swapchain { swapchain, .. } => swapchain.layer_mut(),
         }
     }
 
+    fn layer(&mut self, part: LayerPart) -> Option<&mut LayerImages> {
+        self.static_layer().map(|l| l.part(part))
+    }
+
     /// Whether this frame's target has a static layer.
     pub fn has_static_layer(&mut self) -> bool {
-        self.layer().is_some()
+        self.static_layer().is_some()
     }
 
     /// Announces a [`Frame::save_static_layer`] before the frame's first draw, so rendering
@@ -142,16 +204,16 @@ impl Frame<'_> {
         }
     }
 
-    /// Saves what was drawn so far (colour and depth) into the target's static layer and goes
-    /// on drawing over it. Returns the save's token for [`Frame::restore_static_layer`];
-    /// `None` when the target has no layer, or rendering began without
-    /// [`Frame::keep_depth`] (nothing is recorded then).
-    pub fn save_static_layer(&mut self) -> GpuResult<Option<u64>> {
+    /// Saves what was drawn so far (colour and depth) into `part` of the target's static
+    /// layer and goes on drawing over it. Returns the save's token for
+    /// [`Frame::restore_static_layer`]; `None` when the target has no layer, or rendering
+    /// began without [`Frame::keep_depth`] (nothing is recorded then).
+    pub fn save_static_layer(&mut self, part: LayerPart) -> GpuResult<Option<u64>> {
         let (view, cmd) = (self.view, self.cmd);
         if !self.keep_depth {
             return Ok(None);
         }
-        let Some(layer) = self.layer() else {
+        let Some(layer) = self.layer(part) else {
             return Ok(None);
         };
         let (lc, ld) = (layer.color.raw, layer.depth.raw);
@@ -222,8 +284,9 @@ impl Frame<'_> {
                 (L::TRANSFER_DST_OPTIMAL, L::TRANSFER_SRC_OPTIMAL),
             ),
         ];
-        let color_copy = [whole_copy(vk::ImageAspectFlags::COLOR, view.extent)];
-        let depth_copy = [whole_copy(vk::ImageAspectFlags::DEPTH, view.extent)];
+        let whole = clamp_rect(None, view.extent);
+        let color_copy = [rect_copy(vk::ImageAspectFlags::COLOR, whole)];
+        let depth_copy = [rect_copy(vk::ImageAspectFlags::DEPTH, whole)];
         // SAFETY: recording outside a rendering scope; the target's attachments and the layer
         // (same size and formats, TRANSFER usages) are live for this frame; the barriers put
         // every image in the layout its copy names.
@@ -250,39 +313,52 @@ impl Frame<'_> {
         self.load = true;
         self.bound = Default::default();
         let token = NEXT_TOKEN.fetch_add(1, Ordering::Relaxed);
-        if let Some(layer) = self.layer() {
+        if let Some(layer) = self.layer(part) {
             layer.saved = Some(token);
         }
         Ok(Some(token))
     }
 
-    /// Starts the frame from the static layer saved with `token` instead of clearing: one
-    /// `vkCmdCopyImage` each of colour and depth. Returns `false`, recording nothing, when the
-    /// layer holds another save (or none, or the target has no layer): draw the whole frame
-    /// then. Must come before the frame's first draw.
-    pub fn restore_static_layer(&mut self, token: u64) -> GpuResult<bool> {
-        if self.rendering {
-            return Err(GpuError::InvalidArgument(
-                "restore_static_layer after the frame began drawing".into(),
-            ));
-        }
+    /// Copies `rect` (`None`: all) of `part` of the static layer, saved with `token`, into
+    /// the frame's colour and depth: one `vkCmdCopyImage` each. Before the first draw it
+    /// starts the frame from the layer instead of clearing; later it replaces what was drawn
+    /// in `rect`. Returns `false`, recording nothing, when the part holds another save (or
+    /// none, or the target has no layer).
+    pub fn restore_static_layer(
+        &mut self,
+        part: LayerPart,
+        token: u64,
+        rect: Option<[u32; 4]>,
+    ) -> GpuResult<bool> {
         let (view, cmd) = (self.view, self.cmd);
-        let Some(layer) = self.layer().filter(|l| l.saved == Some(token)) else {
+        let Some(layer) = self.layer(part).filter(|l| l.saved == Some(token)) else {
             return Ok(false);
         };
         let (lc, ld) = (layer.color.raw, layer.depth.raw);
+        let rect = clamp_rect(rect, view.extent);
+        if rect[2] == 0 || rect[3] == 0 {
+            return Ok(true);
+        }
+        if self.rendering {
+            let raw = &self.ctx.device.raw;
+            // SAFETY: `cmd` is recording inside the rendering scope the flag says is open.
+            unsafe { raw.cmd_end_rendering(cmd) };
+            self.rendering = false;
+        }
+        // Earlier draws (or begin's layout transition) finish their attachment reads and
+        // writes before the copy overwrites the pixels.
         let to_dst = [
             image_barrier(
                 view.image,
                 view.format,
-                (S::COLOR_ATTACHMENT_OUTPUT, A::NONE),
+                (S::COLOR_ATTACHMENT_OUTPUT, A::COLOR_ATTACHMENT_WRITE),
                 (S::COPY, A::TRANSFER_WRITE),
                 (L::COLOR_ATTACHMENT_OPTIMAL, L::TRANSFER_DST_OPTIMAL),
             ),
             image_barrier(
                 view.depth.0,
                 DEPTH_FORMAT,
-                (DEPTH_STAGES, A::NONE),
+                (DEPTH_STAGES, A::DEPTH_STENCIL_ATTACHMENT_WRITE),
                 (S::COPY, A::TRANSFER_WRITE),
                 (L::DEPTH_STENCIL_ATTACHMENT_OPTIMAL, L::TRANSFER_DST_OPTIMAL),
             ),
@@ -303,12 +379,12 @@ impl Frame<'_> {
                 (L::TRANSFER_DST_OPTIMAL, L::DEPTH_STENCIL_ATTACHMENT_OPTIMAL),
             ),
         ];
-        let color_copy = [whole_copy(vk::ImageAspectFlags::COLOR, view.extent)];
-        let depth_copy = [whole_copy(vk::ImageAspectFlags::DEPTH, view.extent)];
+        let color_copy = [rect_copy(vk::ImageAspectFlags::COLOR, rect)];
+        let depth_copy = [rect_copy(vk::ImageAspectFlags::DEPTH, rect)];
         let raw = &self.ctx.device.raw;
-        // SAFETY: recording outside a rendering scope (checked above); the layer holds a save
-        // of this target (same size and formats) in TRANSFER_SRC_OPTIMAL, made visible to
-        // copies by the save's closing barrier; the attachments were made attachments at begin.
+        // SAFETY: recording outside a rendering scope (ended above); the layer part holds a
+        // save of this target (same size and formats) in TRANSFER_SRC_OPTIMAL, made visible to
+        // copies by the save's closing barrier; `rect` lies inside both images.
         unsafe {
             barrier::record(raw, cmd, &to_dst);
             raw.cmd_copy_image(
@@ -330,6 +406,7 @@ impl Frame<'_> {
             barrier::record(raw, cmd, &back);
         }
         self.load = true;
+        self.bound = Default::default();
         Ok(true)
     }
 }

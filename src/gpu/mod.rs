@@ -103,6 +103,7 @@ pub use grid::{
     GridShape, GridStride, grid_lines, grid_lines_strided, grid_triangles, grid_triangles_strided,
 };
 pub use instance::{ValidationMode, force_driver_files};
+pub use layer::LayerPart;
 pub use memory::{Buffer, BufferDesc};
 pub use mirror::{Mirror, MirrorBuffer, MirrorWriter};
 pub use offscreen::{OFFSCREEN_FORMAT, OffscreenDesc, OffscreenTarget, Pixels};

@@ -6,7 +6,8 @@ use super::analysis::curve_pieces;
 use super::lod::{GridMetrics, Lod};
 use super::map_mirror::{MapScalars, MapView, SurfaceSlot};
 use super::retained::{
-    Gesture, LayerKey, Redraw, SplitCells, overlaps, sample_bounds, screen_rect, split_cells,
+    Gesture, LayerKey, Redraw, SplitCells, covers, moving_vertices, overlaps, sample_bounds,
+    screen_rect, screen_rect_with, split_cells, touched_vertices, union_rect, vertex_bounds,
 };
 use super::style::{NetMode, Palette, ViewOptions, Wire};
 use crate::editor::{
@@ -14,11 +15,11 @@ use crate::editor::{
     LOCAL_PATCH_SAMPLES, LocalEntry,
 };
 use crate::gpu::{
-    FRAMES_IN_FLIGHT, Frame, GpuResult, GridShape, GridStride, MapStyle, Mirror, PointRun,
-    PointStyle, PolylineStyle, Renderer, SurfaceBatch, SurfaceStyle,
+    FRAMES_IN_FLIGHT, Frame, GpuError, GpuResult, GridShape, GridStride, LayerPart, MapStyle,
+    Mirror, PointRun, PointStyle, PolylineStyle, Renderer, SurfaceBatch, SurfaceStyle,
 };
 use crate::model::{Index2, LocalPath};
-use crate::sampling::DirtySet;
+use crate::sampling::{DirtyRegion, DirtySet};
 use glam::DVec3;
 use std::collections::BTreeMap;
 
@@ -134,14 +135,31 @@ pub struct GpuScene {
     layer: Option<Layer>,
     /// Test hook: the dynamic set misses one chunk (a negative control).
     drop_chunk: bool,
+    /// Test hook: the lines through moved control points are left out of the redrawn
+    /// rectangle (a negative control).
+    drop_lines: bool,
+    /// Control vertices of the gesture's object its edits rewrote so far (the next layer
+    /// redraws the lines through them every frame).
+    moved_controls: DirtySet,
 }
 
 /// A static layer in the target and what it was built for.
 struct Layer {
     key: LayerKey,
-    token: u64,
+    /// The saves of the static surfaces ([`LayerPart::Surfaces`]) and of the surfaces with
+    /// every line and point over them ([`LayerPart::Lines`]).
+    surfaces: u64,
+    lines: u64,
     /// The support of the gesture's target when the layer was built.
-    support: Vec<crate::sampling::DirtyRegion>,
+    support: Vec<DirtyRegion>,
+    /// Control vertices of the gesture's object that may move, and the vertices of every
+    /// line and point drawn through them.
+    moving: DirtySet,
+    touched: DirtySet,
+    /// Screen rectangle of those lines and points as the layer holds them.
+    lines_then: [u32; 4],
+    /// Screen rectangle of each other object's lines and points (`None`: nothing drawn).
+    line_rects: Vec<Option<[u32; 4]>>,
     /// The dragged surface's cells (`None`: the gesture moves a curve).
     cells: Option<SplitCells>,
     /// Surfaces after the dragged one in draw order, with their screen rectangles.
@@ -169,6 +187,8 @@ impl GpuScene {
             gesture: None,
             layer: None,
             drop_chunk: false,
+            drop_lines: false,
+            moved_controls: DirtySet::default(),
         };
         // On failure, give back what was created.
         match scene.fill(renderer, doc, &places, &sizes) {
@@ -235,9 +255,31 @@ impl GpuScene {
                         .iter()
                         .all(|r| layer.support.iter().any(|s| s.contains(r)))
             };
+            // Controls drawn in the layer changed: a resize, or vertices it did not expect.
+            let controls_moved = |c: &crate::editor::ObjectChange| match &c.controls {
+                ControlsChange::Unchanged => true,
+                ControlsChange::Vertices(set) => {
+                    set.ranges().iter().all(|r| covers(&layer.moving, r))
+                }
+                ControlsChange::Resized => false,
+            };
             // Samples drawn in the layer changed (an undo, another object, a structural edit).
-            if applied.structure_changed() || !applied.changes.iter().all(moved) {
+            if applied.structure_changed()
+                || !applied
+                    .changes
+                    .iter()
+                    .all(|c| moved(c) && controls_moved(c))
+            {
                 layer.stale = true;
+            }
+        }
+        if let Some(g) = self.gesture {
+            for c in applied.changes.iter().filter(|c| c.object == g.object) {
+                if let ControlsChange::Vertices(set) = &c.controls {
+                    set.ranges()
+                        .iter()
+                        .for_each(|r| self.moved_controls.insert(r.clone()));
+                }
             }
         }
         for c in &applied.changes {
@@ -391,6 +433,7 @@ impl GpuScene {
         }
         self.gesture = gesture;
         self.layer = None;
+        self.moved_controls = DirtySet::default();
     }
 
     /// Test hook, a negative control: the dynamic set of the next static layers misses one
@@ -398,6 +441,14 @@ impl GpuScene {
     #[doc(hidden)]
     pub fn set_drop_chunk(&mut self, drop: bool) {
         self.drop_chunk = drop;
+        self.layer = None;
+    }
+
+    /// Test hook, a negative control: retained frames leave the lines through moved control
+    /// points out of the rectangle they redraw, so their old pixels stay in the layer.
+    #[doc(hidden)]
+    pub fn set_drop_lines(&mut self, drop: bool) {
+        self.drop_lines = drop;
         self.layer = None;
     }
 
@@ -414,7 +465,6 @@ impl GpuScene {
         hl: &Highlight,
         lod: &Lod,
     ) -> GpuResult<DrawReport> {
-        let palette = Palette::default();
         let mut report = DrawReport::default();
         if self.lod_view != Some(*lod) {
             self.lod_view = Some(*lod);
@@ -428,7 +478,7 @@ impl GpuScene {
             report.full_triangles += 2 * GridStride::FULL.cells(shape) * n;
         }
         let before = frame.stats().surface_triangles;
-        if self.draw_retained(frame, doc, opts, &order)? {
+        if self.draw_retained(frame, doc, opts, hl, &order)? {
             report.retained = true;
             report.retained_of = report.triangles;
             report.triangles = frame.stats().surface_triangles - before;
@@ -436,8 +486,24 @@ impl GpuScene {
             for b in &order {
                 self.draw_batch(frame, doc, opts, b, &b.members)?;
             }
+            self.draw_lines(frame, doc, opts, hl, &|_| true, None)?;
         }
-        for (i, o) in self.objects.iter().enumerate() {
+        Ok(report)
+    }
+
+    /// The curves' samples and every object's control display (of the objects `only`
+    /// admits), in document order.
+    fn draw_lines(
+        &self,
+        frame: &mut Frame<'_>,
+        doc: &Document,
+        opts: &ViewOptions,
+        hl: &Highlight,
+        only: &dyn Fn(usize) -> bool,
+        clip: Option<&NetClip>,
+    ) -> GpuResult<()> {
+        let palette = Palette::default();
+        for (i, o) in self.objects.iter().enumerate().filter(|(i, _)| only(*i)) {
             let grid = doc.objects[i].sampled.grid();
             if grid.normals.is_none() && grid.dims[0] >= 2 {
                 let color = palette.object(i, doc.objects[i].color);
@@ -456,10 +522,17 @@ impl GpuScene {
                     polyline(frame, &self.arenas[o.samples.arena], run, &style)?;
                 }
             }
-            let layout = &doc.objects[i].controls.layout;
-            self.draw_controls(frame, i, o, layout, opts, hl, &palette)?;
+            let controls = &doc.objects[i].controls;
+            if let (Some(c), ControlLayout::Net { rows, cols }) = (clip, &controls.layout)
+                && c.object == i
+                && net_shown(opts, hl, i)
+            {
+                clipped_net(frame, o, &controls.vertices, [*rows, *cols], opts, hl, c)?;
+                continue;
+            }
+            self.draw_controls(frame, i, o, &controls.layout, opts, hl, &palette)?;
         }
-        Ok(report)
+        Ok(())
     }
 
     /// The surfaces in draw order: per group, per stride (ascending), the members sharing it.
@@ -563,14 +636,16 @@ impl GpuScene {
         }
     }
 
-    /// Draws the surfaces from the static layer when a gesture allows it: restores a valid
-    /// layer or builds one, then draws the dynamic set. `false`: nothing was drawn, draw
-    /// everything (no gesture, `--redraw full`, isolines on, or a target without a layer).
+    /// Draws the frame's surfaces and lines from the static layer when a gesture allows it:
+    /// restores a valid layer or builds one, then draws the dynamic set. `false`: nothing was
+    /// drawn, draw everything (no gesture, `--redraw full`, isolines on, or a target without
+    /// a layer).
     fn draw_retained(
         &mut self,
         frame: &mut Frame<'_>,
         doc: &Document,
         opts: &ViewOptions,
+        hl: &Highlight,
         order: &[Batch],
     ) -> GpuResult<bool> {
         let Some(g) = self.gesture.filter(|_| self.redraw == Redraw::Retained) else {
@@ -596,6 +671,7 @@ impl GpuScene {
             scalars: self.scalars.is_some(),
             objects: self.objects.len(),
             gesture: g,
+            highlight: *hl,
             stride: place.map(|(bi, _)| order[bi].stride),
         };
         let valid = self
@@ -603,28 +679,30 @@ impl GpuScene {
             .as_ref()
             .is_some_and(|l| !l.stale && l.key == key);
         let restored = match &self.layer {
-            Some(l) if valid => frame.restore_static_layer(l.token)?,
+            Some(l) if valid => frame.restore_static_layer(LayerPart::Lines, l.lines, None)?,
             _ => false,
         };
         if !restored {
             self.layer = None;
             frame.keep_depth();
-            self.build_layer(frame, doc, opts, order, place, key)?;
+            self.build_layer(frame, doc, opts, hl, order, place, key)?;
             if self.layer.is_none() {
                 return Ok(true);
             }
         }
-        self.draw_dynamic(frame, doc, opts, order, place)?;
+        self.draw_dynamic(frame, doc, opts, hl, order, place)?;
         Ok(true)
     }
 
-    /// Draws everything but the dynamic chunks in full order, saves it as the static layer
-    /// and notes what later frames need.
+    /// Draws everything but the dynamic chunks in full order, saving the surfaces and then
+    /// the surfaces with the lines as the static layer, and notes what later frames need.
+    #[allow(clippy::too_many_arguments)]
     fn build_layer(
         &mut self,
         frame: &mut Frame<'_>,
         doc: &Document,
         opts: &ViewOptions,
+        hl: &Highlight,
         order: &[Batch],
         place: Option<(usize, usize)>,
         key: LayerKey,
@@ -645,64 +723,149 @@ impl GpuScene {
                 _ => self.draw_batch(frame, doc, opts, b, &b.members)?,
             }
         }
-        let Some(token) = frame.save_static_layer()? else {
+        let Some(surfaces) = frame.save_static_layer(LayerPart::Surfaces)? else {
             // The target lost its layer: finish this frame without one.
             if let (Some((pb, _)), Some(c)) = (place, &cells) {
                 self.draw_cells(frame, doc, &order[pb], g.object, &c.dynamic)?;
             }
-            return Ok(());
+            return self.draw_lines(frame, doc, opts, hl, &|_| true, None);
         };
+        self.draw_lines(frame, doc, opts, hl, &|_| true, None)?;
+        // Saves need the same as the first one did: this one cannot fail where it succeeded.
+        let lines = frame
+            .save_static_layer(LayerPart::Lines)?
+            .ok_or_else(|| GpuError::InvalidArgument("static layer lost between saves".into()))?;
+        let (camera, viewport) = (frame.camera(), frame.viewport());
         let mut later = Vec::new();
         if let Some((pb, m)) = place {
-            let (camera, viewport) = (frame.camera(), frame.viewport());
             let after = order[pb].members[m + 1..]
                 .iter()
                 .chain(order[pb + 1..].iter().flat_map(|b| &b.members));
             for &i in after {
-                let o = &mut self.objects[i];
-                let bounds = *o
-                    .bounds
-                    .get_or_insert_with(|| sample_bounds(doc.objects[i].sampled.grid(), None));
-                if let Some(b) = bounds {
+                if let Some(b) = self.sample_bounds_of(doc, i) {
                     later.push((i, screen_rect(&camera, b, viewport)));
                 }
             }
         }
-        self.layer = Some(Layer {
+        let controls = &doc.objects[g.object].controls;
+        let mut moving = moving_vertices(&controls.layout, g.target);
+        for r in self.moved_controls.ranges() {
+            moving.insert(r.clone());
+        }
+        let touched = touched_vertices(&controls.layout, &moving);
+        let line_rects = (0..self.objects.len())
+            .map(|i| {
+                let curve = (doc.objects[i].sampled.grid().normals.is_none())
+                    .then(|| self.sample_bounds_of(doc, i))
+                    .flatten();
+                let all = DirtySet::all(doc.objects[i].controls.vertices.len());
+                let b = join_bounds(
+                    vertex_bounds(&doc.objects[i].controls.vertices, &all),
+                    curve,
+                );
+                b.map(|b| screen_rect_with(&camera, b, viewport, line_margin(opts)))
+            })
+            .collect();
+        let mut layer = Layer {
             key,
-            token,
+            surfaces,
+            lines,
             support,
+            moving,
+            touched,
+            lines_then: [0; 4],
+            line_rects,
             cells,
             later,
             stale: false,
-        });
+        };
+        layer.lines_then = moving_rect(doc, &layer, &camera, viewport, opts);
+        self.layer = Some(layer);
         Ok(())
     }
 
-    /// The dynamic chunks, then, clipped to their screen rectangle, the surfaces after them
-    /// in draw order that reach it (so ties in depth go as in a full redraw).
+    /// World-space bounds of object `i`'s samples, measured once per change of them.
+    fn sample_bounds_of(&mut self, doc: &Document, i: usize) -> Option<[DVec3; 2]> {
+        *self.objects[i]
+            .bounds
+            .get_or_insert_with(|| sample_bounds(doc.objects[i].sampled.grid(), None))
+    }
+
+    /// Inside the rectangle R of what moves (the dynamic chunks, and the lines and points
+    /// through moving control points as drawn now and as the layer holds them), the frame
+    /// is drawn again from the static surfaces: the dynamic chunks, then, clipped to their
+    /// screen rectangle, the surfaces after them in draw order that reach it (so ties in
+    /// depth go as in a full redraw), then every line and point that reaches R in full
+    /// order, clipped to R. Outside R the layer of surfaces and lines is the full redraw.
     fn draw_dynamic(
         &self,
         frame: &mut Frame<'_>,
         doc: &Document,
         opts: &ViewOptions,
+        hl: &Highlight,
         order: &[Batch],
         place: Option<(usize, usize)>,
     ) -> GpuResult<()> {
-        // A gesture on a curve has no dynamic surface: its samples are drawn with the lines.
-        let (Some((pb, _)), Some(layer)) = (place, &self.layer) else {
-            return Ok(());
-        };
-        let Some(cells) = &layer.cells else {
+        let Some(layer) = &self.layer else {
             return Ok(());
         };
         let g = layer.key.gesture;
-        self.draw_cells(frame, doc, &order[pb], g.object, &cells.dynamic)?;
-        let grid = doc.objects[g.object].sampled.grid();
-        let Some(bounds) = sample_bounds(grid, Some(&cells.chunks)) else {
+        let (camera, viewport) = (frame.camera(), frame.viewport());
+        let chunks = match (place, &layer.cells) {
+            (Some(_), Some(cells)) => {
+                let grid = doc.objects[g.object].sampled.grid();
+                sample_bounds(grid, Some(&cells.chunks))
+                    .map_or([0; 4], |b| screen_rect(&camera, b, viewport))
+            }
+            _ => [0; 4],
+        };
+        let lines = if self.drop_lines {
+            [0; 4]
+        } else {
+            union_rect(
+                layer.lines_then,
+                moving_rect(doc, layer, &camera, viewport, opts),
+            )
+        };
+        let r = union_rect(chunks, lines);
+        if r[2] == 0 || r[3] == 0 {
+            return Ok(());
+        }
+        if !frame.restore_static_layer(LayerPart::Surfaces, layer.surfaces, Some(r))? {
+            return Err(GpuError::InvalidArgument(
+                "static layer lost within a frame".into(),
+            ));
+        }
+        if let (Some((pb, _)), Some(cells)) = (place, &layer.cells) {
+            self.draw_cells(frame, doc, &order[pb], g.object, &cells.dynamic)?;
+            self.draw_later(frame, doc, opts, order, chunks)?;
+        }
+        frame.set_scissor(Some(r));
+        let reaches =
+            |i: usize| i == g.object || layer.line_rects[i].is_some_and(|lr| overlaps(lr, r));
+        let clip = NetClip {
+            object: g.object,
+            rect: r,
+            camera,
+            viewport,
+        };
+        self.draw_lines(frame, doc, opts, hl, &reaches, Some(&clip))?;
+        frame.set_scissor(None);
+        Ok(())
+    }
+
+    /// Clipped to `rect`, the surfaces after the dragged one in draw order that reach it.
+    fn draw_later(
+        &self,
+        frame: &mut Frame<'_>,
+        doc: &Document,
+        opts: &ViewOptions,
+        order: &[Batch],
+        rect: [u32; 4],
+    ) -> GpuResult<()> {
+        let Some(layer) = &self.layer else {
             return Ok(());
         };
-        let rect = screen_rect(&frame.camera(), bounds, frame.viewport());
         if rect[2] == 0 || rect[3] == 0 {
             return Ok(());
         }
@@ -784,11 +947,7 @@ impl GpuScene {
             width: 1.0,
             depth_test: true,
         };
-        let nets = match opts.control_nets {
-            NetMode::All => true,
-            NetMode::Focused => hl.focuses(i),
-            NetMode::Off => false,
-        };
+        let nets = net_shown(opts, hl, i);
         let index_in = |h: Option<Handle>, f: &dyn Fn(Handle) -> Option<u32>| {
             h.filter(|h| h.object() == i).and_then(f)
         };
@@ -955,6 +1114,140 @@ impl GpuScene {
             renderer.destroy_mirror(o.controls);
         }
     }
+}
+
+/// Whether object `i`'s control net or polygon is shown.
+fn net_shown(opts: &ViewOptions, hl: &Highlight, i: usize) -> bool {
+    match opts.control_nets {
+        NetMode::All => true,
+        NetMode::Focused => hl.focuses(i),
+        NetMode::Off => false,
+    }
+}
+
+/// A pixel rectangle that draws are clipped to, so the gesture's control net need only draw
+/// its rows and columns that reach it.
+struct NetClip {
+    object: usize,
+    rect: [u32; 4],
+    camera: crate::gpu::Camera,
+    viewport: [u32; 4],
+}
+
+/// The rows, then the columns, then the points (row by row) of a `rows × cols` control net
+/// whose screen rectangles reach `clip`'s. Within the clip this is the full net's image: net
+/// lines are one colour, so their order among themselves changes no pixel, points follow all
+/// lines as in the full draw and keep their order, and what is left out has no pixel there.
+fn clipped_net(
+    frame: &mut Frame<'_>,
+    o: &ObjectGpu,
+    vertices: &[DVec3],
+    [rows, cols]: [usize; 2],
+    opts: &ViewOptions,
+    hl: &Highlight,
+    clip: &NetClip,
+) -> GpuResult<()> {
+    let palette = Palette::default();
+    let margin = line_margin(opts);
+    let reaches = |points: &mut dyn Iterator<Item = DVec3>| {
+        let b = points.fold(None, |b: Option<[DVec3; 2]>, p| {
+            Some(b.map_or([p, p], |[lo, hi]| [lo.min(p), hi.max(p)]))
+        });
+        b.is_some_and(|b| {
+            overlaps(
+                screen_rect_with(&clip.camera, b, clip.viewport, margin),
+                clip.rect,
+            )
+        })
+    };
+    let row_hit: Vec<bool> = (0..rows)
+        .map(|r| reaches(&mut vertices[r * cols..(r + 1) * cols].iter().copied()))
+        .collect();
+    let col_hit: Vec<bool> = (0..cols)
+        .map(|c| reaches(&mut (0..rows).map(|r| vertices[r * cols + c])))
+        .collect();
+    let net = PolylineStyle {
+        color: palette.net,
+        width: 1.0,
+        depth_test: true,
+    };
+    let run = |offset: usize, stride: usize, count: usize| PointRun {
+        offset: offset * 3,
+        stride: stride * 3,
+        count,
+    };
+    for r in (0..rows).filter(|&r| row_hit[r]) {
+        polyline(frame, &o.controls, run(r * cols, 1, cols), &net)?;
+    }
+    for c in (0..cols).filter(|&c| col_hit[c]) {
+        polyline(frame, &o.controls, run(c, cols, rows), &net)?;
+    }
+    let index_of = |h: Option<Handle>, r: usize| match h {
+        Some(Handle::Point {
+            object,
+            point: Index2::Two(a, b),
+        }) if object == clip.object && a == r => Some(b as u32),
+        _ => None,
+    };
+    for r in (0..rows).filter(|&r| row_hit[r]) {
+        let style = PointStyle {
+            color: palette.point,
+            size: opts.point_size,
+            hovered: index_of(hl.hovered, r),
+            selected: index_of(hl.selected, r),
+            ..PointStyle::default()
+        };
+        frame.draw_points(&o.controls, run(r * cols, 1, cols), &style)?;
+    }
+    Ok(())
+}
+
+/// Pixels that lines and points reach beyond their vertices' projections: half the largest
+/// point (a selected one is 1.5 times the size) and the widest line.
+fn line_margin(opts: &ViewOptions) -> f32 {
+    0.75 * opts.point_size + opts.curve_width.max(2.5) + 2.0
+}
+
+/// The box holding both.
+fn join_bounds(a: Option<[DVec3; 2]>, b: Option<[DVec3; 2]>) -> Option<[DVec3; 2]> {
+    match (a, b) {
+        (Some([l0, h0]), Some([l1, h1])) => Some([l0.min(l1), h0.max(h1)]),
+        (x, None) | (None, x) => x,
+    }
+}
+
+/// Screen rectangle of the lines and points of `layer`'s gesture that move, as the document
+/// holds them now: those through its moving control points, and for a curve the sample
+/// polyline's segments through its support.
+fn moving_rect(
+    doc: &Document,
+    layer: &Layer,
+    camera: &crate::gpu::Camera,
+    viewport: [u32; 4],
+    opts: &ViewOptions,
+) -> [u32; 4] {
+    let object = &doc.objects[layer.key.gesture.object];
+    let controls = vertex_bounds(&object.controls.vertices, &layer.touched);
+    let grid = object.sampled.grid();
+    let curve = if grid.normals.is_none() {
+        let spans: Vec<[std::ops::Range<usize>; 2]> = layer
+            .support
+            .iter()
+            .filter(|r| !r.is_empty())
+            .map(|r| {
+                [
+                    r.rows.start.saturating_sub(1)..r.rows.end + 1,
+                    0..grid.dims[1],
+                ]
+            })
+            .collect();
+        sample_bounds(grid, Some(&spans))
+    } else {
+        None
+    };
+    join_bounds(controls, curve).map_or([0; 4], |b| {
+        screen_rect_with(camera, b, viewport, line_margin(opts))
+    })
 }
 
 /// Floats per sample on the GPU: position and normal for surfaces, position for curves.

@@ -4,8 +4,8 @@
 //! Why a retained frame equals a full redraw bit for bit (MSAA 1): surfaces are opaque and
 //! drawn with depth test LESS_OR_EQUAL, so a pixel ends up with the *last* of the fragments of
 //! least depth, in draw order. The full order is P (surfaces before the dragged one), O (the
-//! dragged surface, its cells row by row), Q (surfaces after it); lines, points and overlays
-//! follow and are drawn in every frame in both modes, on the same surface image.
+//! dragged surface, its cells row by row), Q (surfaces after it); then lines and points (L),
+//! then overlays, drawn in every frame in both modes.
 //! - The layer holds P, O's static cells and Q in that order; the dynamic cells D are drawn
 //!   after it. Against P, D comes later in both orders, so ties go to D in both.
 //! - Against Q, D comes *earlier* in the full order: a Q fragment tying D must win. So every
@@ -18,13 +18,25 @@
 //!   fill rule gives each pixel of a shared edge to one triangle only: they meet at a tie
 //!   only where the surface folds onto itself with equal depth, the one case this leaves to
 //!   draw order within O.
+//!
+//! Lines and points: the layer has two saves, the surfaces above (S) and S with all of L drawn
+//! over it (SL). Let R be a pixel rectangle holding the dynamic cells' fragments and those of
+//! every line or point through a control vertex that moves, both as drawn now and as SL holds
+//! them. Outside R no fragment differs from the full redraw's, so SL is its image there. Inside
+//! R a frame copies S back and draws the surfaces as above, then every line and point draw that
+//! reaches R in full order, clipped to R: a full redraw of R. (A draw left out has no fragment
+//! in R; of the dragged surface's net only rows and columns that reach R are drawn, which
+//! changes no pixel because its segments are one colour and its points still follow them in
+//! order.) Points are drawn without depth test, so order matters between every line and point
+//! draw: that is why R is redrawn in full order and not only the moving parts.
 
 use super::lod::Lod;
 use super::map_mirror::MapView;
 use super::style::ViewOptions;
+use crate::editor::{ControlLayout, LOCAL_CURVE_SAMPLES, LOCAL_PATCH_SAMPLES};
 use crate::gpu::{Camera, GridShape, GridStride};
-use crate::model::Target;
-use crate::sampling::{DirtyRegion, SampleGrid};
+use crate::model::{Index2, Target};
+use crate::sampling::{DirtyRegion, DirtySet, SampleGrid};
 use glam::{DVec3, Vec4};
 use std::ops::Range;
 
@@ -82,9 +94,11 @@ pub(crate) struct LayerKey {
     /// Whether the curvature map's scalars were built (before, plain shading stands in).
     pub scalars: bool,
     pub objects: usize,
-    /// The gesture the layer leaves out (highlights are not part of the key: they only
-    /// change control points and nets, which are drawn every frame).
+    /// The gesture the layer leaves out.
     pub gesture: Gesture,
+    /// Hovered and selected handles and locals: they colour and size points and nets drawn
+    /// in the layer.
+    pub highlight: super::gpu_scene::Highlight,
     /// The stride the dragged surface is drawn at (frozen for the gesture).
     pub stride: Option<GridStride>,
 }
@@ -208,6 +222,18 @@ pub fn sample_bounds(grid: &SampleGrid, rects: Option<&[[Range<usize>; 2]]>) -> 
 /// eye or is not finite.
 #[must_use]
 pub fn screen_rect(camera: &Camera, bounds: [DVec3; 2], viewport: [u32; 4]) -> [u32; 4] {
+    screen_rect_with(camera, bounds, viewport, 2.0)
+}
+
+/// [`screen_rect`] with a margin of `margin` pixels (for lines and points drawn wider than a
+/// pixel around their vertices).
+#[must_use]
+pub fn screen_rect_with(
+    camera: &Camera,
+    bounds: [DVec3; 2],
+    viewport: [u32; 4],
+    margin: f32,
+) -> [u32; 4] {
     let [lo, hi] = bounds;
     let mut ndc_lo = [f32::INFINITY; 2];
     let mut ndc_hi = [f32::NEG_INFINITY; 2];
@@ -231,12 +257,12 @@ pub fn screen_rect(camera: &Camera, bounds: [DVec3; 2], viewport: [u32; 4]) -> [
     }
     let [vx, vy, vw, vh] = viewport;
     let (w, h) = (vw as f32, vh as f32);
-    const MARGIN: f32 = 2.0;
+    let margin = margin.max(2.0);
     // y grows downwards on screen: NDC y = 1 is the top row.
-    let x0 = (ndc_lo[0] + 1.0) * 0.5 * w - MARGIN;
-    let x1 = (ndc_hi[0] + 1.0) * 0.5 * w + MARGIN;
-    let y0 = (1.0 - ndc_hi[1]) * 0.5 * h - MARGIN;
-    let y1 = (1.0 - ndc_lo[1]) * 0.5 * h + MARGIN;
+    let x0 = (ndc_lo[0] + 1.0) * 0.5 * w - margin;
+    let x1 = (ndc_hi[0] + 1.0) * 0.5 * w + margin;
+    let y0 = (1.0 - ndc_hi[1]) * 0.5 * h - margin;
+    let y1 = (1.0 - ndc_lo[1]) * 0.5 * h + margin;
     let clamp = |v: f32, max: u32| v.floor().clamp(0.0, max as f32) as u32;
     let (x0, x1) = (clamp(x0, vw), clamp(x1.ceil(), vw));
     let (y0, y1) = (clamp(y0, vh), clamp(y1.ceil(), vh));
@@ -247,6 +273,133 @@ pub fn screen_rect(camera: &Camera, bounds: [DVec3; 2], viewport: [u32; 4]) -> [
 #[must_use]
 pub fn overlaps(a: [u32; 4], b: [u32; 4]) -> bool {
     a[0] < b[0] + b[2] && b[0] < a[0] + a[2] && a[1] < b[1] + b[3] && b[1] < a[1] + a[3]
+}
+
+/// The smallest pixel rectangle holding both (an empty one adds nothing).
+#[must_use]
+pub fn union_rect(a: [u32; 4], b: [u32; 4]) -> [u32; 4] {
+    if a[2] == 0 || a[3] == 0 {
+        return b;
+    }
+    if b[2] == 0 || b[3] == 0 {
+        return a;
+    }
+    let (x0, y0) = (a[0].min(b[0]), a[1].min(b[1]));
+    let x1 = (a[0] + a[2]).max(b[0] + b[2]);
+    let y1 = (a[1] + a[3]).max(b[1] + b[3]);
+    [x0, y0, x1 - x0, y1 - y0]
+}
+
+/// The control display vertices a gesture on `target` rewrites, as far as the layout tells
+/// before it does (an edit that rewrites others makes the layer stale; see
+/// [`super::GpuScene::consume`]).
+#[must_use]
+pub fn moving_vertices(layout: &ControlLayout, target: Target) -> DirtySet {
+    let mut set = DirtySet::default();
+    match (layout, target) {
+        (ControlLayout::Polygon { count }, Target::Point(Index2::One(k))) if k < *count => {
+            set.insert(k..k + 1);
+        }
+        (ControlLayout::Net { rows, cols }, Target::Point(Index2::Two(i, j)))
+            if i < *rows && j < *cols =>
+        {
+            set.insert(i * cols + j..i * cols + j + 1);
+        }
+        (
+            ControlLayout::LocalCurves(entries) | ControlLayout::LocalPatches(entries),
+            Target::Local(local),
+        ) => {
+            for e in entries.iter().filter(|e| e.path.starts_with(&local)) {
+                set.insert(e.samples..e.samples + entry_samples(layout));
+                set.insert(e.points..e.points + e.rows * e.cols);
+            }
+        }
+        _ => {}
+    }
+    set
+}
+
+/// Display sample vertices of one ERBS local (patches store a normal after each position).
+fn entry_samples(layout: &ControlLayout) -> usize {
+    match layout {
+        ControlLayout::LocalPatches(_) => 2 * LOCAL_PATCH_SAMPLES * LOCAL_PATCH_SAMPLES,
+        _ => LOCAL_CURVE_SAMPLES,
+    }
+}
+
+/// The vertices of every line and point drawn through a vertex of `moving`: its neighbours
+/// in the polygon or net, the whole local for ERBS locals (their wires, nets and points).
+#[must_use]
+pub fn touched_vertices(layout: &ControlLayout, moving: &DirtySet) -> DirtySet {
+    let mut set = DirtySet::default();
+    let hit = |r: &Range<usize>| {
+        moving
+            .ranges()
+            .iter()
+            .any(|m| m.start < r.end && r.start < m.end)
+    };
+    match layout {
+        ControlLayout::Polygon { count } => {
+            for m in moving.ranges() {
+                set.insert(m.start.saturating_sub(1)..(m.end + 1).min(*count));
+            }
+        }
+        ControlLayout::Net { rows, cols } => {
+            for k in moving.ranges().iter().flat_map(|m| m.clone()) {
+                let (i, j) = (k / cols, k % cols);
+                set.insert(k..k + 1);
+                if i > 0 {
+                    set.insert(k - cols..k - cols + 1);
+                }
+                if i + 1 < *rows {
+                    set.insert(k + cols..k + cols + 1);
+                }
+                if j > 0 {
+                    set.insert(k - 1..k);
+                }
+                if j + 1 < *cols {
+                    set.insert(k + 1..k + 2);
+                }
+            }
+        }
+        ControlLayout::LocalCurves(entries) | ControlLayout::LocalPatches(entries) => {
+            for e in entries {
+                let samples = e.samples..e.samples + entry_samples(layout);
+                let points = e.points..e.points + e.rows * e.cols;
+                if hit(&samples) || hit(&points) {
+                    set.insert(samples);
+                    set.insert(points);
+                }
+            }
+        }
+    }
+    set
+}
+
+/// Whether `set` holds every index of `r`.
+#[must_use]
+pub fn covers(set: &DirtySet, r: &Range<usize>) -> bool {
+    r.is_empty()
+        || set
+            .ranges()
+            .iter()
+            .any(|s| s.start <= r.start && r.end <= s.end)
+}
+
+/// World-space bounds of `vertices` at the indices of `set` (patch normals among them only
+/// make the box larger).
+#[must_use]
+pub fn vertex_bounds(vertices: &[DVec3], set: &DirtySet) -> Option<[DVec3; 2]> {
+    let mut b: Option<[DVec3; 2]> = None;
+    for r in set.ranges() {
+        for &p in vertices.get(r.clone()).unwrap_or(&[]) {
+            b = Some(match b {
+                Some([lo, hi]) => [lo.min(p), hi.max(p)],
+                None => [p, p],
+            });
+        }
+    }
+    b
 }
 
 #[cfg(test)]
@@ -302,5 +455,33 @@ mod tests {
         assert_eq!(r, [23, 23, 29, 29]);
         assert!(overlaps(r, [50, 50, 10, 10]));
         assert!(!overlaps(r, [52, 0, 10, 100]));
+    }
+
+    #[test]
+    fn a_moving_net_point_touches_its_four_neighbours_only() {
+        let layout = ControlLayout::Net { rows: 3, cols: 4 };
+        let moving = moving_vertices(&layout, Target::Point(Index2::Two(1, 0)));
+        assert_eq!(moving.ranges().to_vec(), vec![4..5]);
+        let touched = touched_vertices(&layout, &moving);
+        // (0,0), (1,0), (1,1), (2,0): no left neighbour on column 0.
+        assert_eq!(touched.ranges(), &[0..1, 4..6, 8..9]);
+        assert!(covers(&touched, &(4..6)));
+        assert!(!covers(&touched, &(3..5)));
+        let polygon = ControlLayout::Polygon { count: 5 };
+        let m = moving_vertices(&polygon, Target::Point(Index2::One(4)));
+        assert_eq!(touched_vertices(&polygon, &m).ranges().to_vec(), vec![3..5]);
+        // A weight moves no control point.
+        assert!(moving_vertices(&polygon, Target::Weight(Index2::One(4))).is_empty());
+    }
+
+    #[test]
+    fn rectangles_join_and_an_empty_one_adds_nothing() {
+        assert_eq!(union_rect([0, 0, 0, 0], [5, 6, 7, 8]), [5, 6, 7, 8]);
+        assert_eq!(union_rect([1, 2, 3, 4], [5, 6, 7, 8]), [1, 2, 11, 12]);
+        let bounds = vertex_bounds(
+            &[DVec3::ZERO, DVec3::ONE, DVec3::splat(-3.0)],
+            &DirtySet::all(2),
+        );
+        assert_eq!(bounds, Some([DVec3::ZERO, DVec3::ONE]));
     }
 }

@@ -260,6 +260,13 @@ impl Session {
         self.gpu.set_drop_chunk(drop);
     }
 
+    /// Test hook: retained frames leave the lines through moved control points out of what
+    /// they redraw (a negative control).
+    #[doc(hidden)]
+    pub fn set_drop_lines(&mut self, drop: bool) {
+        self.gpu.set_drop_lines(drop);
+    }
+
     pub fn set_naive(&mut self, naive: bool) {
         self.stage.editor.naive = naive;
     }

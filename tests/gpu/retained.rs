@@ -424,3 +424,51 @@ fn a_dynamic_set_missing_one_chunk_is_caught() {
     );
     pair.finish();
 }
+
+/// Nets of every object (the twin's net lies over the dragged surface and crosses its
+/// dynamic rectangle), then nets of the focused object only: every frame of point drags on
+/// surfaces and curves equals the full redraw.
+#[test]
+fn static_nets_over_the_dragged_surface_and_focused_nets_redraw_exactly() {
+    let mut rng = Rng::new(0xc0de);
+    let scene = random_scene(&mut rng);
+    let mut pair = Pair::new(&scene, None);
+    check(&mut pair, &[vec![]], "first frame");
+    for round in 0..2 {
+        for object in [0, 1, 2, 4, 6] {
+            let h = handle_of(&pair, &mut rng, object);
+            let script = drag(&mut rng, h, false, 5);
+            check(&mut pair, &script, &format!("round {round}: drag of {h:?}"));
+        }
+        // All → focused nets.
+        check(&mut pair, &[vec![key('c')]], "cycling the nets");
+    }
+    assert!(
+        pair.retained_frames * 2 > pair.frames,
+        "only {} of {} frames were retained",
+        pair.retained_frames,
+        pair.frames
+    );
+    pair.finish();
+}
+
+#[test]
+fn lines_left_out_of_the_redrawn_rectangle_are_caught() {
+    let mut rng = Rng::new(5);
+    let scene = random_scene(&mut rng);
+    let mut pair = Pair::new(&scene, None);
+    pair.runs[0].session.set_drop_lines(true);
+    // A middle point of the B-spline curve: its polygon and samples move.
+    let h = Handle::Point {
+        object: 4,
+        point: prespline::model::Index2::One(2),
+    };
+    let script = drag(&mut rng, h, false, 6);
+    let found = pair.first_difference(&script);
+    assert!(
+        found.is_some(),
+        "moved lines left in the static layer went unnoticed ({} retained frames)",
+        pair.retained_frames
+    );
+    pair.finish();
+}
