@@ -60,12 +60,14 @@
 //! (`destroy_*`); dropping the renderer destroys everything else. With validation on,
 //! anything leaked is reported by the layer at teardown.
 
+mod attachments;
 mod barrier;
 mod device;
 mod draw;
 mod error;
 pub mod font;
 mod frame;
+mod frame_layer;
 mod grid;
 mod image;
 mod instance;

@@ -7,10 +7,11 @@ use ash::vk;
 use gpu_allocator::MemoryLocation;
 
 use super::FRAMES_IN_FLIGHT;
+use super::attachments::Attachments;
 use super::barrier::image_barrier;
 use super::device::Device;
 use super::error::{GpuError, GpuResult};
-use super::image::{Attachments, Image, ImageDesc};
+use super::image::{Image, ImageDesc};
 use super::memory::{Buffer, BufferDesc};
 use super::target::TargetView;
 

@@ -7,9 +7,10 @@ use ash::vk;
 use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 
 use super::FRAMES_IN_FLIGHT;
+use super::attachments::Attachments;
 use super::device::Device;
 use super::error::{GpuError, GpuResult, VkResultExt, vk_error};
-use super::image::{Attachments, create_view};
+use super::image::create_view;
 use super::instance::Instance;
 use super::layer::StaticLayer;
 use super::target::TargetView;
