@@ -169,7 +169,10 @@ fn objects() -> Vec<(&'static str, Model)> {
 
 fn bench(c: &mut Criterion) {
     // `BENCH_THREADS=1 cargo bench --bench sampling -- full/` measures one thread (default: all).
-    if let Some(n) = std::env::var("BENCH_THREADS").ok().and_then(|n| n.parse().ok()) {
+    if let Some(n) = std::env::var("BENCH_THREADS")
+        .ok()
+        .and_then(|n| n.parse().ok())
+    {
         prespline::parallel::set_threads(n);
     }
     let mut g = c.benchmark_group("full");
