@@ -8,6 +8,7 @@
 //!
 //! `cargo bench --bench sampling` runs criterion and then prints a summary table (full sampling
 //! time, M samples/s, µs per edit, samples touched, edit/full ratio) from criterion's estimates.
+//! `BENCH_THREADS=N` runs the full passes on N threads (default: every core).
 
 use criterion::{BenchmarkId, Criterion, Throughput};
 use glam::{DMat4, DVec3};
@@ -167,6 +168,13 @@ fn objects() -> Vec<(&'static str, Model)> {
 }
 
 fn bench(c: &mut Criterion) {
+    // `BENCH_THREADS=1 cargo bench --bench sampling -- full/` measures one thread (default: all).
+    if let Some(n) = std::env::var("BENCH_THREADS")
+        .ok()
+        .and_then(|n| n.parse().ok())
+    {
+        prespline::parallel::set_threads(n);
+    }
     let mut g = c.benchmark_group("full");
     g.sample_size(20).measurement_time(Duration::from_secs(4));
     for (name, model) in objects() {

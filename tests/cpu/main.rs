@@ -15,6 +15,7 @@ mod curvature_maps;
 mod delta_vs_full;
 mod erbs_hierarchy;
 mod geom_properties;
+mod large_surface_threads;
 mod lints;
 mod obj_blender;
 mod obj_errors;

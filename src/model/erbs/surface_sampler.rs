@@ -12,6 +12,7 @@ use crate::geom::point::binomial;
 use crate::model::{
     ErbsEdit, ErbsSurfaceEdit, ErbsSurfaceModel, KindEdit, LocalEdit, Target as EditTarget,
 };
+use crate::parallel;
 use crate::sampling::dirty::DirtyRegion;
 use crate::sampling::fallback::{NormalSource, resolve_degenerate};
 use crate::sampling::grid::{PartialSet, SampleGrid};
@@ -224,16 +225,21 @@ impl SurfaceLevel {
         let mut normals = true;
         let ucells = self.axes[0].cells().to_vec();
         let vcells = self.axes[1].cells().to_vec();
+        let done = self.fill_dense_in_parallel(region);
+        // `done` has one entry per u-cell with rows in the region.
+        let mut bands = done.iter();
         for cu in &ucells {
             let rows = clip(&cu.samples, &region[0]);
             if rows.is_empty() {
                 continue;
             }
-            for cv in &vcells {
+            let done = bands.next();
+            for (m, cv) in vcells.iter().enumerate() {
                 let cols = clip(&cv.samples, &region[1]);
-                if !cols.is_empty() {
-                    normals &= self.fill_cell(cu.locals, cv.locals, [rows.clone(), cols]);
+                if cols.is_empty() || done.is_some_and(|row| row[m]) {
+                    continue;
                 }
+                normals &= self.fill_cell(cu.locals, cv.locals, [rows.clone(), cols]);
             }
         }
         Patch {
@@ -242,6 +248,87 @@ impl SurfaceLevel {
             values: Vec::new(),
             normals: normals && self.grid.normals.is_some(),
         }
+    }
+
+    /// The dense cells of a large `region` (a full pass of a drawn surface), one band of knot
+    /// cells' rows per task on every core; returns per u-cell and v-cell whether it was
+    /// written (nothing when the region is small or there is one thread). Each cell is the
+    /// same dense pass as in [`Self::fill_cell`] and the degenerate samples are kept in the
+    /// same order, so the result is bit for bit that of one thread.
+    fn fill_dense_in_parallel(&mut self, region: &[Range<usize>; 2]) -> Vec<Vec<bool>> {
+        let bands: Vec<(Range<usize>, [usize; 2])> = self.axes[0]
+            .cells()
+            .iter()
+            .map(|c| (clip(&c.samples, &region[0]), c.locals))
+            .filter(|(rows, _)| !rows.is_empty())
+            .collect();
+        let blocks: Vec<Range<usize>> = bands.iter().map(|b| b.0.clone()).collect();
+        let samples = region[0].len() * region[1].len();
+        let ascending = blocks.windows(2).all(|w| w[0].end <= w[1].start);
+        if !self.shading
+            || !ascending
+            || blocks.len() < 2
+            || samples < parallel::MIN_PARALLEL_SAMPLES
+            || parallel::threads() < 2
+        {
+            return Vec::new();
+        }
+        let mv = self.grid.dims[1];
+        let mut data = std::mem::take(&mut self.grid.data);
+        let mut normals = self.grid.normals.take();
+        let vcells = self.axes[1].cells();
+        let this = &*self;
+        let data_parts = parallel::split_rows(&mut data, &blocks, mv * 3);
+        let mut normal_parts: Vec<Option<&mut [DVec3]>> = match normals.as_deref_mut() {
+            Some(n) => parallel::split_rows(n, &blocks, mv)
+                .into_iter()
+                .map(Some)
+                .collect(),
+            None => blocks.iter().map(|_| None).collect(),
+        };
+        let mut jobs: Vec<_> = bands
+            .iter()
+            .zip(data_parts)
+            .zip(normal_parts.iter_mut())
+            .map(|((band, d), n)| (band, d, n.take(), Vec::new(), Vec::new()))
+            .collect();
+        parallel::for_each_mut(&mut jobs, |(band, data, normals, degenerate, done)| {
+            let (rows, ku) = (&band.0, band.1);
+            for cv in vcells {
+                let cols = clip(&cv.samples, &region[1]);
+                let kv = cv.locals;
+                let ids = ku.map(|k| kv.map(|l| k * this.nv() + l));
+                let rect = [rows.clone(), cols.clone()];
+                let cell = match cols.is_empty() {
+                    true => None,
+                    false => this.dense_cell(ids, ku, kv, &rect),
+                };
+                done.push(cell.is_some());
+                let Some(cell) = cell else { continue };
+                let target = Target {
+                    data,
+                    normals: normals.as_deref_mut(),
+                    width: mv,
+                    row0: 0,
+                    col0: cols.start,
+                };
+                let first = degenerate.len();
+                dense::pass::<{ 2 * DENSE }, { 2 * DENSE }, false>(
+                    &cell.cu, &cell.cv, &cell.net, target, degenerate,
+                );
+                for d in &mut degenerate[first..] {
+                    d.0 += rows.start;
+                }
+            }
+        });
+        let mut done = Vec::with_capacity(jobs.len());
+        for (_, _, _, degenerate, cells) in jobs {
+            self.degenerate.extend(degenerate);
+            done.push(cells);
+        }
+        self.grid.data = data;
+        self.grid.normals = normals;
+        done
     }
 
     /// One knot cell's samples in `rect`: in one dense pass when its four patches allow,

@@ -3,10 +3,12 @@
 use super::curve_sampler::PointState;
 use crate::geom::TensorSurface;
 use crate::model::{Index2, KindEdit, SurfaceEdit, SurfaceModel, Target};
+use crate::parallel;
 use crate::sampling::dirty::DirtyRegion;
 use crate::sampling::fallback::{NormalSource, resolve_degenerate};
 use crate::sampling::grid::{PartialSet, SampleGrid};
 use crate::sampling::kernels::curvature;
+use crate::sampling::kernels::lanes::LANES;
 use crate::sampling::kernels::shading::{self, ShadingGrid};
 use crate::sampling::object::Sampler;
 use crate::sampling::rational::QuotientRule;
@@ -64,65 +66,90 @@ impl SplineSurfaceSampler {
     /// Exact re-evaluation of a rectangle from the control points, in two passes: first each
     /// sample row against every control column (Q_a = M_u[a]·C), then each sample in the row
     /// (S_ab = Q_a·M_v[b]ᵀ) — (d+1) products per output instead of (d+1)².
+    ///
+    /// Large rectangles (a full pass, a periodic exact rebuild of a wide region) are split into
+    /// row blocks on every core ([`crate::parallel::row_blocks`]); each sample is computed by the
+    /// same code whichever block holds it, so the result is bit for bit that of one thread.
     fn rebuild_rect(&mut self, rows: Range<usize>, cols: Range<usize>) -> DirtyRegion {
         let surface = self.model.surface();
         let nv = surface.count()[1];
+        let [tu, tv] = &self.tables;
         if self.fast_shading() && shading::surface_supported(surface.degree()) {
-            let mut degenerate = Vec::new();
-            let [tu, tv] = &self.tables;
-            shading::sample_surface(
-                tu,
-                tv,
-                surface.points(),
-                nv,
-                rows.clone(),
-                cols.clone(),
-                shading_grid(&mut self.grid),
-                &mut degenerate,
-            );
+            let pts = surface.points();
+            let blocks = parallel::row_blocks(rows.clone(), cols.len(), LANES);
+            let grid = shading_grid(&mut self.grid);
+            let width = grid.width;
+            let normals = grid.normals.expect("shading grids keep normals");
+            let mut jobs: Vec<_> = parallel::split_rows(grid.data, &blocks, width * 3)
+                .into_iter()
+                .zip(parallel::split_rows(normals, &blocks, width))
+                .zip(&blocks)
+                .map(|((data, normals), block)| (block.clone(), data, normals, Vec::new()))
+                .collect();
+            parallel::for_each_mut(&mut jobs, |(block, data, normals, degenerate)| {
+                let out = ShadingGrid {
+                    data,
+                    normals: Some(normals),
+                    width,
+                    first_row: block.start,
+                };
+                shading::sample_surface(
+                    tu,
+                    tv,
+                    pts,
+                    nv,
+                    block.clone(),
+                    cols.clone(),
+                    out,
+                    degenerate,
+                );
+            });
+            let degenerate: Vec<_> = jobs.into_iter().flat_map(|job| job.3).collect();
             let params = params(&self.tables);
             resolve_degenerate(&mut self.grid, &degenerate, params, surface);
             return DirtyRegion::surface(rows, cols);
         }
         let stride = self.grid.stride();
         let mv = self.grid.dims[1];
-        let [tu, tv] = &self.tables;
-        let target = Rect {
-            rows: rows.clone(),
+        let blocks = parallel::row_blocks(rows.clone(), cols.len(), 1);
+        let block_rect = |block: &Range<usize>| Rect {
+            rows: block.clone(),
             cols: cols.clone(),
             origin: (0, 0),
+            first_row: block.start,
             width: mv,
             stride,
         };
+        let row_len = mv * stride;
+        let partials = &self.partials;
         match &mut self.hom {
-            None => two_pass(
-                tu,
-                tv,
-                surface.points(),
-                nv,
-                &self.partials,
-                &target,
-                &mut self.grid.data,
-            ),
+            None => {
+                let pts = surface.points();
+                let mut jobs: Vec<_> = blocks
+                    .iter()
+                    .zip(parallel::split_rows(&mut self.grid.data, &blocks, row_len))
+                    .collect();
+                parallel::for_each_mut(&mut jobs, |(block, out)| {
+                    two_pass(tu, tv, pts, nv, partials, &block_rect(block), out);
+                });
+            }
             Some(hom) => {
-                two_pass(
-                    tu,
-                    tv,
-                    &surface.homogeneous_points(),
-                    nv,
-                    &self.partials,
-                    &target,
-                    hom,
-                );
-                for i in rows.clone() {
-                    for j in cols.clone() {
-                        let base = (i * mv + j) * stride;
-                        self.rule.project(
-                            &hom[base..base + stride],
-                            &mut self.grid.data[base..base + stride],
-                        );
+                let pts = surface.homogeneous_points();
+                let rule = &self.rule;
+                let mut jobs: Vec<_> = blocks
+                    .iter()
+                    .zip(parallel::split_rows(hom, &blocks, row_len))
+                    .zip(parallel::split_rows(&mut self.grid.data, &blocks, row_len))
+                    .collect();
+                parallel::for_each_mut(&mut jobs, |((block, hom), out)| {
+                    two_pass(tu, tv, &pts, nv, partials, &block_rect(block), hom);
+                    for i in (*block).clone() {
+                        for j in cols.clone() {
+                            let base = ((i - block.start) * mv + j) * stride;
+                            rule.project(&hom[base..base + stride], &mut out[base..base + stride]);
+                        }
                     }
-                }
+                });
             }
         }
         self.update_normals(rows.clone(), cols.clone());
@@ -324,15 +351,19 @@ fn shading_grid(grid: &mut SampleGrid) -> ShadingGrid<'_> {
         data: &mut grid.data,
         normals: Some(grid.normals.as_mut().expect("shading grids keep normals")),
         width: grid.dims[1],
+        first_row: 0,
     }
 }
 
 /// Where [`two_pass`] writes: samples `rows × cols` (parent indices) of a row-major array of
-/// `width` samples per row whose first entry is parent sample `origin`, `stride` values each.
+/// `width` samples per row whose first entry is parent sample `origin` shifted by `first_row`
+/// rows (0 for a whole array, a block's first row for one thread's row block), `stride` values
+/// each.
 pub(crate) struct Rect {
     pub rows: Range<usize>,
     pub cols: Range<usize>,
     pub origin: (usize, usize),
+    pub first_row: usize,
     pub width: usize,
     pub stride: usize,
 }
@@ -373,7 +404,7 @@ pub(crate) fn two_pass<P>(
         for j in rect.cols.clone() {
             let lj = j - oj;
             let first = tv.first(lj);
-            let base = (li * rect.width + lj) * rect.stride;
+            let base = ((li - rect.first_row) * rect.width + lj) * rect.stride;
             for (p, &(a, b)) in partials.iter().enumerate() {
                 out[base + p] = match tv.row(lj, b) {
                     Some(row) => dot(row, &q[a * nv + first..]),

@@ -19,12 +19,14 @@ use crate::sampling::tables::axis::HermiteTable;
 use glam::DVec3;
 use std::ops::Range;
 
-/// The `Shading` grid a kernel writes: `data[(i * width + j) * 3 + p]` with p over S, Su, Sv,
-/// and `normals[i * width + j]` when there are normals.
+/// The `Shading` grid a kernel writes: `data[((i - first_row) * width + j) * 3 + p]` with p over
+/// S, Su, Sv, and `normals[(i - first_row) * width + j]` when there are normals. `first_row` is
+/// 0 for a whole grid, the block's first row for one thread's row block.
 pub(crate) struct ShadingGrid<'a> {
     pub data: &'a mut [DVec3],
     pub normals: Option<&'a mut [DVec3]>,
     pub width: usize,
+    pub first_row: usize,
 }
 
 /// Whether [`sample_surface`] handles degrees `[du, dv]`: 1 to 3 each way. Degree 0 has no
@@ -107,11 +109,12 @@ impl Rect<'_> {
             cols,
         };
         let mv = out.width;
-        let mut data = out.data[rows.start * mv * 3..rows.end * mv * 3].chunks_exact_mut(mv * 3);
+        let (r0, r1) = (rows.start - out.first_row, rows.end - out.first_row);
+        let mut data = out.data[r0 * mv * 3..r1 * mv * 3].chunks_exact_mut(mv * 3);
         let split = rows.start + rows.len() / LANES * LANES;
         match out.normals {
             Some(normals) => {
-                let mut normals = normals[rows.start * mv..rows.end * mv].chunks_exact_mut(mv);
+                let mut normals = normals[r0 * mv..r1 * mv].chunks_exact_mut(mv);
                 kernel.rows::<LANES, true>(rows.start..split, &mut data, &mut normals, degenerate);
                 kernel.rows::<1, true>(split..rows.end, &mut data, &mut normals, degenerate);
             }
@@ -261,7 +264,8 @@ pub(crate) fn translate_surface(
     let mv = out.width;
     for i in rows.clone() {
         let cu = coeffs(tu, k, i);
-        let (a, b) = (i * mv + cols.start, i * mv + cols.end);
+        let row = (i - out.first_row) * mv;
+        let (a, b) = (row + cols.start, row + cols.end);
         let data = out.data[a * 3..b * 3].as_chunks_mut::<3>().0;
         let normals = &mut out
             .normals
