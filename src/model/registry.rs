@@ -344,7 +344,7 @@ impl SampledObject {
         self.sampler().grid()
     }
 
-    /// The samples whose values edits of `target` can change ([`crate::sampling::Sampler::support`]).
+    /// The samples whose values edits of `target` can change ([`crate::model::kind::Support`]).
     #[must_use]
     pub fn support(&self, target: Target) -> Vec<DirtyRegion> {
         self.sampler().support(target)
