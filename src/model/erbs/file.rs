@@ -459,16 +459,34 @@ fn write_bfunction(s: &mut String, b: BFunctionKind) {
     }
 }
 
-/// An ERBS curve's edit: a local edit (`local` with `transform`, or `point` and `delta`), a refinement
-/// (`insert_knot`, optionally of the ERBS local at `local`, with an optional `degree`), or a
-/// local turned into an ERBS local of its own (`local` with `to_erbs`).
-pub fn read_curve_edit(at: &At, obj: &Map<String, Value>) -> Result<ErbsCurveEdit, SceneError> {
+/// Degree elevation is refused: ERBS objects refine by knot insertion.
+fn refuse_elevation(at: &At, obj: &Map<String, Value>) -> Result<(), SceneError> {
     if obj.contains_key("elevate_degree") {
         return Err(at.err(
             "elevate_degree",
             "ERBS objects are refined by inserting knots (insert_knot), not by degree elevation",
         ));
     }
+    Ok(())
+}
+
+/// The `to_erbs` specification, its fields checked, with where errors inside it are reported.
+fn to_erbs_spec<'v>(
+    at: &At,
+    v: &'v Value,
+    count_field: &str,
+) -> Result<(&'v Map<String, Value>, At), SceneError> {
+    let spec = as_object(at, "to_erbs", v)?;
+    let inner = At(format!("{}: field 'to_erbs'", at.0));
+    check_fields(&inner, spec, &[count_field, "local_degree"])?;
+    Ok((spec, inner))
+}
+
+/// An ERBS curve's edit: a local edit (`local` with `transform`, or `point` and `delta`), a refinement
+/// (`insert_knot`, optionally of the ERBS local at `local`, with an optional `degree`), or a
+/// local turned into an ERBS local of its own (`local` with `to_erbs`).
+pub fn read_curve_edit(at: &At, obj: &Map<String, Value>) -> Result<ErbsCurveEdit, SceneError> {
+    refuse_elevation(at, obj)?;
     let path = |v: &Value| curve_path(at, v);
     let point = |v: &Value| index(at, "point", v);
     if let Some(v) = obj.get("insert_knot") {
@@ -488,9 +506,7 @@ pub fn read_curve_edit(at: &At, obj: &Map<String, Value>) -> Result<ErbsCurveEdi
     if let Some(v) = obj.get("to_erbs") {
         check_fields(at, obj, &["object", "local", "to_erbs"])?;
         let local = path(require(at, obj, "local")?)?;
-        let spec = as_object(at, "to_erbs", v)?;
-        let inner = At(format!("{}: field 'to_erbs'", at.0));
-        check_fields(&inner, spec, &["local_curves", "local_degree"])?;
+        let (spec, inner) = to_erbs_spec(at, v, "local_curves")?;
         let count = as_usize(
             at,
             "to_erbs",
@@ -515,12 +531,7 @@ pub fn read_curve_edit(at: &At, obj: &Map<String, Value>) -> Result<ErbsCurveEdi
 /// An ERBS surface's edit, likewise (paths and points are index pairs, knots are inserted in
 /// one direction).
 pub fn read_surface_edit(at: &At, obj: &Map<String, Value>) -> Result<ErbsSurfaceEdit, SceneError> {
-    if obj.contains_key("elevate_degree") {
-        return Err(at.err(
-            "elevate_degree",
-            "ERBS objects are refined by inserting knots (insert_knot), not by degree elevation",
-        ));
-    }
+    refuse_elevation(at, obj)?;
     let path = |v: &Value| surface_path(at, v);
     let point = |v: &Value| pair(at, "point", v);
     if let Some(v) = obj.get("insert_knot") {
@@ -540,9 +551,7 @@ pub fn read_surface_edit(at: &At, obj: &Map<String, Value>) -> Result<ErbsSurfac
     if let Some(v) = obj.get("to_erbs") {
         check_fields(at, obj, &["object", "local", "to_erbs"])?;
         let local = path(require(at, obj, "local")?)?;
-        let spec = as_object(at, "to_erbs", v)?;
-        let inner = At(format!("{}: field 'to_erbs'", at.0));
-        check_fields(&inner, spec, &["local_patches", "local_degree"])?;
+        let (spec, inner) = to_erbs_spec(at, v, "local_patches")?;
         let count = usize_pair(
             at,
             "to_erbs",
