@@ -102,7 +102,8 @@ pub use device::{Device, DeviceCaps, GPU_ENV};
 pub use error::{GpuError, GpuResult};
 pub use frame::{DrawStats, Frame};
 pub use grid::{
-    GridShape, GridStride, grid_lines, grid_lines_strided, grid_triangles, grid_triangles_strided,
+    GridShape, GridStride, RUN_VERTICES, grid_lines, grid_lines_strided, grid_triangles,
+    grid_triangles_strided,
 };
 pub use instance::{ValidationMode, force_driver_files};
 pub use layer::LayerPart;

@@ -127,6 +127,8 @@ pub struct GpuScene {
     /// The curvature map's scalars, built by the first upload after the map changed.
     scalars: Option<MapScalars>,
     scratch: Vec<f32>,
+    /// Per arena, the frame slots not yet written since the arena was created.
+    unfilled: Vec<[bool; FRAMES_IN_FLIGHT]>,
     /// `--redraw`: whether gestures draw from a static layer.
     redraw: Redraw,
     /// The gesture in progress ([`GpuScene::set_gesture`]).
@@ -172,7 +174,8 @@ struct Layer {
 const ZEBRA_STRIPES: f32 = 16.0;
 
 impl GpuScene {
-    /// Creates and fills every mirror (all slots).
+    /// Creates every mirror; the sample arenas are written by the first upload into each
+    /// frame slot, the control mirrors now.
     pub fn new(renderer: &mut Renderer, doc: &Document) -> GpuResult<Self> {
         let (places, sizes) = arena_layout(doc);
         let mut scene = Self {
@@ -183,6 +186,7 @@ impl GpuScene {
             map: None,
             scalars: None,
             scratch: Vec::new(),
+            unfilled: Vec::with_capacity(sizes.len()),
             redraw: Redraw::default(),
             gesture: None,
             layer: None,
@@ -207,21 +211,12 @@ impl GpuScene {
         places: &[Place],
         sizes: &[usize],
     ) -> GpuResult<()> {
+        // Arenas are written by the first upload into each slot (`unfilled`), so a slot that
+        // is never drawn (`render` draws one frame) is never touched, nor its pages resident.
         for (a, &len) in sizes.iter().enumerate() {
-            let mut data = vec![0.0f32; len.max(3)];
-            for (i, p) in places.iter().enumerate().filter(|(_, p)| p.arena == a) {
-                sample_floats(
-                    doc,
-                    i,
-                    0..doc.objects[i].sampled.grid().dims[0],
-                    &mut self.scratch,
-                );
-                data[p.offset..p.offset + self.scratch.len()].copy_from_slice(&self.scratch);
-            }
-            let mut mirror = renderer.create_mirror(&format!("samples {a}"), data.len())?;
-            let filled = renderer.fill_mirror(&mut mirror, 0, &data);
-            self.arenas.push(mirror);
-            filled?;
+            self.arenas
+                .push(renderer.create_mirror(&format!("samples {a}"), len.max(3))?);
+            self.unfilled.push([true; FRAMES_IN_FLIGHT]);
         }
         for (i, o) in doc.objects.iter().enumerate() {
             let data = vertex_floats(&o.controls.vertices);
@@ -352,6 +347,7 @@ impl GpuScene {
         let slot = frame.slot();
         let mut stats = UploadStats::default();
         stats.bytes += self.sync_scalars(frame, doc)?;
+        stats.bytes += self.fill_arenas(frame, doc)?;
         for (i, o) in self.objects.iter_mut().enumerate() {
             let ranges = o.dirty[slot].take();
             if !ranges.is_empty() {
@@ -405,6 +401,28 @@ impl GpuScene {
             }
         }
         Ok(stats)
+    }
+
+    /// Writes every object's samples into this frame's slot of each arena not yet written
+    /// there (objects lie back to back, so that fills the arena); returns the bytes written.
+    fn fill_arenas(&mut self, frame: &mut Frame<'_>, doc: &Document) -> GpuResult<usize> {
+        let slot = frame.slot();
+        let mut bytes = 0;
+        for (a, unfilled) in self.unfilled.iter_mut().enumerate() {
+            if !std::mem::take(&mut unfilled[slot]) {
+                continue;
+            }
+            let mut w = frame.write_mirror(&mut self.arenas[a]);
+            for (i, o) in self.objects.iter().enumerate() {
+                if o.samples.arena == a {
+                    let rows = doc.objects[i].sampled.grid().dims[0];
+                    sample_floats(doc, i, 0..rows, &mut self.scratch);
+                    w.write(o.samples.offset, &self.scratch)?;
+                    bytes += self.scratch.len() * 4;
+                }
+            }
+        }
+        Ok(bytes)
     }
 
     /// How gestures redraw (`--redraw`); `Full` drops any static layer.
@@ -537,6 +555,9 @@ impl GpuScene {
 
     /// The surfaces in draw order: per group, per stride (ascending), the members sharing it.
     fn surface_order(&mut self, doc: &Document, opts: &ViewOptions, lod: &Lod) -> Vec<Batch> {
+        if opts.lod {
+            self.measure_grids(doc);
+        }
         let mut order = Vec::new();
         for (g, group) in self.groups.iter().enumerate() {
             let mut by_stride: BTreeMap<(u32, u32), Vec<usize>> = BTreeMap::new();
@@ -563,6 +584,22 @@ impl GpuScene {
             }
         }
         order
+    }
+
+    /// Measures every surface not measured since its samples last changed, on every core:
+    /// after a load that is one pass over all the samples of the scene.
+    fn measure_grids(&mut self, doc: &Document) {
+        let stale: Vec<usize> = self
+            .groups
+            .iter()
+            .flat_map(|g| g.members.iter().copied())
+            .filter(|&i| self.objects[i].metrics.is_none())
+            .collect();
+        let measured =
+            crate::parallel::map(&stale, |&i| GridMetrics::new(doc.objects[i].sampled.grid()));
+        for (i, m) in stale.into_iter().zip(measured) {
+            self.objects[i].metrics = Some(m);
+        }
     }
 
     /// The surfaces `members` of batch `b` (shaded or mapped, then their isolines).
