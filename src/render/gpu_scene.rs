@@ -135,6 +135,11 @@ pub struct GpuScene {
     gesture: Option<Gesture>,
     /// The static layer of the gesture, once built.
     layer: Option<Layer>,
+    /// The last gesture whose dynamic set was too much of the frame for a static layer to
+    /// pay (see [`worth_a_layer`]): its frames draw in full without trying again.
+    unworthy: Option<LayerKey>,
+    /// Test hook: build a layer for every gesture ([`GpuScene::set_layer_always`]).
+    layer_always: bool,
     /// Test hook: the dynamic set misses one chunk (a negative control).
     drop_chunk: bool,
     /// Test hook: the lines through moved control points are left out of the redrawn
@@ -190,6 +195,8 @@ impl GpuScene {
             redraw: Redraw::default(),
             gesture: None,
             layer: None,
+            unworthy: None,
+            layer_always: false,
             drop_chunk: false,
             drop_lines: false,
             moved_controls: DirtySet::default(),
@@ -462,6 +469,14 @@ impl GpuScene {
         self.layer = None;
     }
 
+    /// Test hook: every gesture builds a static layer, whether it pays or not (see
+    /// [`worth_a_layer`]), so exactness tests reach the retained path on small scenes.
+    #[doc(hidden)]
+    pub fn set_layer_always(&mut self, always: bool) {
+        self.layer_always = always;
+        self.unworthy = None;
+    }
+
     /// Test hook, a negative control: retained frames leave the lines through moved control
     /// points out of the rectangle they redraw, so their old pixels stay in the layer.
     #[doc(hidden)]
@@ -721,8 +736,21 @@ impl GpuScene {
         };
         if !restored {
             self.layer = None;
+            if self.unworthy.as_ref() == Some(&key) {
+                return Ok(false);
+            }
+            let support = doc.objects[g.object].sampled.support(g.target);
+            let cells = place.map(|(bi, _)| {
+                let shape = self.groups[order[bi].group].shape;
+                split_cells(shape, order[bi].stride, &support, self.drop_chunk)
+            });
+            if !self.layer_always && !worth_a_layer(cells.as_ref(), order, &self.groups) {
+                self.unworthy = Some(key);
+                return Ok(false);
+            }
+            self.unworthy = None;
             frame.keep_depth();
-            self.build_layer(frame, doc, opts, hl, order, place, key)?;
+            self.build_layer(frame, doc, opts, hl, order, place, key, (support, cells))?;
             if self.layer.is_none() {
                 return Ok(true);
             }
@@ -743,13 +771,9 @@ impl GpuScene {
         order: &[Batch],
         place: Option<(usize, usize)>,
         key: LayerKey,
+        (support, cells): (Vec<DirtyRegion>, Option<SplitCells>),
     ) -> GpuResult<()> {
         let g = key.gesture;
-        let support = doc.objects[g.object].sampled.support(g.target);
-        let cells = place.map(|(bi, _)| {
-            let shape = self.groups[order[bi].group].shape;
-            split_cells(shape, order[bi].stride, &support, self.drop_chunk)
-        });
         for (bi, b) in order.iter().enumerate() {
             match (place, &cells) {
                 (Some((pb, m)), Some(c)) if pb == bi => {
@@ -1327,6 +1351,22 @@ fn arena_layout(doc: &Document) -> (Vec<Place>, Vec<usize>) {
         sizes[arena] += len;
     }
     (places, sizes)
+}
+
+/// Whether a static layer pays for a gesture whose dragged surface splits into `cells`: its
+/// dynamic cells must leave at least a quarter of the frame's surface triangles in the layer.
+/// Otherwise the frame would draw nearly everything anyway, on top of restoring the layer
+/// (two full-image copies; about 1 ms at 1280 × 720 on lavapipe, docs/performance.md): an
+/// ERBS local patch whose support is the whole surface, say. A moving curve (`None`) always
+/// pays: the surfaces stay in the layer.
+fn worth_a_layer(cells: Option<&SplitCells>, order: &[Batch], groups: &[SurfaceGroup]) -> bool {
+    let Some(cells) = cells else { return true };
+    let dynamic: u64 = cells.dynamic.iter().map(|&(_, n)| u64::from(n) / 3).sum();
+    let all: u64 = order
+        .iter()
+        .map(|b| 2 * b.stride.cells(groups[b.group].shape) * b.members.len() as u64)
+        .sum();
+    4 * dynamic < 3 * all
 }
 
 /// Surfaces grouped by arena, grid shape and colour (in order of first appearance).
