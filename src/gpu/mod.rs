@@ -106,7 +106,7 @@ pub use grid::{
     grid_triangles_strided,
 };
 pub use instance::{ValidationMode, force_driver_files};
-pub use layer::LayerPart;
+pub use layer::{LayerPart, Restore};
 pub use memory::{Buffer, BufferDesc};
 pub use mirror::{Mirror, MirrorBuffer, MirrorWriter};
 pub use offscreen::{OFFSCREEN_FORMAT, OffscreenDesc, OffscreenTarget, Pixels};

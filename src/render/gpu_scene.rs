@@ -16,7 +16,7 @@ use crate::editor::{
 };
 use crate::gpu::{
     FRAMES_IN_FLIGHT, Frame, GpuError, GpuResult, GridShape, GridStride, LayerPart, MapStyle,
-    Mirror, PointRun, PointStyle, PolylineStyle, Renderer, SurfaceBatch, SurfaceStyle,
+    Mirror, PointRun, PointStyle, PolylineStyle, Renderer, Restore, SurfaceBatch, SurfaceStyle,
 };
 use crate::model::{Index2, LocalPath};
 use crate::sampling::{DirtyRegion, DirtySet};
@@ -731,7 +731,11 @@ impl GpuScene {
             .as_ref()
             .is_some_and(|l| !l.stale && l.key == key);
         let restored = match &self.layer {
-            Some(l) if valid => frame.restore_static_layer(LayerPart::Lines, l.lines, None)?,
+            // Depth only inside the redrawn rectangle (restored with the surfaces' save
+            // there): every depth-tested draw of a retained frame stays inside it.
+            Some(l) if valid => {
+                frame.restore_static_layer(LayerPart::Lines, l.lines, None, Restore::Color)?
+            }
             _ => false,
         };
         if !restored {
@@ -892,7 +896,8 @@ impl GpuScene {
         if r[2] == 0 || r[3] == 0 {
             return Ok(());
         }
-        if !frame.restore_static_layer(LayerPart::Surfaces, layer.surfaces, Some(r))? {
+        let what = Restore::ColorAndDepth;
+        if !frame.restore_static_layer(LayerPart::Surfaces, layer.surfaces, Some(r), what)? {
             return Err(GpuError::InvalidArgument(
                 "static layer lost within a frame".into(),
             ));
