@@ -748,7 +748,8 @@ impl GpuScene {
                 let shape = self.groups[order[bi].group].shape;
                 split_cells(shape, order[bi].stride, &support, self.drop_chunk)
             });
-            if !self.layer_always && !worth_a_layer(cells.as_ref(), order, &self.groups) {
+            let [w, h] = key.extent.map(u64::from);
+            if !self.layer_always && !worth_a_layer(cells.as_ref(), order, &self.groups, w * h) {
                 self.unworthy = Some(key);
                 return Ok(false);
             }
@@ -1358,21 +1359,33 @@ fn arena_layout(doc: &Document) -> (Vec<Place>, Vec<usize>) {
     (places, sizes)
 }
 
-/// Whether a static layer pays for a gesture whose dragged surface splits into `cells`: its
-/// dynamic cells must leave at least a quarter of the frame's surface triangles in the layer.
-/// Otherwise the frame would draw nearly everything anyway, on top of restoring the layer
-/// (two full-image copies; about 1 ms at 1280 × 720 on lavapipe, docs/performance.md): an
-/// ERBS local patch whose support is the whole surface, say. A moving curve (`None`) always
-/// pays: the surfaces stay in the layer.
-fn worth_a_layer(cells: Option<&SplitCells>, order: &[Batch], groups: &[SurfaceGroup]) -> bool {
-    let Some(cells) = cells else { return true };
-    let dynamic: u64 = cells.dynamic.iter().map(|&(_, n)| u64::from(n) / 3).sum();
+/// Whether a static layer pays for a gesture whose dragged surface splits into `cells`
+/// (`None`: the gesture moves a curve, and every surface stays in the layer) on a target of
+/// `pixels`. Restoring the layer copies every pixel each frame (about 0.7 ms at 1280 × 720 on
+/// lavapipe, as much as drawing a few thousand surface triangles: docs/performance.md), so
+/// what stays in it must be a surface triangle per [`PIXELS_PER_KEPT_TRIANGLE`] pixels at
+/// least, and a quarter of the frame's triangles. Otherwise the frame is drawn in full: a
+/// scene of curves only, or an ERBS local patch whose support is the whole surface.
+fn worth_a_layer(
+    cells: Option<&SplitCells>,
+    order: &[Batch],
+    groups: &[SurfaceGroup],
+    pixels: u64,
+) -> bool {
+    let dynamic: u64 = cells.map_or(0, |c| {
+        c.dynamic.iter().map(|&(_, n)| u64::from(n) / 3).sum()
+    });
     let all: u64 = order
         .iter()
         .map(|b| 2 * b.stride.cells(groups[b.group].shape) * b.members.len() as u64)
         .sum();
-    4 * dynamic < 3 * all
+    let kept = all.saturating_sub(dynamic);
+    kept * PIXELS_PER_KEPT_TRIANGLE >= pixels && 4 * dynamic < 3 * all
 }
+
+/// A static layer must keep a surface triangle per this many pixels of its target to pay for
+/// its copy (see [`worth_a_layer`]): 3,600 triangles at 1280 × 720.
+const PIXELS_PER_KEPT_TRIANGLE: u64 = 256;
 
 /// Surfaces grouped by arena, grid shape and colour (in order of first appearance).
 fn surface_groups(doc: &Document, places: &[Place]) -> Vec<SurfaceGroup> {

@@ -478,8 +478,9 @@ fn lines_left_out_of_the_redrawn_rectangle_are_caught() {
 
 /// Without the test hook, a gesture whose dynamic set is most of the frame's triangles draws
 /// in full (a layer would cost two image copies and save little): rotating the middle local
-/// patch of `examples/erbs_surface.json`, whose support is the whole surface. A drag whose
-/// support is a small part of the frame still takes the retained path. Both equal full.
+/// patch of `examples/erbs_surface.json`, whose support is the whole surface, and dragging a
+/// point of a scene of curves only. A drag whose support is a small part of the frame still
+/// takes the retained path. All equal full.
 #[test]
 fn a_layer_that_would_not_pay_is_skipped() {
     let mut rng = Rng::new(11);
@@ -519,6 +520,23 @@ fn a_layer_that_would_not_pay_is_skipped() {
     assert!(
         pair.retained_frames > 0,
         "a drag on one of several objects drew no frame from a layer"
+    );
+    pair.finish();
+
+    // Curves only: no surface would stay in a layer.
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/bezier_curve.json"
+    ))
+    .unwrap();
+    let mut pair = Pair::new(&parse_scene(&text).unwrap(), None);
+    pair.runs[0].session.set_layer_always(false);
+    let h = handle_of(&pair, &mut rng, 0);
+    let script = drag(&mut rng, h, false, 6);
+    check(&mut pair, &script, "a drag on a curve");
+    assert_eq!(
+        pair.retained_frames, 0,
+        "a curve-only scene drew from a layer"
     );
     pair.finish();
 }
