@@ -108,7 +108,7 @@ pub use grid::{
 pub use instance::{ValidationMode, force_driver_files};
 pub use layer::{LayerPart, Restore};
 pub use memory::{Buffer, BufferDesc};
-pub use mirror::{Mirror, MirrorBuffer, MirrorWriter};
+pub use mirror::{Mirror, MirrorBuffer, MirrorWriter, RangeWriter};
 pub use offscreen::{OFFSCREEN_FORMAT, OffscreenDesc, OffscreenTarget, Pixels};
 pub use pipeline::DEPTH_FORMAT;
 pub use region::{PointRun, SurfaceBatch, SurfaceGrid};

@@ -411,7 +411,8 @@ impl GpuScene {
     }
 
     /// Writes every object's samples into this frame's slot of each arena not yet written
-    /// there (objects lie back to back, so that fills the arena); returns the bytes written.
+    /// there (objects lie back to back, so that fills the arena), on every core: runs of
+    /// consecutive objects each go to a disjoint range of the slot. Returns the bytes written.
     fn fill_arenas(&mut self, frame: &mut Frame<'_>, doc: &Document) -> GpuResult<usize> {
         let slot = frame.slot();
         let mut bytes = 0;
@@ -419,15 +420,41 @@ impl GpuScene {
             if !std::mem::take(&mut unfilled[slot]) {
                 continue;
             }
+            // (object, float offset, floats) of the arena's objects, in order of offset.
+            let mut members: Vec<(usize, usize, usize)> = (0..self.objects.len())
+                .filter(|&i| self.objects[i].samples.arena == a)
+                .map(|i| {
+                    let [rows, cols] = doc.objects[i].sampled.grid().dims;
+                    let floats = rows * cols * floats_per_sample(doc, i);
+                    (i, self.objects[i].samples.offset, floats)
+                })
+                .collect();
+            members.sort_by_key(|m| m.1);
+            let runs = fill_runs(&members, crate::parallel::threads());
+            let ranges: Vec<std::ops::Range<usize>> = runs
+                .iter()
+                .map(|r| {
+                    let (first, last) = (members[r.start], members[r.end - 1]);
+                    first.1..last.1 + last.2
+                })
+                .collect();
+            bytes += ranges.iter().map(|r| r.len() * 4).sum::<usize>();
             let mut w = frame.write_mirror(&mut self.arenas[a]);
-            for (i, o) in self.objects.iter().enumerate() {
-                if o.samples.arena == a {
+            let mut jobs: Vec<_> = w
+                .split(&ranges)?
+                .into_iter()
+                .zip(&runs)
+                .map(|(writer, run)| (writer, &members[run.clone()], Ok(())))
+                .collect();
+            crate::parallel::for_each_mut(&mut jobs, |(writer, run, result)| {
+                let mut scratch = Vec::new();
+                *result = run.iter().try_for_each(|&(i, offset, _)| {
                     let rows = doc.objects[i].sampled.grid().dims[0];
-                    sample_floats(doc, i, 0..rows, &mut self.scratch);
-                    w.write(o.samples.offset, &self.scratch)?;
-                    bytes += self.scratch.len() * 4;
-                }
-            }
+                    sample_floats(doc, i, 0..rows, &mut scratch);
+                    writer.write(offset, &scratch)
+                });
+            });
+            jobs.into_iter().try_for_each(|(_, _, result)| result)?;
         }
         Ok(bytes)
     }
@@ -1387,6 +1414,26 @@ fn worth_a_layer(
 /// its copy (see [`worth_a_layer`]): 3,600 triangles at 1280 × 720.
 const PIXELS_PER_KEPT_TRIANGLE: u64 = 256;
 
+/// Runs of consecutive `members` (object, offset, floats) for a parallel fill: about four
+/// per thread of similar float counts, so a thread that finishes early takes another.
+fn fill_runs(members: &[(usize, usize, usize)], threads: usize) -> Vec<std::ops::Range<usize>> {
+    let total: usize = members.iter().map(|m| m.2).sum();
+    let per = total.div_ceil((threads.max(1) * 4).max(1)).max(1);
+    let mut runs = Vec::new();
+    let (mut start, mut floats) = (0, 0);
+    for (k, m) in members.iter().enumerate() {
+        floats += m.2;
+        if floats >= per {
+            runs.push(start..k + 1);
+            (start, floats) = (k + 1, 0);
+        }
+    }
+    if start < members.len() {
+        runs.push(start..members.len());
+    }
+    runs
+}
+
 /// Surfaces grouped by arena, grid shape and colour (in order of first appearance).
 fn surface_groups(doc: &Document, places: &[Place]) -> Vec<SurfaceGroup> {
     let mut groups: Vec<SurfaceGroup> = Vec::new();
@@ -1484,4 +1531,24 @@ fn vertex_floats(vertices: &[DVec3]) -> Vec<f32> {
         .iter()
         .flat_map(|p| [p.x as f32, p.y as f32, p.z as f32])
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fill_runs;
+
+    #[test]
+    fn fill_runs_cover_the_members_in_order() {
+        let members: Vec<(usize, usize, usize)> = (0..10).map(|i| (i, i * 100, 100)).collect();
+        for threads in [1, 2, 3, 16] {
+            let runs = fill_runs(&members, threads);
+            assert_eq!(runs.first().map(|r| r.start), Some(0));
+            assert_eq!(runs.last().map(|r| r.end), Some(10));
+            assert!(runs.windows(2).all(|w| w[0].end == w[1].start));
+            assert!(runs.iter().all(|r| !r.is_empty()));
+        }
+        // One thread: four runs of similar size.
+        assert_eq!(fill_runs(&members, 1).len(), 4);
+        assert!(fill_runs(&[], 2).is_empty());
+    }
 }
