@@ -9,7 +9,7 @@ use super::retained::{
     Gesture, LayerKey, Redraw, SplitCells, covers, moving_vertices, overlaps, sample_bounds,
     screen_rect, screen_rect_with, split_cells, touched_vertices, union_rect, vertex_bounds,
 };
-use super::style::{NetMode, Palette, ViewOptions, Wire};
+use super::style::{Highlight, NetMode, Palette, ViewOptions, Wire};
 use crate::editor::{
     Applied, ControlLayout, ControlsChange, Document, Handle, LOCAL_CURVE_SAMPLES,
     LOCAL_PATCH_SAMPLES, LocalEntry,
@@ -18,7 +18,7 @@ use crate::gpu::{
     FRAMES_IN_FLIGHT, Frame, GpuError, GpuResult, GridShape, GridStride, LayerPart, MapStyle,
     Mirror, PointRun, PointStyle, PolylineStyle, Renderer, Restore, SurfaceBatch, SurfaceStyle,
 };
-use crate::model::{Index2, LocalPath};
+use crate::model::Index2;
 use crate::sampling::{DirtyRegion, DirtySet};
 use glam::DVec3;
 use std::collections::BTreeMap;
@@ -89,28 +89,6 @@ pub struct DrawReport {
     /// of a full redraw at the same levels of detail) were drawn.
     pub retained: bool,
     pub retained_of: u64,
-}
-
-/// Which handle the cursor is over and which one is selected (for highlighting).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct Highlight {
-    pub hovered: Option<Handle>,
-    pub selected: Option<Handle>,
-    /// A selected ERBS local curve/patch (drawn emphasised).
-    pub selected_local: Option<(usize, LocalPath<Index2>)>,
-    /// The object under the cursor (its controls show in [`NetMode::Focused`]).
-    pub hovered_object: Option<usize>,
-}
-
-impl Highlight {
-    /// Whether object `i` is selected or under the cursor.
-    #[must_use]
-    pub fn focuses(&self, i: usize) -> bool {
-        self.hovered.is_some_and(|h| h.object() == i)
-            || self.selected.is_some_and(|h| h.object() == i)
-            || self.selected_local.is_some_and(|(o, _)| o == i)
-            || self.hovered_object == Some(i)
-    }
 }
 
 /// The document's GPU side. Samples of all objects live in a few large *arena* mirrors

@@ -16,11 +16,11 @@ pub mod retained;
 pub mod style;
 
 pub use camera::{Bounds, OrbitCamera};
-pub use gpu_scene::{DrawReport, GpuScene, Highlight, UploadStats};
+pub use gpu_scene::{DrawReport, GpuScene, UploadStats};
 pub use lod::Lod;
 pub use map_mirror::MapView;
 pub use retained::{Gesture, Redraw};
-pub use style::{NetMode, Palette, ViewOptions, Wire};
+pub use style::{Highlight, NetMode, Palette, ViewOptions, Wire};
 
 use crate::gpu::ValidationMode;
 use crate::sampling::budget::Uses;
