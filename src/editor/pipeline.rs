@@ -6,7 +6,7 @@
 use super::applied::Applied;
 use super::document::Document;
 use super::undo::{UndoStack, UndoStep};
-use crate::model::{Edit, EditError, merge_edits};
+use crate::model::{Edit, EditError, Model, merge_edits};
 use crate::sampling::budget::{Extent, MemoryBudget, Uses, check_extents};
 use crate::sampling::{DirtyRegion, SampleMode};
 use crate::scene::{EditList, Scene, SceneError};
@@ -131,16 +131,22 @@ impl Editor {
         }
         self.flush();
         let model = self.doc.objects[edit.object].sampled.model();
-        edit.edit.validate(model)?;
-        let mut grown = model.to_model();
-        grown.apply(&edit.edit)?;
+        let result = edit.edit.prepare(model)?;
+        let grown = match &result {
+            Some(after) => after.kind().extent(),
+            // Put back in place (one ERBS local): grown as applying it grows it.
+            None => {
+                let mut grown = model.to_model();
+                grown.apply(&edit.edit)?;
+                grown.kind().extent()
+            }
+        };
         let mut extents = self.extents();
-        extents[edit.object].1 = grown.kind().extent();
+        extents[edit.object].1 = grown;
         let o = &self.options;
         check_extents(&extents, o.mode, o.uses, &o.budget).map_err(Refused::OverBudget)?;
         self.undo.record(&self.doc, &edit);
-        self.pending.push(edit);
-        self.flush();
+        self.apply_now(&edit, result);
         Ok(())
     }
 
@@ -198,22 +204,52 @@ impl Editor {
         };
         let mut edited = Vec::new();
         for e in &edits {
-            let o = &mut self.doc.objects[e.object];
             // Validated when submitted; a stale edit (an undo racing a refinement) is dropped
             // by the sampler's own check rather than reaching the kernels.
-            let Ok(region) = o.sampled.apply(&e.edit) else {
-                continue;
-            };
-            if self.naive {
-                if !edited.contains(&e.object) {
-                    edited.push(e.object);
-                }
-                continue;
-            }
-            let controls = o.controls.update(o.sampled.model(), e.edit.target());
-            report.record(e.object, region, controls);
+            self.apply_one(e, None, &mut report, &mut edited);
         }
-        for &i in &edited {
+        self.finish(report, &edited, start);
+    }
+
+    /// Applies one structural edit now with the model its preparation computed (`result`),
+    /// into the held report.
+    fn apply_now(&mut self, edit: &Edit, result: Option<Model>) {
+        let start = Instant::now();
+        let mut report = Applied {
+            edits: 1,
+            ..Applied::default()
+        };
+        let mut edited = Vec::new();
+        self.apply_one(edit, result, &mut report, &mut edited);
+        self.finish(report, &edited, start);
+    }
+
+    /// Applies one edit through its object's delta path and records what it rewrote; a naive
+    /// editor only notes the object in `edited`, to re-sample it whole.
+    fn apply_one(
+        &mut self,
+        e: &Edit,
+        result: Option<Model>,
+        report: &mut Applied,
+        edited: &mut Vec<usize>,
+    ) {
+        let o = &mut self.doc.objects[e.object];
+        let Ok(region) = o.sampled.apply_prepared(&e.edit, result) else {
+            return;
+        };
+        if self.naive {
+            if !edited.contains(&e.object) {
+                edited.push(e.object);
+            }
+            return;
+        }
+        let controls = o.controls.update(o.sampled.model(), e.edit.target());
+        report.record(e.object, region, controls);
+    }
+
+    /// Re-samples the `edited` objects of a naive editor whole, and keeps the report.
+    fn finish(&mut self, mut report: Applied, edited: &[usize], start: Instant) {
+        for &i in edited {
             let o = &mut self.doc.objects[i];
             let region = o.sampled.rebuild_all();
             let controls = o.controls.refresh(o.sampled.model());

@@ -151,23 +151,27 @@ const STACK_SCRATCH: usize = 15 * 17;
 /// BasisFuns (NURBS Book A2.2): the d+1 non-vanishing basis functions N_{i−d..=i, d}(t).
 #[must_use]
 pub fn basis_funs(knots: &[f64], degree: usize, span: usize, t: f64) -> Vec<f64> {
-    let d = degree;
-    let mut n = vec![0.0; d + 1];
-    let mut left = vec![0.0; d + 1];
-    let mut right = vec![0.0; d + 1];
+    let mut n = vec![0.0; degree + 1];
+    basis_funs_into(knots, degree, span, t, &mut n);
+    n
+}
+
+/// [`basis_funs`] into `n` (d+1 entries), without allocating: callers that evaluate at many
+/// parameters (the shape guard) keep one buffer. A2.2's `left[j]` and `right[j]` are t minus
+/// a knot and a knot minus t, read where they are used (the same values bit for bit).
+pub fn basis_funs_into(knots: &[f64], degree: usize, span: usize, t: f64, n: &mut [f64]) {
+    let left = |j: usize| t - knots[span + 1 - j];
+    let right = |j: usize| knots[span + j] - t;
     n[0] = 1.0;
-    for j in 1..=d {
-        left[j] = t - knots[span + 1 - j];
-        right[j] = knots[span + j] - t;
+    for j in 1..=degree {
         let mut saved = 0.0;
         for r in 0..j {
-            let temp = n[r] / (right[r + 1] + left[j - r]);
-            n[r] = saved + right[r + 1] * temp;
-            saved = left[j - r] * temp;
+            let temp = n[r] / (right(r + 1) + left(j - r));
+            n[r] = saved + right(r + 1) * temp;
+            saved = left(j - r) * temp;
         }
         n[j] = saved;
     }
-    n
 }
 
 /// DersBasisFuns (NURBS Book A2.3): `ders[k][j]` is the k-th derivative of N_{i−d+j, d} at t,

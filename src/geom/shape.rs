@@ -1,19 +1,27 @@
 //! How far a structural edit moves a shape. Knot insertion and degree elevation promise the
 //! same shape; ERBS refinement promises it outside the refined interval and at the knots. Before
-//! such an edit is applied, its result is compared with the shape it replaces ([`shape_change`])
-//! at parameters where the promise must hold ([`span_probes`]: d+1 per span), and src/model
-//! refuses an edit that would move the shape by more than [`SHAPE_TOLERANCE`] of its size.
+//! such an edit is applied, its result is compared with the shape it replaces ([`shape_kept`],
+//! [`shape_change`]) at parameters where the promise must hold ([`span_probes`]: d+1 per span),
+//! and src/model refuses an edit that would move the shape by more than [`SHAPE_TOLERANCE`] of
+//! its size.
+//!
+//! The check runs on every structural edit, so it is kept cheap: a tensor surface refined in
+//! one direction is compared line by line along it (every line of the net, no sum across),
+//! which bounds the comparison of the surfaces; the exact comparison runs only for a result
+//! that bound cannot accept (docs/performance.md, structural edits).
 //!
 //! Positions only: a refined net carries the shape's derivatives as accurately as its spans
 //! allow (docs/scene-format.md), and that is a property of the representation, not a move.
 
-use super::basis::basis_funs;
+use super::basis::basis_funs_into;
 use super::bspline::BSplineCurve;
 use super::erbs::{ErbsCurve, ErbsKnots, ErbsSurface, LocalCurve, LocalPatch};
 use super::knots::KnotVector;
 use super::point::nan_max;
 use super::surface::TensorSurface;
 use glam::{DVec3, DVec4};
+use std::borrow::Cow;
+use std::ops::Range;
 
 /// How far a structural edit may move a shape, as a fraction of its size: far above the rounding
 /// of a stable refinement (about 1e-15 of the size), far below anything visible.
@@ -57,65 +65,154 @@ impl ShapeChange {
     }
 }
 
-/// A shape that structural edits compare: its positions at given parameters, and its control
-/// points (for its size).
+/// A shape that structural edits compare: how far it lies from another shape of its type at
+/// given parameters, and its control points (for its size).
 pub trait Shape {
     /// Where positions are compared: parameters (curves) or a grid of them (surfaces).
     type Probes: ?Sized;
 
-    /// The positions at `at` in a fixed order, a row at a time (a surface: one u at a time),
-    /// so a large surface's grid is never held in memory (fresh pages cost more than the
-    /// arithmetic).
-    fn positions<'a>(&'a self, at: &'a Self::Probes) -> Box<dyn Iterator<Item = Vec<DVec3>> + 'a>;
+    /// The largest distance between this shape's and `other`'s positions at `at`; NaN when a
+    /// position of either is NaN there.
+    fn distance(&self, other: &Self, at: &Self::Probes) -> f64;
+
+    /// At least [`Shape::distance`] (NaN where that is NaN), where a bound is cheaper to compute
+    /// than the distance itself: enough to accept a change far below the tolerance.
+    fn distance_bound(&self, other: &Self, at: &Self::Probes) -> f64 {
+        self.distance(other, at)
+    }
 
     /// Calls `f` on every control net (at any depth, for ERBS locals).
     fn each_control_net(&self, f: &mut dyn FnMut(&[DVec3]));
 }
 
-/// How far `new` lies from `old` at `at`, against the size of `old`'s control net: the one
-/// comparison every structural edit runs before it is applied.
+/// How far `new` lies from `old` at `at`, against the size of `old`'s control net.
 #[must_use]
 pub fn shape_change<S: Shape + ?Sized>(old: &S, new: &S, at: &S::Probes) -> ShapeChange {
-    let moved_squared = old
-        .positions(at)
-        .zip(new.positions(at))
-        .fold(0.0, |m, (a, b)| {
-            let row = a
-                .iter()
-                .zip(&b)
-                .fold(0.0f64, |m, (p, q)| m.max(p.distance_squared(*q)));
-            // f64::max drops a NaN: look for one per row.
-            let nan = a.iter().chain(&b).any(|p| p.is_nan());
-            nan_max(m, if nan { f64::NAN } else { row })
-        });
-    let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-    let mut magnitude = 0.0;
-    old.each_control_net(&mut |net| {
-        for &p in net {
-            lo = lo.min(p);
-            hi = hi.max(p);
+    let (size, magnitude) = net_extent(old);
+    ShapeChange {
+        moved: old.distance(new, at),
+        size,
+        magnitude,
+    }
+}
+
+/// Whether `new` keeps `old`'s shape at `at` ([`ShapeChange::is_kept`]), with the
+/// [`ShapeChange`] when it does not: the check every structural edit runs before it is
+/// applied. A refinement that keeps the shape moves it by rounding, orders of magnitude below
+/// the tolerance, so a bound of the distance ([`Shape::distance_bound`]) against the size of a
+/// few control points (a lower bound of the net's size) decides it; the distance itself and
+/// the whole net are measured only for a change that may be refused.
+pub fn shape_kept<S: Shape + ?Sized>(old: &S, new: &S, at: &S::Probes) -> Result<(), ShapeChange> {
+    if old.distance_bound(new, at) <= SHAPE_TOLERANCE * sampled_size(old) {
+        return Ok(());
+    }
+    let change = shape_change(old, new, at);
+    if change.is_kept() {
+        Ok(())
+    } else {
+        Err(change)
+    }
+}
+
+/// A bounding box grown point by point.
+struct Bounds {
+    lo: DVec3,
+    hi: DVec3,
+}
+
+impl Bounds {
+    fn new() -> Self {
+        Self {
+            lo: DVec3::INFINITY,
+            hi: DVec3::NEG_INFINITY,
         }
+    }
+
+    fn add(&mut self, p: DVec3) {
+        self.lo = self.lo.min(p);
+        self.hi = self.hi.max(p);
+    }
+
+    /// The diagonal; 0 for an empty box.
+    fn diagonal(&self) -> f64 {
+        if self.lo.cmple(self.hi).all() {
+            (self.hi - self.lo).length()
+        } else {
+            0.0
+        }
+    }
+}
+
+/// The size (bounding-box diagonal) of every control net together, and its largest
+/// coordinate (NaN when a net holds a NaN).
+fn net_extent<S: Shape + ?Sized>(s: &S) -> (f64, f64) {
+    let mut bounds = Bounds::new();
+    let mut magnitude = 0.0;
+    s.each_control_net(&mut |net| {
+        net.iter().for_each(|&p| bounds.add(p));
         let nan = net.iter().any(|p| p.is_nan());
         magnitude = nan_max(
             magnitude,
             if nan {
                 f64::NAN
             } else {
-                lo.abs().max(hi.abs()).max_element()
+                bounds.lo.abs().max(bounds.hi.abs()).max_element()
             },
         );
     });
-    let moved = moved_squared.sqrt();
-    let size = if lo.cmple(hi).all() {
-        (hi - lo).length()
-    } else {
-        0.0
-    };
-    ShapeChange {
-        moved,
-        size,
-        magnitude,
+    (bounds.diagonal(), magnitude)
+}
+
+/// How many points of each control net [`sampled_size`] reads (besides the last), at most.
+const SIZE_SAMPLE: usize = 16;
+
+/// The size of every k-th point and the last of each control net: at most the nets' size
+/// (a model's nets are finite), since the bounding box of some of the points lies inside that
+/// of all.
+fn sampled_size<S: Shape + ?Sized>(s: &S) -> f64 {
+    let mut bounds = Bounds::new();
+    s.each_control_net(&mut |net| {
+        let step = (net.len() / SIZE_SAMPLE).max(1);
+        net.iter()
+            .step_by(step)
+            .chain(net.last())
+            .for_each(|&p| bounds.add(p));
+    });
+    bounds.diagonal()
+}
+
+/// The largest distance over pairs of positions. f64::max drops a NaN, so a NaN position is
+/// looked for apart, where a distance came out NaN (a NaN or two infinities).
+#[derive(Default)]
+struct Farthest {
+    squared: f64,
+    nan: bool,
+}
+
+impl Farthest {
+    fn add(&mut self, p: DVec3, q: DVec3) {
+        let d = p.distance_squared(q);
+        if d.is_nan() {
+            self.nan |= p.is_nan() || q.is_nan();
+        } else {
+            self.squared = self.squared.max(d);
+        }
     }
+
+    fn distance(&self) -> f64 {
+        if self.nan {
+            f64::NAN
+        } else {
+            self.squared.sqrt()
+        }
+    }
+}
+
+/// The largest distance between the two positions of each pair.
+fn farthest(pairs: impl Iterator<Item = (DVec3, DVec3)>) -> f64 {
+    let mut far = Farthest::default();
+    pairs.for_each(|(p, q)| far.add(p, q));
+    far.distance()
 }
 
 /// d+1 parameters inside each non-empty span of `knots` within [a, b] (the midpoints of d+1
@@ -207,11 +304,51 @@ pub fn erbs_knot_probes(knots: &ErbsKnots) -> Vec<f64> {
         .collect()
 }
 
+/// A B-spline curve's positions at parameters: BasisFuns once per parameter into one buffer,
+/// then the d+1 points of its span (homogeneous for a rational curve).
+struct CurveProbe<'a> {
+    curve: &'a BSplineCurve,
+    basis: Vec<f64>,
+}
+
+impl<'a> CurveProbe<'a> {
+    fn new(curve: &'a BSplineCurve) -> Self {
+        Self {
+            curve,
+            basis: vec![0.0; curve.degree() + 1],
+        }
+    }
+
+    fn at(&mut self, t: f64) -> DVec3 {
+        let c = self.curve;
+        let (d, n) = (c.degree(), c.points().len());
+        let (a, b) = c.domain();
+        let t = t.clamp(a, b);
+        let span = c.knots().find_span(d, n, t);
+        basis_funs_into(c.knots(), d, span, t, &mut self.basis);
+        let first = span - d;
+        let points = &c.points()[first..=span];
+        match c.weights() {
+            None => points.iter().zip(&self.basis).map(|(&p, &w)| p * w).sum(),
+            Some(ws) => {
+                let h: DVec4 = points
+                    .iter()
+                    .zip(&ws[first..=span])
+                    .zip(&self.basis)
+                    .map(|((&p, &h), &w)| (p * h).extend(h) * w)
+                    .sum();
+                h.truncate() / h.w
+            }
+        }
+    }
+}
+
 impl Shape for BSplineCurve {
     type Probes = [f64];
 
-    fn positions<'a>(&'a self, at: &'a [f64]) -> Box<dyn Iterator<Item = Vec<DVec3>> + 'a> {
-        Box::new(std::iter::once(at.iter().map(|&t| self.eval(t)).collect()))
+    fn distance(&self, other: &Self, at: &[f64]) -> f64 {
+        let (mut a, mut b) = (CurveProbe::new(self), CurveProbe::new(other));
+        farthest(at.iter().map(|&t| (a.at(t), b.at(t))))
     }
 
     fn each_control_net(&self, f: &mut dyn FnMut(&[DVec3])) {
@@ -219,41 +356,85 @@ impl Shape for BSplineCurve {
     }
 }
 
-/// One direction's basis at a parameter: the span and the d+1 non-vanishing functions.
-fn probe_basis(s: &TensorSurface, dir: usize, t: f64) -> (usize, Vec<f64>) {
-    let (d, n, knots) = (s.degree()[dir], s.count()[dir], &s.knots()[dir]);
-    let (a, b) = s.domain()[dir];
-    let t = t.clamp(a, b);
-    let span = knots.find_span(d, n, t);
-    (span, basis_funs(knots, d, span, t))
+/// One direction's B-spline basis at each probe parameter: the first control point of its
+/// span and the d+1 non-vanishing functions (BasisFuns once per parameter, kept flat).
+struct ProbeBasis {
+    first: Vec<usize>,
+    values: Vec<f64>,
+    per: usize,
 }
 
-/// S(u, v) over a grid `us × vs`, row by row of u, by the tensor structure: each row of the
+impl ProbeBasis {
+    fn new(s: &TensorSurface, dir: usize, at: &[f64]) -> Self {
+        let (d, n, knots) = (s.degree()[dir], s.count()[dir], &s.knots()[dir]);
+        let (a, b) = s.domain()[dir];
+        let per = d + 1;
+        let mut values = vec![0.0; at.len() * per];
+        let first = at
+            .iter()
+            .zip(values.chunks_exact_mut(per))
+            .map(|(&t, out)| {
+                let t = t.clamp(a, b);
+                let span = knots.find_span(d, n, t);
+                basis_funs_into(knots, d, span, t, out);
+                span - d
+            })
+            .collect();
+        Self { first, values, per }
+    }
+
+    fn len(&self) -> usize {
+        self.first.len()
+    }
+
+    /// The first control point and the basis functions at the k-th parameter.
+    fn get(&self, k: usize) -> (usize, &[f64]) {
+        (
+            self.first[k],
+            &self.values[k * self.per..(k + 1) * self.per],
+        )
+    }
+
+    /// The control points some parameter reaches (empty without parameters).
+    fn reach(&self) -> Range<usize> {
+        let lo = self.first.iter().copied().min().unwrap_or(0);
+        let hi = self.first.iter().copied().max().map_or(0, |f| f + self.per);
+        lo..hi
+    }
+}
+
+/// Whether two surfaces have one basis in direction `dir` (degree, count and knots).
+fn same_basis(a: &TensorSurface, b: &TensorSurface, dir: usize) -> bool {
+    a.degree()[dir] == b.degree()[dir]
+        && a.count()[dir] == b.count()[dir]
+        && a.knots()[dir] == b.knots()[dir]
+}
+
+/// S(u, v) over a grid `us × vs`, one u at a time, by the tensor structure: each row of the
 /// net is combined for every v once (kept in a ring of d_u + 1 rows, which is all one u
-/// needs), then d_u + 1 such rows for each u (BasisFuns once per parameter, homogeneous form).
-struct GridPositions<'a> {
+/// needs), then d_u + 1 such rows for each u. Sums are homogeneous (x·w, y·w, z·w, w); a
+/// polynomial net's w is the partition of unity and its positions need no division.
+struct GridRows<'a> {
     surface: &'a TensorSurface,
-    us: &'a [f64],
-    bv: Vec<(usize, Vec<f64>)>,
+    bu: &'a ProbeBasis,
+    bv: &'a ProbeBasis,
     /// Row i of the net combined for every v, in slot i mod (d_u + 1).
     ring: Vec<DVec4>,
     ring_rows: Vec<Option<usize>>,
-    /// The current u's homogeneous sums, and the next u.
+    /// The current u's sums.
     acc: Vec<DVec4>,
-    next_u: usize,
 }
 
-impl<'a> GridPositions<'a> {
-    fn new(surface: &'a TensorSurface, [us, vs]: &'a [Vec<f64>; 2]) -> Self {
-        let du = surface.degree()[0];
+impl<'a> GridRows<'a> {
+    fn new(surface: &'a TensorSurface, bu: &'a ProbeBasis, bv: &'a ProbeBasis) -> Self {
+        let slots = surface.degree()[0] + 1;
         Self {
             surface,
-            us,
-            bv: vs.iter().map(|&v| probe_basis(surface, 1, v)).collect(),
-            ring: vec![DVec4::ZERO; (du + 1) * vs.len()],
-            ring_rows: vec![None; du + 1],
-            acc: Vec::with_capacity(vs.len()),
-            next_u: 0,
+            bu,
+            bv,
+            ring: vec![DVec4::ZERO; slots * bv.len()],
+            ring_rows: vec![None; slots],
+            acc: vec![DVec4::ZERO; bv.len()],
         }
     }
 
@@ -263,69 +444,193 @@ impl<'a> GridPositions<'a> {
         if self.ring_rows[slot] == Some(i) {
             return;
         }
-        let s = self.surface;
-        let (dv, nv) = (s.degree()[1], s.count()[1]);
-        let (points, weights) = (s.points(), s.weights());
-        let m = self.bv.len();
-        for (r, (span, n)) in self.ring[slot * m..(slot + 1) * m].iter_mut().zip(&self.bv) {
-            let first = i * nv + span - dv;
-            *r = n
-                .iter()
-                .enumerate()
-                .map(|(l, &w)| {
-                    let k = first + l;
-                    let h = weights.map_or(1.0, |ws| ws[k]);
-                    (points[k] * h).extend(h) * w
-                })
-                .sum();
+        let (s, bv, m) = (self.surface, self.bv, self.acc.len());
+        let start = i * s.count()[1];
+        let ring = &mut self.ring[slot * m..(slot + 1) * m];
+        match s.weights() {
+            None => {
+                for (j, out) in ring.iter_mut().enumerate() {
+                    let (first, n) = bv.get(j);
+                    let net = &s.points()[start + first..];
+                    *out = net.iter().zip(n).map(|(&p, &w)| p.extend(1.0) * w).sum();
+                }
+            }
+            Some(ws) => {
+                for (j, out) in ring.iter_mut().enumerate() {
+                    let (first, n) = bv.get(j);
+                    let k = start + first;
+                    let net = s.points()[k..].iter().zip(&ws[k..]);
+                    *out = net.zip(n).map(|((&p, &h), &w)| (p * h).extend(h) * w).sum();
+                }
+            }
         }
         self.ring_rows[slot] = Some(i);
     }
 
-    /// The positions at the next u, if any is left.
-    fn next_row(&mut self) -> Option<Vec<DVec3>> {
-        let &u = self.us.get(self.next_u)?;
-        self.next_u += 1;
-        let du = self.surface.degree()[0];
-        let (span, n) = probe_basis(self.surface, 0, u);
-        for i in span - du..=span {
+    /// The homogeneous sums at the k-th u.
+    fn row(&mut self, k: usize) -> &[DVec4] {
+        let (first, n) = self.bu.get(k);
+        for i in first..first + n.len() {
             self.combine_row(i);
         }
-        let m = self.bv.len();
-        let mut acc = std::mem::take(&mut self.acc);
-        acc.clear();
-        acc.resize(m, DVec4::ZERO);
-        for (i, &w) in (span - du..=span).zip(&n) {
-            let slot = i % (du + 1);
-            for (a, r) in acc.iter_mut().zip(&self.ring[slot * m..(slot + 1) * m]) {
-                *a += *r * w;
+        let (slots, m) = (self.ring_rows.len(), self.acc.len());
+        self.acc.fill(DVec4::ZERO);
+        for (i, &w) in (first..).zip(n) {
+            let slot = i % slots;
+            let ring = &self.ring[slot * m..(slot + 1) * m];
+            for (a, &r) in self.acc.iter_mut().zip(ring) {
+                *a += r * w;
             }
         }
-        // A polynomial net's w is the partition of unity: its positions need no division.
-        let row = if self.surface.is_rational() {
-            acc.iter().map(|p| p.truncate() / p.w).collect()
-        } else {
-            acc.iter().map(|p| p.truncate()).collect()
-        };
-        self.acc = acc;
-        Some(row)
+        &self.acc
     }
 }
 
-impl Iterator for GridPositions<'_> {
-    type Item = Vec<DVec3>;
-
-    fn next(&mut self) -> Option<Vec<DVec3>> {
-        self.next_row()
+/// The position of homogeneous sums.
+fn project(h: DVec4, rational: bool) -> DVec3 {
+    if rational {
+        h.truncate() / h.w
+    } else {
+        h.truncate()
     }
+}
+
+/// The lines of a net along direction `dir` (the net's columns for u, its rows for v) that
+/// parameters reach, each laid out across the other direction: the net's own rows for u, a
+/// copy of the reached columns for v.
+struct Lines<'a> {
+    points: Cow<'a, [DVec3]>,
+    first: usize,
+    width: usize,
+}
+
+impl<'a> Lines<'a> {
+    fn new(s: &'a TensorSurface, dir: usize, reach: Range<usize>) -> Self {
+        let [nu, nv] = s.count();
+        let points = if dir == 0 {
+            Cow::Borrowed(&s.points()[reach.start * nv..reach.end * nv])
+        } else {
+            let net = s.points();
+            let mut block = Vec::with_capacity(reach.len() * nu);
+            for j in reach.clone() {
+                block.extend(net[j..].iter().step_by(nv).take(nu));
+            }
+            Cow::Owned(block)
+        };
+        Self {
+            points,
+            first: reach.start,
+            width: [nv, nu][dir],
+        }
+    }
+
+    /// The lines the basis at the k-th parameter combines, with their weights times `sign`.
+    fn terms<'s>(&'s self, basis: &ProbeBasis, k: usize, sign: f64, out: &mut Vec<Term<'s>>) {
+        let (first, n) = basis.get(k);
+        out.extend((first..).zip(n).map(|(i, &w)| {
+            let start = (i - self.first) * self.width;
+            (&self.points[start..start + self.width], sign * w)
+        }));
+    }
+}
+
+/// A line of a net and its weight in a combination.
+type Term<'a> = (&'a [DVec3], f64);
+
+/// Points combined per pass of [`add_squares`]: their coordinates fill three vector registers
+/// of eight lanes.
+const CHUNK: usize = 8;
+
+/// Adds the squares of Σ w·line, coordinate by coordinate, to `squares` (one sum per lane).
+/// One pass over the lines, a chunk of points at a time: the sums stay in registers.
+fn add_squares(terms: &[Term<'_>], width: usize, squares: &mut [f64; 3 * CHUNK]) {
+    let mut lanes = *squares;
+    let whole = width - width % CHUNK;
+    for x in (0..whole).step_by(CHUNK) {
+        let mut acc = [0.0; 3 * CHUNK];
+        for &(line, w) in terms {
+            let mut coordinates = [0.0; 3 * CHUNK];
+            for (c, p) in coordinates.chunks_exact_mut(3).zip(&line[x..x + CHUNK]) {
+                c.copy_from_slice(&p.to_array());
+            }
+            for (a, c) in acc
+                .chunks_exact_mut(CHUNK)
+                .zip(coordinates.chunks_exact(CHUNK))
+            {
+                for (a, &c) in a.iter_mut().zip(c) {
+                    *a += c * w;
+                }
+            }
+        }
+        for (s, a) in lanes.iter_mut().zip(acc) {
+            *s += a * a;
+        }
+    }
+    for x in whole..width {
+        let a: DVec3 = terms.iter().map(|&(line, w)| line[x] * w).sum();
+        lanes[0] += a.length_squared();
+    }
+    *squares = lanes;
+}
+
+/// A bound of the grid distance between two polynomial surfaces with one basis across
+/// direction `dir`: the root of the sum of squared distances between their lines along `dir`
+/// at `at` (every line of both nets). Across `dir` a position is a convex combination of the
+/// lines (B-splines are a partition of unity), so it moves by at most the farthest line, at
+/// any parameter across. A NaN or an infinity anywhere gives a NaN.
+fn lines_bound(old: &TensorSurface, new: &TensorSurface, dir: usize, at: &[f64]) -> f64 {
+    let (bo, bn) = (ProbeBasis::new(old, dir, at), ProbeBasis::new(new, dir, at));
+    let (lo, ln) = (
+        Lines::new(old, dir, bo.reach()),
+        Lines::new(new, dir, bn.reach()),
+    );
+    let mut terms = Vec::new();
+    let mut squares = [0.0; 3 * CHUNK];
+    for k in 0..at.len() {
+        terms.clear();
+        ln.terms(&bn, k, 1.0, &mut terms);
+        lo.terms(&bo, k, -1.0, &mut terms);
+        add_squares(&terms, lo.width, &mut squares);
+    }
+    squares.iter().sum::<f64>().sqrt()
 }
 
 impl Shape for TensorSurface {
     /// The grid `us × vs`.
     type Probes = [Vec<f64>; 2];
 
-    fn positions<'a>(&'a self, at: &'a [Vec<f64>; 2]) -> Box<dyn Iterator<Item = Vec<DVec3>> + 'a> {
-        Box::new(GridPositions::new(self, at))
+    fn distance(&self, other: &Self, at: &[Vec<f64>; 2]) -> f64 {
+        let [ou, ov] = [0, 1].map(|dir| ProbeBasis::new(self, dir, &at[dir]));
+        // A direction an edit did not refine has one basis in both: computed once.
+        let [tu, tv] = [0, 1].map(|dir| {
+            (!same_basis(self, other, dir)).then(|| ProbeBasis::new(other, dir, &at[dir]))
+        });
+        let mut a = GridRows::new(self, &ou, &ov);
+        let mut b = GridRows::new(
+            other,
+            tu.as_ref().unwrap_or(&ou),
+            tv.as_ref().unwrap_or(&ov),
+        );
+        let (ra, rb) = (self.is_rational(), other.is_rational());
+        let mut far = Farthest::default();
+        for k in 0..ou.len() {
+            for (&p, &q) in a.row(k).iter().zip(b.row(k)) {
+                far.add(project(p, ra), project(q, rb));
+            }
+        }
+        far.distance()
+    }
+
+    /// Polynomial surfaces refined in at most one direction: their lines along it
+    /// ([`lines_bound`]), without combining across.
+    fn distance_bound(&self, other: &Self, at: &[Vec<f64>; 2]) -> f64 {
+        let refined: Vec<usize> = (0..2).filter(|&d| !same_basis(self, other, d)).collect();
+        match refined[..] {
+            _ if self.is_rational() || other.is_rational() => self.distance(other, at),
+            [] => lines_bound(self, other, 0, &at[0]),
+            [dir] => lines_bound(self, other, dir, &at[dir]),
+            _ => self.distance(other, at),
+        }
     }
 
     fn each_control_net(&self, f: &mut dyn FnMut(&[DVec3])) {
@@ -336,8 +641,8 @@ impl Shape for TensorSurface {
 impl Shape for LocalCurve {
     type Probes = [f64];
 
-    fn positions<'a>(&'a self, at: &'a [f64]) -> Box<dyn Iterator<Item = Vec<DVec3>> + 'a> {
-        Box::new(std::iter::once(at.iter().map(|&t| self.eval(t)).collect()))
+    fn distance(&self, other: &Self, at: &[f64]) -> f64 {
+        farthest(at.iter().map(|&t| (self.eval(t), other.eval(t))))
     }
 
     fn each_control_net(&self, f: &mut dyn FnMut(&[DVec3])) {
@@ -351,8 +656,8 @@ impl Shape for LocalCurve {
 impl Shape for ErbsCurve {
     type Probes = [f64];
 
-    fn positions<'a>(&'a self, at: &'a [f64]) -> Box<dyn Iterator<Item = Vec<DVec3>> + 'a> {
-        Box::new(std::iter::once(at.iter().map(|&t| self.eval(t)).collect()))
+    fn distance(&self, other: &Self, at: &[f64]) -> f64 {
+        farthest(at.iter().map(|&t| (self.eval(t), other.eval(t))))
     }
 
     fn each_control_net(&self, f: &mut dyn FnMut(&[DVec3])) {
@@ -362,22 +667,17 @@ impl Shape for ErbsCurve {
     }
 }
 
-/// `f` over a grid `us × vs`, a row of v for each u.
-fn grid_rows<'a>(
-    [us, vs]: &'a [Vec<f64>; 2],
-    f: impl Fn(f64, f64) -> DVec3 + 'a,
-) -> Box<dyn Iterator<Item = Vec<DVec3>> + 'a> {
-    Box::new(
-        us.iter()
-            .map(move |&u| vs.iter().map(|&v| f(u, v)).collect()),
-    )
+/// Every (u, v) of a grid `us × vs`, u by u.
+fn grid_points([us, vs]: &[Vec<f64>; 2]) -> impl Iterator<Item = (f64, f64)> + '_ {
+    us.iter()
+        .flat_map(move |&u| vs.iter().map(move |&v| (u, v)))
 }
 
 impl Shape for LocalPatch {
     type Probes = [Vec<f64>; 2];
 
-    fn positions<'a>(&'a self, at: &'a [Vec<f64>; 2]) -> Box<dyn Iterator<Item = Vec<DVec3>> + 'a> {
-        grid_rows(at, |u, v| self.eval(u, v))
+    fn distance(&self, other: &Self, at: &[Vec<f64>; 2]) -> f64 {
+        farthest(grid_points(at).map(|(u, v)| (self.eval(u, v), other.eval(u, v))))
     }
 
     fn each_control_net(&self, f: &mut dyn FnMut(&[DVec3])) {
@@ -391,8 +691,8 @@ impl Shape for LocalPatch {
 impl Shape for ErbsSurface {
     type Probes = [Vec<f64>; 2];
 
-    fn positions<'a>(&'a self, at: &'a [Vec<f64>; 2]) -> Box<dyn Iterator<Item = Vec<DVec3>> + 'a> {
-        grid_rows(at, |u, v| self.eval(u, v))
+    fn distance(&self, other: &Self, at: &[Vec<f64>; 2]) -> f64 {
+        farthest(grid_points(at).map(|(u, v)| (self.eval(u, v), other.eval(u, v))))
     }
 
     fn each_control_net(&self, f: &mut dyn FnMut(&[DVec3])) {
@@ -500,6 +800,98 @@ mod tests {
                 moved.translate_point(i, j, DVec3::Z * 1e-6);
                 let change = shape_change(&s, &moved, &at);
                 assert!(!change.is_kept(), "point [{i}, {j}]: {change:?}");
+            }
+        }
+    }
+
+    fn surface(rational: bool) -> TensorSurface {
+        let (nu, nv) = (9, 7);
+        let pts: Vec<DVec3> = (0..nu * nv)
+            .map(|k| {
+                let (i, j) = ((k / nv) as f64, (k % nv) as f64);
+                DVec3::new(i, j, (0.7 * i).sin() * (0.4 * j).cos() + 3.0)
+            })
+            .collect();
+        let w = rational.then(|| (0..nu * nv).map(|k| 1.0 + 0.1 * (k % 5) as f64).collect());
+        let ku = KnotVector::clamped_uniform(3, nu, 0.0, 1.0).into_vec();
+        let kv = vec![0., 0., 0., 0.5, 0.7, 1.5, 1.8, 2., 2., 2.];
+        TensorSurface::bspline([3, 2], [ku, kv], [nu, nv], pts, w).unwrap()
+    }
+
+    /// The probes the model compares a refinement at: d+1 per span where it changed, the
+    /// Greville abscissae across.
+    fn surface_probes(new: &TensorSurface, refined: [bool; 2]) -> [Vec<f64>; 2] {
+        [0, 1].map(|dir| {
+            let (d, knots) = (new.degree()[dir], &new.knots()[dir]);
+            if refined[dir] {
+                span_probes(knots, d, new.domain()[dir])
+            } else {
+                greville(knots, d, new.count()[dir], new.domain()[dir])
+            }
+        })
+    }
+
+    /// The cheap check decides as the exact comparison does, and reports the exact change:
+    /// refinements in u, v and both, polynomial and rational, kept; each of them with one
+    /// point of the result moved by 1e-6, or made NaN, refused.
+    #[test]
+    fn the_cheap_surface_check_decides_as_the_exact_comparison() {
+        for rational in [false, true] {
+            let s = surface(rational);
+            let refinements = [
+                (s.insert_knot(0, 0.37, 2).unwrap(), [true, false]),
+                (s.insert_knot(1, 1.1, 1).unwrap(), [false, true]),
+                (s.elevate_degree(0, 2), [true, false]),
+                (s.elevate_degree(1, 1), [false, true]),
+                (s.elevate_degree(0, 1).elevate_degree(1, 1), [true, true]),
+            ];
+            for (k, (new, refined)) in refinements.into_iter().enumerate() {
+                let at = surface_probes(&new, refined);
+                assert_eq!(shape_kept(&s, &new, &at), Ok(()), "{rational} {k}");
+                assert!(shape_change(&s, &new, &at).is_kept());
+                let [nu, nv] = new.count();
+                for (i, j) in [(0, 0), (nu / 2, nv / 3), (nu - 1, nv - 1)] {
+                    let mut moved = new.clone();
+                    moved.translate_point(i, j, DVec3::new(0.0, 1e-6, 0.0));
+                    let exact = shape_change(&s, &moved, &at);
+                    assert!(!exact.is_kept(), "{rational} {k} [{i}, {j}]");
+                    assert_eq!(shape_kept(&s, &moved, &at), Err(exact));
+                    moved.translate_point(i, j, DVec3::new(f64::NAN, 0.0, 0.0));
+                    let refused = shape_kept(&s, &moved, &at).unwrap_err();
+                    assert!(refused.moved.is_nan(), "{rational} {k} [{i}, {j}]");
+                }
+            }
+        }
+    }
+
+    /// The line bound is at least the distance on the grid, for moves anywhere in the net.
+    #[test]
+    fn the_line_bound_is_at_least_the_grid_distance() {
+        let s = surface(false);
+        for (new, refined) in [
+            (s.insert_knot(0, 0.61, 1).unwrap(), [true, false]),
+            (s.elevate_degree(1, 1), [false, true]),
+        ] {
+            let at = surface_probes(&new, refined);
+            for k in 0..new.points().len() {
+                let mut moved = new.clone();
+                let [_, nv] = new.count();
+                moved.translate_point(k / nv, k % nv, DVec3::new(0.3, -0.2, 0.1) * k as f64);
+                let (bound, distance) = (s.distance_bound(&moved, &at), s.distance(&moved, &at));
+                assert!(distance > 0.0 && bound >= distance * (1.0 - 1e-12), "{k}");
+            }
+        }
+    }
+
+    /// Curve positions at probes agree with the curve's own evaluator.
+    #[test]
+    fn curve_probes_agree_with_evaluation() {
+        for weights in [false, true] {
+            let c = curve(weights);
+            let mut probe = CurveProbe::new(&c);
+            for t in probes(&c) {
+                let (a, b) = (probe.at(t), c.eval(t));
+                assert!(a.distance(b) <= 1e-13 * b.length().max(1.0), "{t}: {a} {b}");
             }
         }
     }

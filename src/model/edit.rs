@@ -81,11 +81,28 @@ pub trait KindEdit: Clone + Debug + PartialEq + Sized + IntoObject {
     /// The model this kind of edit acts on.
     type Model;
 
-    /// Checks the edit against the model it is about to be applied to.
-    fn validate(&self, model: &Self::Model) -> Result<(), EditError>;
+    /// Checks the edit against the model it is about to be applied to, and computes what
+    /// applying it takes: a structural edit hands back the model it leaves (a refinement is
+    /// computed here once, since the shape guard needs it), so applying it computes nothing
+    /// again; an edit applied in place hands back `None`.
+    fn prepare(&self, model: &Self::Model) -> Result<Option<Self::Model>, EditError>;
 
-    /// Applies a validated edit to the model.
+    /// Checks the edit against the model it is about to be applied to.
+    fn validate(&self, model: &Self::Model) -> Result<(), EditError> {
+        self.prepare(model).map(|_| ())
+    }
+
+    /// Applies a validated edit to the model (a structural edit computes its result).
     fn apply(&self, model: &mut Self::Model);
+
+    /// Applies an edit to the model it was prepared against, taking the prepared result where
+    /// [`KindEdit::prepare`] computed one.
+    fn apply_prepared(&self, model: &mut Self::Model, result: Option<Self::Model>) {
+        match result {
+            Some(after) => *model = after,
+            None => self.apply(model),
+        }
+    }
 
     /// The edit that brings `model` (before this edit is applied) back bit for bit.
     #[must_use]

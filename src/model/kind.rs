@@ -125,7 +125,9 @@ pub trait DynKind {
     fn to_bspline_curve(&self) -> Option<Model>;
     /// Applies an edit of this kind to the model (another kind's is an error).
     fn apply(&mut self, edit: &ObjectEdit) -> Result<(), EditError>;
-    fn validate(&self, edit: &ObjectEdit) -> Result<(), EditError>;
+    /// Checks an edit of this kind; a structural edit hands back the model it leaves
+    /// ([`KindEdit::prepare`]).
+    fn prepare(&self, edit: &ObjectEdit) -> Result<Option<Model>, EditError>;
     fn inverse(&self, edit: &ObjectEdit) -> Result<ObjectEdit, EditError>;
     fn controls(&self) -> ControlDisplay;
     fn extent(&self) -> Extent;
@@ -196,10 +198,11 @@ where
         Ok(())
     }
 
-    fn validate(&self, edit: &ObjectEdit) -> Result<(), EditError> {
-        K::Edit::from_object(edit)
+    fn prepare(&self, edit: &ObjectEdit) -> Result<Option<Model>, EditError> {
+        let after = K::Edit::from_object(edit)
             .ok_or_else(|| edit_kind_mismatch(edit, Kind::type_name(self)))?
-            .validate(self)
+            .prepare(self)?;
+        Ok(after.map(Model::from))
     }
 
     fn inverse(&self, edit: &ObjectEdit) -> Result<ObjectEdit, EditError> {
@@ -294,10 +297,13 @@ pub trait DynSampler {
     fn params(&self) -> Vec<&[f64]>;
     fn interval(&self) -> Option<usize>;
     fn set_interval(&mut self, every: Option<usize>);
-    /// Applies an edit of the sampler's kind through the delta path. Edits arrive validated;
-    /// checking again costs a few comparisons and keeps a stale index (say, after an undone
-    /// refinement) from ever reaching the kernels.
-    fn apply(&mut self, edit: &ObjectEdit) -> Result<DirtyRegion, EditError>;
+    /// Applies an edit of the sampler's kind through the delta path. `result` is the model
+    /// the edit leaves where [`ObjectEdit::prepare`] computed it against this sampler's model
+    /// (a structural edit), and is taken as it is. Without one, the edit is prepared here:
+    /// edits arrive validated, and checking again costs a few comparisons and keeps a stale
+    /// index (say, after an undone refinement) from ever reaching the kernels.
+    fn apply(&mut self, edit: &ObjectEdit, result: Option<Model>)
+    -> Result<DirtyRegion, EditError>;
     fn rebuild_touched(&mut self) -> DirtyRegion;
     fn full(&mut self) -> DirtyRegion;
     fn support(&self, target: Target) -> Vec<DirtyRegion>;
@@ -323,7 +329,7 @@ impl<S> DynSampler for Tracked<S>
 where
     S: Sampler + Support,
     S::Edit: KindEdit<Model = S::Model>,
-    S::Model: Kind<Edit = S::Edit>,
+    S::Model: Kind<Edit = S::Edit> + TryFrom<Model, Error = Model>,
     for<'a> ModelRef<'a>: From<&'a S::Model>,
 {
     fn model(&self) -> ModelRef<'_> {
@@ -346,12 +352,22 @@ where
         self.interval = every;
     }
 
-    fn apply(&mut self, edit: &ObjectEdit) -> Result<DirtyRegion, EditError> {
+    fn apply(
+        &mut self,
+        edit: &ObjectEdit,
+        result: Option<Model>,
+    ) -> Result<DirtyRegion, EditError> {
         let model = Sampler::model(self);
         let e = <S::Edit as KindEdit>::from_object(edit)
             .ok_or_else(|| edit_kind_mismatch(edit, Kind::type_name(model)))?;
-        e.validate(model)?;
-        Ok(Sampler::apply(self, e))
+        let after = match result {
+            Some(after) => Some(
+                S::Model::try_from(after)
+                    .map_err(|other| edit_kind_mismatch(edit, other.type_name()))?,
+            ),
+            None => e.prepare(model)?,
+        };
+        Ok(Sampler::apply_prepared(self, e, after))
     }
 
     fn rebuild_touched(&mut self) -> DirtyRegion {

@@ -69,6 +69,18 @@ macro_rules! kinds {
                 }
             }
 
+            impl TryFrom<Model> for $m {
+                /// The model of another kind, handed back.
+                type Error = Model;
+
+                fn try_from(m: Model) -> Result<Self, Model> {
+                    match m {
+                        Model::$v(m) => Ok(m),
+                        other => Err(other),
+                    }
+                }
+            }
+
             impl<'a> From<&'a $m> for ModelRef<'a> {
                 fn from(m: &'a $m) -> Self {
                     ModelRef::$v(m)
@@ -205,12 +217,26 @@ impl Model {
 
     /// Applies a validated edit of this object's kind (a kind mismatch is an error).
     pub fn apply(&mut self, edit: &ObjectEdit) -> Result<(), EditError> {
-        match edit {
-            ObjectEdit::Replace(new) => {
+        self.apply_prepared(edit, None)
+    }
+
+    /// Applies an edit prepared against this model ([`ObjectEdit::prepare`]): the model it
+    /// leaves where the preparation computed one, else the edit itself.
+    pub fn apply_prepared(
+        &mut self,
+        edit: &ObjectEdit,
+        result: Option<Model>,
+    ) -> Result<(), EditError> {
+        match (edit, result) {
+            (_, Some(after)) => {
+                *self = after;
+                Ok(())
+            }
+            (ObjectEdit::Replace(new), None) => {
                 *self = (**new).clone();
                 Ok(())
             }
-            e => self.kind_mut().apply(e),
+            (e, None) => self.kind_mut().apply(e),
         }
     }
 }
@@ -272,7 +298,21 @@ impl ObjectEdit {
     pub fn validate(&self, model: ModelRef<'_>) -> Result<(), EditError> {
         match self {
             ObjectEdit::Replace(new) => check_replacement(new.as_ref().as_ref(), model),
-            e => model.kind().validate(e),
+            e => model.kind().prepare(e).map(|_| ()),
+        }
+    }
+
+    /// Checks the edit against a model (of its own kind) and computes what applying it takes
+    /// ([`KindEdit::prepare`](super::KindEdit::prepare)): the model a structural edit leaves,
+    /// computed once, or `None` for an edit applied in place. The budget reads the result,
+    /// and [`SampledObject::apply_prepared`] or [`Model::apply_prepared`] takes it.
+    pub fn prepare(&self, model: ModelRef<'_>) -> Result<Option<Model>, EditError> {
+        match self {
+            ObjectEdit::Replace(new) => {
+                check_replacement(new.as_ref().as_ref(), model)?;
+                Ok(Some((**new).clone()))
+            }
+            e => model.kind().prepare(e),
         }
     }
 
@@ -360,15 +400,28 @@ impl SampledObject {
     /// periodic rebuild's). An edit of another kind, or one that does not fit the model, is an
     /// error and changes nothing.
     pub fn apply(&mut self, edit: &ObjectEdit) -> Result<DirtyRegion, EditError> {
+        self.apply_prepared(edit, None)
+    }
+
+    /// [`SampledObject::apply`] of an edit prepared against this object's model
+    /// ([`ObjectEdit::prepare`]): `result`, the model a structural edit leaves, is taken as it
+    /// is, not computed or checked again.
+    pub fn apply_prepared(
+        &mut self,
+        edit: &ObjectEdit,
+        result: Option<Model>,
+    ) -> Result<DirtyRegion, EditError> {
         if let ObjectEdit::Replace(model) = edit {
-            edit.validate(self.model())?;
+            if result.is_none() {
+                edit.validate(self.model())?;
+            }
             let interval = self.sampler().interval();
-            *self = SampledObject::new(model, self.mode());
+            *self = SampledObject::new(result.as_ref().unwrap_or(model), self.mode());
             self.set_rebuild_interval(interval);
             let [rows, cols] = self.grid().dims;
             return Ok(DirtyRegion::surface(0..rows, 0..cols));
         }
-        self.sampler_mut().apply(edit)
+        self.sampler_mut().apply(edit, result)
     }
 
     /// Exact re-evaluation of everything touched since the last rebuild (drift reset).

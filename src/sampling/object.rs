@@ -46,7 +46,13 @@ pub trait Sampler {
 
     /// Applies a validated edit through the delta path (the model changes with it) and returns
     /// the samples it rewrote.
-    fn apply(&mut self, edit: &Self::Edit) -> DirtyRegion;
+    fn apply(&mut self, edit: &Self::Edit) -> DirtyRegion {
+        self.apply_prepared(edit, None)
+    }
+
+    /// [`Sampler::apply`], taking `result`, the model the edit leaves, where checking the edit
+    /// computed it (a structural edit's refinement), instead of computing it again.
+    fn apply_prepared(&mut self, edit: &Self::Edit, result: Option<Self::Model>) -> DirtyRegion;
 
     /// Exact re-evaluation of (at least) `region` from the model, bounding the rounding the
     /// delta path accumulates; returns the samples it rewrote.
@@ -116,8 +122,8 @@ impl<S: Sampler> Sampler for Tracked<S> {
         self.sampler.params()
     }
 
-    fn apply(&mut self, edit: &S::Edit) -> DirtyRegion {
-        let region = self.sampler.apply(edit);
+    fn apply_prepared(&mut self, edit: &S::Edit, result: Option<S::Model>) -> DirtyRegion {
+        let region = self.sampler.apply_prepared(edit, result);
         self.touched =
             std::mem::replace(&mut self.touched, DirtyRegion::NOTHING).union(region.clone());
         self.edits_since_rebuild += 1;

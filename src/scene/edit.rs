@@ -72,8 +72,8 @@ pub fn parse_edits(text: &str, scene: &Scene) -> Result<Vec<Edit>, SceneError> {
         let model =
             edited[edit.object].get_or_insert_with(|| scene.objects[edit.object].model.clone());
         edit.edit
-            .validate(model.as_ref())
-            .and_then(|()| model.apply(&edit.edit))
+            .prepare(model.as_ref())
+            .and_then(|result| model.apply_prepared(&edit.edit, result))
             .map_err(|e| at.err(e.field, e.message))?;
         out.push(edit);
     }

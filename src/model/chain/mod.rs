@@ -86,10 +86,8 @@ pub enum CatmullRomEdit {
     Point(PointEdit<usize>),
 }
 
-impl KindEdit for CatmullRomEdit {
-    type Model = CatmullRomModel;
-
-    fn validate(&self, m: &CatmullRomModel) -> Result<(), EditError> {
+impl CatmullRomEdit {
+    fn check(&self, m: &CatmullRomModel) -> Result<(), EditError> {
         let CatmullRomEdit::Point(p) = self;
         let j = p.point();
         check_index("point", j, m.spline.points().len())?;
@@ -110,6 +108,15 @@ impl KindEdit for CatmullRomEdit {
             }
         };
         m.spline.check_move(j, to).map_err(geom_error)
+    }
+}
+
+impl KindEdit for CatmullRomEdit {
+    type Model = CatmullRomModel;
+
+    /// Point edits apply in place: nothing to prepare but the checks.
+    fn prepare(&self, m: &CatmullRomModel) -> Result<Option<CatmullRomModel>, EditError> {
+        self.check(m).map(|()| None)
     }
 
     fn apply(&self, m: &mut CatmullRomModel) {
@@ -218,10 +225,8 @@ impl BezierSplineEdit {
     }
 }
 
-impl KindEdit for BezierSplineEdit {
-    type Model = BezierSplineModel;
-
-    fn validate(&self, m: &BezierSplineModel) -> Result<(), EditError> {
+impl BezierSplineEdit {
+    fn check(&self, m: &BezierSplineModel) -> Result<(), EditError> {
         let s = &m.spline;
         match self {
             BezierSplineEdit::Move { point, delta } => {
@@ -239,6 +244,15 @@ impl KindEdit for BezierSplineEdit {
                 Ok(())
             }
         }
+    }
+}
+
+impl KindEdit for BezierSplineEdit {
+    type Model = BezierSplineModel;
+
+    /// Point edits apply in place: nothing to prepare but the checks.
+    fn prepare(&self, m: &BezierSplineModel) -> Result<Option<BezierSplineModel>, EditError> {
+        self.check(m).map(|()| None)
     }
 
     fn apply(&self, m: &mut BezierSplineModel) {

@@ -41,9 +41,9 @@ impl<E: ChainEdit> Sampler for ChainCurveSampler<E> {
     /// The chain points the edit changes, each as an exact `Set` through the B-spline delta
     /// path: only the samples of the segments around them are touched (a Catmull–Rom point:
     /// at most 4 segments).
-    fn apply(&mut self, edit: &E) -> DirtyRegion {
+    fn apply_prepared(&mut self, edit: &E, result: Option<E::Model>) -> DirtyRegion {
         let touched = edit.chain_points(&self.model);
-        edit.apply(&mut self.model);
+        edit.apply_prepared(&mut self.model, result);
         let mut region = DirtyRegion::NOTHING;
         for point in touched {
             let position = self.model.chain_point(point);

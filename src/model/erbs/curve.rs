@@ -138,6 +138,13 @@ impl ErbsNet for ErbsCurve {
         &mut m.curve
     }
 
+    fn in_model(self, m: &ErbsCurveModel) -> ErbsCurveModel {
+        ErbsCurveModel {
+            curve: self,
+            samples: m.samples,
+        }
+    }
+
     fn local_at(&self, path: &[usize]) -> Option<&LocalCurve> {
         ErbsCurve::local_at(self, path)
     }

@@ -4,6 +4,7 @@
 //! of that level's samples over the edited local's support; each parent blends it in over the
 //! same samples, so the cost at every level is what the edit touches.
 
+use super::edit::apply_keeping_old;
 use crate::geom::erbs::{ErbsCurve, LocalCurve};
 use crate::geom::knots::uniform_params;
 use crate::model::{ErbsCurveEdit, ErbsCurveModel, ErbsEdit, KindEdit, LocalEdit, Target};
@@ -349,25 +350,29 @@ impl Sampler for ErbsCurveSampler {
         vec![&self.level.axis.params]
     }
 
-    fn apply(&mut self, edit: &ErbsCurveEdit) -> DirtyRegion {
+    fn apply_prepared(
+        &mut self,
+        edit: &ErbsCurveEdit,
+        result: Option<ErbsCurveModel>,
+    ) -> DirtyRegion {
         match edit {
             ErbsEdit::Local(e) => {
                 let path = e.local();
                 let blocks = match e {
                     LocalEdit::Transform { matrix, .. } => {
-                        edit.apply(&mut self.model);
+                        edit.apply_prepared(&mut self.model, result);
                         self.level.apply(path.steps(), &LocalOp::Transform(matrix))
                     }
                     // Samples move by the model's exact change of the point.
                     LocalEdit::MovePoint { point, .. } => {
                         let before = self.point(path.steps(), *point);
-                        edit.apply(&mut self.model);
+                        edit.apply_prepared(&mut self.model, result);
                         let d = self.point(path.steps(), *point) - before;
                         self.level
                             .apply(path.steps(), &LocalOp::MovePoint(*point, d))
                     }
                     LocalEdit::SetPoints { .. } => {
-                        edit.apply(&mut self.model);
+                        edit.apply_prepared(&mut self.model, result);
                         self.replace(path.steps())
                     }
                 };
@@ -376,13 +381,12 @@ impl Sampler for ErbsCurveSampler {
             ErbsEdit::InsertKnot {
                 local: None, at, ..
             } => {
-                let old = self.model.curve().clone();
-                let i = old.knots().locate(*at);
-                edit.apply(&mut self.model);
-                if self.model.curve() == &old {
+                let i = self.model.curve().knots().locate(*at);
+                let old = apply_keeping_old(edit, &mut self.model, result);
+                if self.model.curve() == old.curve() {
                     return DirtyRegion::NOTHING;
                 }
-                let inside = self.level.refine(&old, self.model.curve(), i);
+                let inside = self.level.refine(old.curve(), self.model.curve(), i);
                 DirtyRegion::curve(inside)
             }
             ErbsEdit::InsertKnot {
@@ -390,12 +394,12 @@ impl Sampler for ErbsCurveSampler {
             }
             | ErbsEdit::ToErbs { local: path, .. }
             | ErbsEdit::SetLocal { local: path, .. } => {
-                edit.apply(&mut self.model);
+                edit.apply_prepared(&mut self.model, result);
                 let blocks = self.replace(path.steps());
                 self.region(&blocks)
             }
             ErbsEdit::Restore(_) => {
-                edit.apply(&mut self.model);
+                edit.apply_prepared(&mut self.model, result);
                 self.full()
             }
         }

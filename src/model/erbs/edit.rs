@@ -28,6 +28,8 @@ pub trait ErbsNet: Clone + PartialEq + Debug + Sized {
 
     fn of(model: &Self::Model) -> &Self;
     fn of_mut(model: &mut Self::Model) -> &mut Self;
+    /// `model` with this net in place of its own (same sample counts).
+    fn in_model(self, model: &Self::Model) -> Self::Model;
 
     fn local_at(&self, path: &[Self::Index]) -> Option<&Self::Local>;
     /// An error naming the first step of `path` that does not exist.
@@ -210,7 +212,9 @@ pub(super) fn geom(e: GeomError) -> EditError {
 }
 
 impl<N: ErbsNet> ErbsEdit<N> {
-    fn validate_net(&self, net: &N) -> Result<(), EditError> {
+    /// Checks the edit; a structural edit hands back the net it leaves (see
+    /// [`KindEdit::prepare`]).
+    fn prepare_net(&self, net: &N) -> Result<Option<N>, EditError> {
         match self {
             ErbsEdit::Local(e) => {
                 let local = local_of(net, &e.local())?;
@@ -232,6 +236,7 @@ impl<N: ErbsNet> ErbsEdit<N> {
                         points.iter().try_for_each(|&p| check_vector("points", p))
                     }
                 }
+                .map(|()| None)
             }
             ErbsEdit::InsertKnot { local, at, degree } => {
                 if let Some(d) = degree {
@@ -251,7 +256,11 @@ impl<N: ErbsNet> ErbsEdit<N> {
                     "insert_knot",
                     N::NOUN,
                     target.refinement_change(&refined, *at),
-                )
+                )?;
+                Ok(Some(match local {
+                    None => refined,
+                    Some(path) => with_local(net, path, N::wrap(refined)),
+                }))
             }
             ErbsEdit::ToErbs {
                 local,
@@ -269,10 +278,12 @@ impl<N: ErbsNet> ErbsEdit<N> {
                     ));
                 }
                 let built = N::build(l, *count, *degree, net.bfunction()).map_err(geom)?;
-                check_shape_kept("to_erbs", N::LOCAL_NOUN, N::build_change(l, &built))
+                check_shape_kept("to_erbs", N::LOCAL_NOUN, N::build_change(l, &built))?;
+                Ok(Some(with_local(net, local, N::wrap(built))))
             }
-            ErbsEdit::SetLocal { local, .. } => local_of(net, local).map(|_| ()),
-            ErbsEdit::Restore(_) => Ok(()),
+            // Puts one local back in place (cheaper than a copy of the net).
+            ErbsEdit::SetLocal { local, .. } => local_of(net, local).map(|_| None),
+            ErbsEdit::Restore(to) => Ok(Some((**to).clone())),
         }
     }
 
@@ -360,8 +371,9 @@ where
 {
     type Model = N::Model;
 
-    fn validate(&self, m: &N::Model) -> Result<(), EditError> {
-        self.validate_net(N::of(m))
+    fn prepare(&self, m: &N::Model) -> Result<Option<N::Model>, EditError> {
+        let after = self.prepare_net(N::of(m))?;
+        Ok(after.map(|net| net.in_model(m)))
     }
 
     fn apply(&self, m: &mut N::Model) {
@@ -385,6 +397,33 @@ where
             _ => None,
         }
     }
+}
+
+/// Applies `edit` to `model` (taking its prepared `result` where there is one) and hands back
+/// the model as it was, for samplers that follow a refinement from the old net to the new one.
+pub(super) fn apply_keeping_old<N: ErbsNet>(
+    edit: &ErbsEdit<N>,
+    model: &mut N::Model,
+    result: Option<N::Model>,
+) -> N::Model
+where
+    ErbsEdit<N>: KindEdit<Model = N::Model>,
+{
+    match result {
+        Some(after) => std::mem::replace(model, after),
+        None => {
+            let old = model.clone();
+            edit.apply(model);
+            old
+        }
+    }
+}
+
+/// `net` with the local at `path` replaced by `local`.
+fn with_local<N: ErbsNet>(net: &N, path: &LocalPath<N::Index>, local: N::Local) -> N {
+    let mut out = net.clone();
+    out.set_local(path.steps(), local);
+    out
 }
 
 pub(super) fn check_count(field: &'static str, i: usize, n: usize) -> Result<(), EditError> {

@@ -142,6 +142,13 @@ impl ErbsNet for ErbsSurface {
         &mut m.surface
     }
 
+    fn in_model(self, m: &ErbsSurfaceModel) -> ErbsSurfaceModel {
+        ErbsSurfaceModel {
+            surface: self,
+            samples: m.samples,
+        }
+    }
+
     fn local_at(&self, path: &[[usize; 2]]) -> Option<&LocalPatch> {
         ErbsSurface::local_at(self, path)
     }

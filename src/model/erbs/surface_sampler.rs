@@ -6,6 +6,7 @@
 //! that level's samples over the edited patch's support, and each parent blends it in by the
 //! Leibniz rule over the same samples.
 
+use super::edit::apply_keeping_old;
 use crate::geom::erbs::{ErbsKnots, ErbsSurface, LocalPatch};
 use crate::geom::knots::uniform_params;
 use crate::geom::point::binomial;
@@ -1020,10 +1021,14 @@ impl Sampler for ErbsSurfaceSampler {
         vec![&self.level.axes[0].params, &self.level.axes[1].params]
     }
 
-    fn apply(&mut self, edit: &ErbsSurfaceEdit) -> DirtyRegion {
+    fn apply_prepared(
+        &mut self,
+        edit: &ErbsSurfaceEdit,
+        result: Option<ErbsSurfaceModel>,
+    ) -> DirtyRegion {
         let changes = match edit {
             ErbsEdit::Local(e) => {
-                edit.apply(&mut self.model);
+                edit.apply_prepared(&mut self.model, result);
                 let transform = match e {
                     LocalEdit::Transform { matrix, .. } => Some(matrix),
                     _ => None,
@@ -1035,24 +1040,26 @@ impl Sampler for ErbsSurfaceSampler {
                 at: (dir, t),
                 ..
             } => {
-                let old = self.model.surface().clone();
-                let i = old.knots()[*dir].locate(*t);
-                edit.apply(&mut self.model);
-                if self.model.surface() == &old {
+                let i = self.model.surface().knots()[*dir].locate(*t);
+                let old = apply_keeping_old(edit, &mut self.model, result);
+                if self.model.surface() == old.surface() {
                     return DirtyRegion::NOTHING;
                 }
-                vec![self.level.refine(&old, self.model.surface(), *dir, i)]
+                vec![
+                    self.level
+                        .refine(old.surface(), self.model.surface(), *dir, i),
+                ]
             }
             ErbsEdit::InsertKnot {
                 local: Some(path), ..
             }
             | ErbsEdit::ToErbs { local: path, .. }
             | ErbsEdit::SetLocal { local: path, .. } => {
-                edit.apply(&mut self.model);
+                edit.apply_prepared(&mut self.model, result);
                 self.follow(path.steps(), None)
             }
             ErbsEdit::Restore(_) => {
-                edit.apply(&mut self.model);
+                edit.apply_prepared(&mut self.model, result);
                 return self.full();
             }
         };

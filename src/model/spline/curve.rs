@@ -2,7 +2,7 @@
 
 use super::curve_sampler::SplineCurveSampler;
 use crate::format::{At, SceneError};
-use crate::geom::shape::{insertion_window, shape_change, span_probes};
+use crate::geom::shape::{insertion_window, shape_kept, span_probes};
 use crate::geom::{BSplineCurve, GeomError, KnotVector};
 use crate::model::Index2;
 use crate::model::Kind;
@@ -177,21 +177,31 @@ pub enum CurveEdit {
 impl KindEdit for CurveEdit {
     type Model = CurveModel;
 
-    fn validate(&self, m: &CurveModel) -> Result<(), EditError> {
+    fn prepare(&self, m: &CurveModel) -> Result<Option<CurveModel>, EditError> {
         let c = &m.curve;
-        match *self {
-            CurveEdit::Point(p) => p.validate(c),
+        let (curve, form) = match *self {
+            CurveEdit::Point(p) => return p.validate(c).map(|()| None),
             CurveEdit::InsertKnot { t, times } => {
                 check_insertion(c.domain(), c.degree(), c.knots().multiplicity(t), t, times)?;
                 let window = insertion_window(c.knots(), c.degree(), t, c.domain());
-                check_curve_kept("insert_knot", c, c.insert_knot(t, times), window)
+                let refined = kept_curve("insert_knot", c, c.insert_knot(t, times), window)?;
+                (refined, SplineForm::BSpline)
             }
             CurveEdit::ElevateDegree { by } => {
                 check_elevation("elevate_degree", c.degree(), by)?;
-                check_curve_kept("elevate_degree", c, c.elevate_degree(by), c.domain())
+                let elevated = kept_curve("elevate_degree", c, c.elevate_degree(by), c.domain())?;
+                (elevated, m.form)
             }
-            CurveEdit::Restore { ref model, .. } => check_restore(model.samples == m.samples),
-        }
+            CurveEdit::Restore { ref model, .. } => {
+                check_restore(model.samples == m.samples)?;
+                return Ok(Some((**model).clone()));
+            }
+        };
+        Ok(Some(CurveModel {
+            form,
+            curve,
+            samples: m.samples,
+        }))
     }
 
     fn apply(&self, m: &mut CurveModel) {
@@ -240,15 +250,16 @@ impl KindEdit for CurveEdit {
 
 /// A refinement of `old` (an edit's `field`) that keeps its shape: the refined curve agrees
 /// with it at d+1 points per span of the refined knots inside `window`, where it can differ.
-fn check_curve_kept(
+fn kept_curve(
     field: &'static str,
     old: &BSplineCurve,
     refined: Result<BSplineCurve, GeomError>,
     window: (f64, f64),
-) -> Result<(), EditError> {
+) -> Result<BSplineCurve, EditError> {
     let new = refined.map_err(|e| EditError::new(field, e.message))?;
     let at = span_probes(new.knots(), new.degree(), window);
-    check_shape_kept(field, "curve", shape_change(old, &new, &at))
+    shape_kept(old, &new, &at).or_else(|change| check_shape_kept(field, "curve", change))?;
+    Ok(new)
 }
 
 /// Takes a refinement's result. Refining a valid model with validated arguments cannot fail;

@@ -172,17 +172,17 @@ impl Sampler for SplineCurveSampler {
         vec![&self.table.params]
     }
 
-    fn apply(&mut self, edit: &CurveEdit) -> DirtyRegion {
+    fn apply_prepared(&mut self, edit: &CurveEdit, result: Option<CurveModel>) -> DirtyRegion {
         match edit {
             CurveEdit::Point(p) => self.edit_point(edit, p.point()),
             CurveEdit::InsertKnot { .. } | CurveEdit::ElevateDegree { .. } => {
-                edit.apply(&mut self.model);
+                edit.apply_prepared(&mut self.model, result);
                 self.retabulate();
                 DirtyRegion::NOTHING
             }
             CurveEdit::Restore { model, shape_kept } => {
                 let rational = self.curve().is_rational();
-                self.model = (**model).clone();
+                self.model = result.unwrap_or_else(|| (**model).clone());
                 self.retabulate();
                 if *shape_kept && rational == self.curve().is_rational() {
                     DirtyRegion::NOTHING

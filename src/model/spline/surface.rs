@@ -3,7 +3,7 @@
 use super::curve::{check_elevation, check_insertion, check_restore, replace};
 use super::surface_sampler::SplineSurfaceSampler;
 use crate::format::{At, SceneError};
-use crate::geom::shape::{greville, insertion_window, shape_change, span_probes};
+use crate::geom::shape::{greville, insertion_window, shape_kept, span_probes};
 use crate::geom::{KnotVector, TensorSurface};
 use crate::model::Index2;
 use crate::model::Kind;
@@ -199,10 +199,10 @@ pub enum SurfaceEdit {
 impl KindEdit for SurfaceEdit {
     type Model = SurfaceModel;
 
-    fn validate(&self, m: &SurfaceModel) -> Result<(), EditError> {
+    fn prepare(&self, m: &SurfaceModel) -> Result<Option<SurfaceModel>, EditError> {
         let s = &m.surface;
-        match *self {
-            SurfaceEdit::Point(p) => p.validate(s),
+        let (surface, form) = match *self {
+            SurfaceEdit::Point(p) => return p.validate(s).map(|()| None),
             SurfaceEdit::InsertKnot { dir, t, times } => {
                 if dir > 1 {
                     return Err(EditError::new("insert_knot", "the direction is u or v"));
@@ -225,7 +225,8 @@ impl KindEdit for SurfaceEdit {
                     t,
                     s.domain()[dir],
                 ));
-                check_surface_kept("insert_knot", s, &refined, windows)
+                check_surface_kept("insert_knot", s, &refined, windows)?;
+                (refined, SplineForm::BSpline)
             }
             SurfaceEdit::ElevateDegree { by } => {
                 if by == [0, 0] {
@@ -241,10 +242,20 @@ impl KindEdit for SurfaceEdit {
                     }
                 }
                 let windows = [0, 1].map(|dir| (by[dir] > 0).then(|| s.domain()[dir]));
-                check_surface_kept("elevate_degree", s, &elevated(s, by), windows)
+                let elevated = elevated(s, by);
+                check_surface_kept("elevate_degree", s, &elevated, windows)?;
+                (elevated, m.form)
             }
-            SurfaceEdit::Restore { ref model, .. } => check_restore(model.samples == m.samples),
-        }
+            SurfaceEdit::Restore { ref model, .. } => {
+                check_restore(model.samples == m.samples)?;
+                return Ok(Some((**model).clone()));
+            }
+        };
+        Ok(Some(SurfaceModel {
+            form,
+            surface,
+            samples: m.samples,
+        }))
     }
 
     fn apply(&self, m: &mut SurfaceModel) {
@@ -318,7 +329,7 @@ fn check_surface_kept(
             None => greville(knots, d, new.count()[dir], new.domain()[dir]),
         }
     });
-    check_shape_kept(field, "surface", shape_change(old, new, &at))
+    shape_kept(old, new, &at).or_else(|change| check_shape_kept(field, "surface", change))
 }
 
 fn in_direction(mut e: EditError, dir: usize) -> EditError {

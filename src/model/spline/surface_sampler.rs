@@ -290,17 +290,17 @@ impl Sampler for SplineSurfaceSampler {
         vec![&self.tables[0].params, &self.tables[1].params]
     }
 
-    fn apply(&mut self, edit: &SurfaceEdit) -> DirtyRegion {
+    fn apply_prepared(&mut self, edit: &SurfaceEdit, result: Option<SurfaceModel>) -> DirtyRegion {
         match edit {
             SurfaceEdit::Point(p) => self.edit_point(edit, p.point()),
             SurfaceEdit::InsertKnot { .. } | SurfaceEdit::ElevateDegree { .. } => {
-                edit.apply(&mut self.model);
+                edit.apply_prepared(&mut self.model, result);
                 self.retabulate();
                 DirtyRegion::NOTHING
             }
             SurfaceEdit::Restore { model, shape_kept } => {
                 let rational = self.surface().is_rational();
-                self.model = (**model).clone();
+                self.model = result.unwrap_or_else(|| (**model).clone());
                 self.retabulate();
                 if *shape_kept && rational == self.surface().is_rational() {
                     DirtyRegion::NOTHING
