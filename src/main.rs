@@ -177,6 +177,10 @@ enum Command {
         samples: SamplesArgs,
         #[command(flatten)]
         memory: MemoryArgs,
+        /// After writing the image, print the memory budget's estimate of the scene next to
+        /// what it made resident (peak resident size less the program and the Vulkan driver).
+        #[arg(long)]
+        memory_report: bool,
     },
     /// Convert a scene between JSON and Wavefront OBJ (direction from the extensions).
     ///
@@ -394,21 +398,40 @@ fn main() -> ExitCode {
             display,
             samples,
             memory,
-        } => cli::render::load_document(
-            &scene,
-            edits.as_deref(),
-            &samples.counts(),
-            &memory.budget(),
-            display.analysis,
-        )
-        .and_then(|doc| {
-            let mut options = display.options();
-            if let Some((name, t)) = &osculating {
-                options.osculating_at = Some(cli::render::osculating_at(&doc, name, *t)?);
-            }
-            cli::render::run(&doc, &out, size.0, size.1, camera, options, msaa)
-        })
-        .map(|line| eprintln!("{}", escape_controls(&line))),
+            memory_report,
+        } => {
+            let before = cli::resident::Resident::read();
+            cli::render::load_document(
+                &scene,
+                edits.as_deref(),
+                &samples.counts(),
+                &memory.budget(),
+                display.analysis,
+            )
+            .and_then(|(doc, estimate)| {
+                let mut options = display.options();
+                if let Some((name, t)) = &osculating {
+                    options.osculating_at = Some(cli::render::osculating_at(&doc, name, *t)?);
+                }
+                let probe = before
+                    .filter(|_| memory_report)
+                    .map(|before| cli::render::MemoryProbe { estimate, before });
+                let (w, h) = size;
+                let lines = cli::render::run(&doc, &out, w, h, camera, options, msaa, probe);
+                // The process ends with this command: freeing a large scene's allocations
+                // one by one (two per object and more) would only delay the exit.
+                std::mem::forget(doc);
+                lines
+            })
+            .map(|(line, report)| {
+                eprintln!("{}", escape_controls(&line));
+                if let Some(r) = report {
+                    eprintln!("{r}");
+                } else if memory_report {
+                    eprintln!("memory: the resident size is not readable here (/proc/self/status)");
+                }
+            })
+        }
         Command::Convert {
             input,
             output,

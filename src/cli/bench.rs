@@ -115,6 +115,15 @@ pub fn run(args: &BenchArgs) -> Result<String, CliError> {
             .sum();
         info = info.with("scene_samples", samples);
         info = info.with("redraw", args.redraw.name());
+        // How many measured frames a static layer served (a gesture draws in full where a
+        // layer would not pay, docs/performance.md).
+        let retained = frames.iter().filter(|f| !f.warmup && f.retained).count();
+        info = info.with("retained_frames", retained);
+        eprintln!(
+            "redraw {}: {retained} of {} measured frames drawn from the static layer",
+            args.redraw.name(),
+            args.frames
+        );
         let paths = write_all(&dir, &info, &frames).map_err(|e| CliError(e.to_string()))?;
         written.extend(paths);
         if !args.window {
@@ -235,6 +244,7 @@ fn run_headless(
             rec.add_bytes(stats.bytes as u64);
             rec.phase_start(Phase::Record);
             session.record(&mut frame, true).map_err(gpu)?;
+            rec.set_retained(session.hud.retained.is_some());
             if k + 1 == total {
                 // Only the last image is written (final.png); no other frame is read back.
                 frame.capture();

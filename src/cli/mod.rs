@@ -3,6 +3,7 @@
 pub mod bench;
 pub mod files;
 pub mod render;
+pub mod resident;
 pub mod sample;
 pub mod view;
 

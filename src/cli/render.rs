@@ -2,6 +2,7 @@
 
 use super::CliError;
 use super::files::{SampleOverride, load_scene};
+use super::resident::{MemoryReport, Resident};
 use crate::editor::{Document, Editor, EditorOptions, ListRefused};
 use crate::gpu::{Renderer, RendererDesc};
 use crate::render::image_file::{ImageFormat, write_image};
@@ -33,7 +34,7 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     Ok((w, h))
 }
 
-pub use crate::render::{DRAW_USES, validation_mode};
+pub use crate::render::{DRAW_USES, RENDER_USES, validation_mode};
 
 /// Refuses a scene whose pre-evaluation and GPU mirrors would not fit `budget` (one line naming
 /// the object and the estimate).
@@ -53,11 +54,11 @@ pub fn load_document(
     samples: &SampleOverride,
     budget: &MemoryBudget,
     map: Option<SurfaceMap>,
-) -> Result<Document, CliError> {
+) -> Result<(Document, u64), CliError> {
     let scene = load_scene(scene_path, samples)?;
     let options = EditorOptions {
         mode: SampleMode::Render,
-        uses: DRAW_USES,
+        uses: RENDER_USES,
         budget: *budget,
     };
     let mut editor = Editor::new(&scene, options).map_err(|e| CliError::in_file(scene_path, e))?;
@@ -75,7 +76,8 @@ pub fn load_document(
             .set_surface_mode(SampleMode::Analysis)
             .map_err(|e| CliError(format!("--analysis {}: {e}", m.name())))?;
     }
-    Ok(editor.into_document())
+    let estimate = editor.estimated_bytes();
+    Ok((editor.into_document(), estimate))
 }
 
 /// Budgets `scene` for `map` (`--analysis`): a curvature map keeps second partials, K and H
@@ -117,7 +119,17 @@ pub fn osculating_at(doc: &Document, name: &str, t: f64) -> Result<(usize, f64),
     Ok((i, t))
 }
 
-/// Renders `doc` headless and writes `out` (PNG); returns a one-line summary.
+/// What `--memory-report` needs from before the render: the budget's estimate of the
+/// document and the resident size before it was loaded.
+#[derive(Debug, Clone, Copy)]
+pub struct MemoryProbe {
+    pub estimate: u64,
+    pub before: Resident,
+}
+
+/// Renders `doc` headless and writes `out` (PNG); returns a one-line summary, and with
+/// `probe` the `--memory-report` line.
+#[allow(clippy::too_many_arguments)]
 pub fn run(
     doc: &Document,
     out: &Path,
@@ -126,16 +138,19 @@ pub fn run(
     camera: Option<OrbitCamera>,
     options: ViewOptions,
     msaa: u32,
-) -> Result<String, CliError> {
+    probe: Option<MemoryProbe>,
+) -> Result<(String, Option<String>), CliError> {
     let start = Instant::now();
     // An image name that names no format the renderer writes is refused before anything runs.
     ImageFormat::of(out).map_err(CliError)?;
+    let before_driver = Resident::read();
     let mut renderer = Renderer::new(&RendererDesc {
         app_name: "prespline render".into(),
         validation: validation_mode(),
         ..RendererDesc::default()
     })
     .map_err(|e| CliError(e.to_string()))?;
+    let after_driver = Resident::read();
     let shot = Shot {
         width,
         height,
@@ -157,10 +172,21 @@ pub fn run(
         )));
     }
     write_image(&pixels, out).map_err(CliError)?;
-    Ok(format!(
+    let summary = format!(
         "wrote {} ({width}x{height}, {} objects, {device}, {:.0} ms)",
         out.display(),
         doc.objects.len(),
         start.elapsed().as_secs_f64() * 1e3
-    ))
+    );
+    let report = probe.map(|p| match (before_driver, after_driver, Resident::read()) {
+        (Some(a), Some(b), Some(end)) => MemoryReport {
+            estimate: p.estimate,
+            peak: end.peak,
+            program: p.before.now,
+            driver: b.now.saturating_sub(a.now),
+        }
+        .line(),
+        _ => "memory: the resident size is not readable here (/proc/self/status)".into(),
+    });
+    Ok((summary, report))
 }

@@ -51,7 +51,7 @@ pub fn run(args: &SampleArgs) -> Result<String, CliError> {
     let options = EditorOptions {
         mode: SampleMode::Derivatives(args.derivatives),
         uses: Uses {
-            gpu: false,
+            gpu_slots: 0,
             json_text: true,
         },
         budget: args.memory,

@@ -202,17 +202,23 @@ impl Document {
     /// Bounds of every sample and control point.
     #[must_use]
     pub fn bounds(&self) -> Bounds {
-        let mut b = Bounds::EMPTY;
-        for (i, o) in self.objects.iter().enumerate() {
+        // A pass over every sample of the scene: per object on every core, then merged (a
+        // minimum and a maximum, so the order does not matter).
+        let each = crate::parallel::map(&self.objects, |o| {
+            let mut b = Bounds::EMPTY;
             let g = o.sampled.grid();
             for p in g.data.iter().step_by(g.stride()) {
                 b.include(*p);
             }
-            for h in self.handles(i) {
-                b.include(h.1);
+            for (_, p) in o.controls.grips() {
+                b.include(p);
             }
-        }
-        b
+            b
+        });
+        each.into_iter().fold(Bounds::EMPTY, |mut all, b| {
+            all.merge(&b);
+            all
+        })
     }
 
     /// Every pickable control point of object `i` with its position: the points its control

@@ -259,6 +259,15 @@ impl Editor {
         self.applied.extend(report);
     }
 
+    /// The memory budget's estimate of the document as it stands, in bytes (what
+    /// `render --memory-report` sets against the resident size).
+    #[must_use]
+    pub fn estimated_bytes(&self) -> u64 {
+        let unlimited = MemoryBudget::from_flag(Some(u64::MAX));
+        let o = &self.options;
+        check_extents(&self.extents(), o.mode, o.uses, &unlimited).unwrap_or(u64::MAX)
+    }
+
     /// Every object's name and budget extent, read from the models in place.
     fn extents(&self) -> Vec<(&str, Extent)> {
         self.doc

@@ -21,6 +21,12 @@ impl Bounds {
         self.max = self.max.max(p);
     }
 
+    /// Grows to cover `other` too (an empty `other` changes nothing).
+    pub fn merge(&mut self, other: &Bounds) {
+        self.min = self.min.min(other.min);
+        self.max = self.max.max(other.max);
+    }
+
     #[must_use]
     pub fn is_empty(&self) -> bool {
         self.min.x > self.max.x

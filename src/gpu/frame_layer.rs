@@ -12,8 +12,8 @@ use super::barrier::{self, image_barrier};
 use super::error::GpuResult;
 use super::frame::{Frame, FrameTarget};
 use super::layer::{
-    COLOR_ACCESS, DEPTH_ACCESS, DEPTH_STAGES, LayerImages, LayerPart, NEXT_TOKEN, StaticLayer,
-    clamp_rect, rect_copy,
+    COLOR_ACCESS, DEPTH_ACCESS, DEPTH_STAGES, LayerImages, LayerPart, NEXT_TOKEN, Restore,
+    StaticLayer, clamp_rect, rect_copy,
 };
 use super::pipeline::DEPTH_FORMAT;
 
@@ -160,15 +160,19 @@ impl Frame<'_> {
     }
 
     /// Copies `rect` (`None`: all) of `part` of the static layer, saved with `token`, into
-    /// the frame's colour and depth: one `vkCmdCopyImage` each. Before the first draw it
-    /// starts the frame from the layer instead of clearing; later it replaces what was drawn
-    /// in `rect`. Returns `false`, recording nothing, when the part holds another save (or
-    /// none, or the target has no layer).
+    /// the frame's colour, and with [`Restore::ColorAndDepth`] its depth: one
+    /// `vkCmdCopyImage` each. Before the first draw it starts the frame from the layer instead
+    /// of clearing; later it replaces what was drawn in `rect`. Returns `false`, recording
+    /// nothing, when the part holds another save (or none, or the target has no layer).
+    ///
+    /// Depth left out keeps whatever the attachment held, undefined at a frame's start: only
+    /// for pixels no depth-tested draw of the frame reaches.
     pub fn restore_static_layer(
         &mut self,
         part: LayerPart,
         token: u64,
         rect: Option<[u32; 4]>,
+        what: Restore,
     ) -> GpuResult<bool> {
         let (view, cmd) = (self.view, self.cmd);
         let Some(layer) = self.layer(part).filter(|l| l.saved == Some(token)) else {
@@ -221,12 +225,17 @@ impl Frame<'_> {
         ];
         let color_copy = [rect_copy(vk::ImageAspectFlags::COLOR, rect)];
         let depth_copy = [rect_copy(vk::ImageAspectFlags::DEPTH, rect)];
+        let images = match what {
+            Restore::Color => 1,
+            Restore::ColorAndDepth => 2,
+        };
         let raw = &self.ctx.device.raw;
         // SAFETY: recording outside a rendering scope (ended above); the layer part holds a
         // save of this target (same size and formats) in TRANSFER_SRC_OPTIMAL, made visible to
-        // copies by the save's closing barrier; `rect` lies inside both images.
+        // copies by the save's closing barrier; `rect` lies inside both images; the barriers
+        // cover exactly the images copied into.
         unsafe {
-            barrier::record(raw, cmd, &to_dst);
+            barrier::record(raw, cmd, &to_dst[..images]);
             raw.cmd_copy_image(
                 cmd,
                 lc,
@@ -235,15 +244,17 @@ impl Frame<'_> {
                 L::TRANSFER_DST_OPTIMAL,
                 &color_copy,
             );
-            raw.cmd_copy_image(
-                cmd,
-                ld,
-                L::TRANSFER_SRC_OPTIMAL,
-                view.depth.0,
-                L::TRANSFER_DST_OPTIMAL,
-                &depth_copy,
-            );
-            barrier::record(raw, cmd, &back);
+            if what == Restore::ColorAndDepth {
+                raw.cmd_copy_image(
+                    cmd,
+                    ld,
+                    L::TRANSFER_SRC_OPTIMAL,
+                    view.depth.0,
+                    L::TRANSFER_DST_OPTIMAL,
+                    &depth_copy,
+                );
+            }
+            barrier::record(raw, cmd, &back[..images]);
         }
         self.load = true;
         self.bound = Default::default();

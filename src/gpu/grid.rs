@@ -20,6 +20,11 @@ use super::memory::Buffer;
 use super::pod::slice_bytes;
 use super::upload::Uploader;
 
+/// Vertices one entry of a batch's multi-draw covers at most (see [`GridShape::run_cap`]):
+/// large enough that llvmpipe's per-draw cost vanishes against the triangles drawn, small
+/// enough that the repeated index buffers stay a few MiB per shape.
+pub const RUN_VERTICES: u64 = 1 << 16;
+
 /// Shape of a row-major vertex grid.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct GridShape {
@@ -34,6 +39,17 @@ impl GridShape {
     #[must_use]
     pub fn vertices(self) -> u64 {
         u64::from(self.rows) * u64::from(self.cols)
+    }
+
+    /// The most grids of this shape one draw covers as a single index range. A run of
+    /// surfaces stored back to back draws from a cached buffer of repeated copies of the
+    /// grid's indices; uncapped, that buffer grew with the scene (80 bytes of indices and
+    /// staging per sample on 32 × 32 teapots, as much as the vertex mirrors). Capped at about
+    /// [`RUN_VERTICES`] vertices, a longer run becomes several entries of the same multi-draw,
+    /// and the buffer's size no longer depends on the scene.
+    #[must_use]
+    pub fn run_cap(self) -> u32 {
+        u32::try_from((RUN_VERTICES / self.vertices().max(1)).max(1)).unwrap_or(u32::MAX)
     }
 
     pub(crate) fn validate(self) -> GpuResult<()> {

@@ -9,6 +9,7 @@
 //! The mapping may be write-combined (uncached) memory on discrete GPUs, where reads are
 //! extremely slow, so this API offers no way to read it back.
 
+use std::ops::Range;
 use std::ptr::NonNull;
 
 use ash::vk;
@@ -259,6 +260,77 @@ impl MirrorWriter<'_> {
         // unaliased mapped memory (see `write`).
         unsafe { self.ptr.as_ptr().add(start).cast::<[f32; N]>().write(value) };
         self.mark(start, N);
+    }
+}
+
+impl MirrorWriter<'_> {
+    /// Splits the slot into writers of the given element ranges, which must be in increasing
+    /// order, disjoint and inside the slot, so they can be filled on several threads at once
+    /// (a scene's initial upload). The ranges count as written.
+    pub fn split(&mut self, ranges: &[Range<usize>]) -> GpuResult<Vec<RangeWriter<'_>>> {
+        let mut end = 0;
+        for r in ranges {
+            if r.start < end || r.start > r.end || r.end > self.len {
+                return Err(GpuError::InvalidArgument(format!(
+                    "mirror split at {r:?} overlaps an earlier range or exceeds length {}",
+                    self.len
+                )));
+            }
+            end = r.end;
+        }
+        for r in ranges {
+            self.mark(r.start, r.len());
+        }
+        Ok(ranges
+            .iter()
+            .map(|r| RangeWriter {
+                ptr: self.ptr,
+                range: r.clone(),
+                _writer: std::marker::PhantomData,
+            })
+            .collect())
+    }
+}
+
+/// Write-only access to one element range of a mirror slot ([`MirrorWriter::split`]); the
+/// ranges of one split are disjoint, so each may be written on its own thread.
+pub struct RangeWriter<'a> {
+    ptr: NonNull<f32>,
+    range: Range<usize>,
+    /// The split borrows its writer mutably for as long as any range writer lives.
+    _writer: std::marker::PhantomData<&'a mut ()>,
+}
+
+// SAFETY: a range writer only writes its own range of the mapping, disjoint from every other
+// writer's of the same split, and the mutable borrow of the slot's writer keeps anything else
+// from writing the slot meanwhile.
+unsafe impl Send for RangeWriter<'_> {}
+
+impl RangeWriter<'_> {
+    /// The element range this writer may write.
+    #[must_use]
+    pub fn range(&self) -> Range<usize> {
+        self.range.clone()
+    }
+
+    /// Copies `data` to elements `offset..offset + data.len()`, which must lie inside the
+    /// writer's range.
+    pub fn write(&mut self, offset: usize, data: &[f32]) -> GpuResult<()> {
+        let end = offset.checked_add(data.len());
+        if offset < self.range.start || end.is_none_or(|e| e > self.range.end) {
+            return Err(GpuError::InvalidArgument(format!(
+                "mirror write of {} elements at {offset} outside the range {:?}",
+                data.len(),
+                self.range
+            )));
+        }
+        // SAFETY: inside this writer's range (checked above), which lies inside the slot
+        // (checked by `split`), is written by no one else, is not read by the GPU (the slot's
+        // fence has signalled, see the module docs) and has no Rust reference to it.
+        unsafe {
+            std::ptr::copy_nonoverlapping(data.as_ptr(), self.ptr.as_ptr().add(offset), data.len())
+        };
+        Ok(())
     }
 }
 

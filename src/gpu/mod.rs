@@ -102,12 +102,13 @@ pub use device::{Device, DeviceCaps, GPU_ENV};
 pub use error::{GpuError, GpuResult};
 pub use frame::{DrawStats, Frame};
 pub use grid::{
-    GridShape, GridStride, grid_lines, grid_lines_strided, grid_triangles, grid_triangles_strided,
+    GridShape, GridStride, RUN_VERTICES, grid_lines, grid_lines_strided, grid_triangles,
+    grid_triangles_strided,
 };
 pub use instance::{ValidationMode, force_driver_files};
-pub use layer::LayerPart;
+pub use layer::{LayerPart, Restore};
 pub use memory::{Buffer, BufferDesc};
-pub use mirror::{Mirror, MirrorBuffer, MirrorWriter};
+pub use mirror::{Mirror, MirrorBuffer, MirrorWriter, RangeWriter};
 pub use offscreen::{OFFSCREEN_FORMAT, OffscreenDesc, OffscreenTarget, Pixels};
 pub use pipeline::DEPTH_FORMAT;
 pub use region::{PointRun, SurfaceBatch, SurfaceGrid};

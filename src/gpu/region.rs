@@ -44,7 +44,7 @@ pub struct SurfaceBatch<'a> {
 impl SurfaceBatch<'_> {
     /// Checks the batch against a mirror of `mirror_len` floats; returns the byte offset to
     /// bind the vertices at and the batch's runs: (vertex offset from there, number of
-    /// surfaces stored back to back).
+    /// surfaces stored back to back, at most [`GridShape::run_cap`] each).
     pub(crate) fn runs(&self, mirror_len: usize) -> GpuResult<(u64, Vec<(i32, u32)>)> {
         let batch = self;
         batch.shape.validate()?;
@@ -55,6 +55,7 @@ impl SurfaceBatch<'_> {
         }
         .floats();
         let residue = batch.offsets.first().map_or(0, |o| o % per);
+        let cap = batch.shape.run_cap();
         let mut runs: Vec<(i32, u32)> = Vec::with_capacity(batch.offsets.len());
         let mut next = None;
         for &offset in batch.offsets {
@@ -65,8 +66,8 @@ impl SurfaceBatch<'_> {
             match vertex {
                 Some(v) if fits && offset % per == residue => {
                     match runs.last_mut() {
-                        // Right after the previous surface: the same run.
-                        Some(run) if next == Some(offset) => run.1 += 1,
+                        // Right after the previous surface: the same run, up to the cap.
+                        Some(run) if next == Some(offset) && run.1 < cap => run.1 += 1,
                         _ => runs.push((v, 1)),
                     }
                     next = Some(offset + floats);
@@ -154,5 +155,44 @@ impl PointRun {
                  (or has fewer than {min_count} points / stride < 3)"
             )))
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn runs_of_surfaces_stored_back_to_back_stop_at_the_cap() {
+        let shape = GridShape { rows: 17, cols: 17 };
+        let floats = 17 * 17 * SurfaceGrid::FLOATS_PER_VERTEX;
+        let cap = shape.run_cap();
+        assert_eq!(cap, (1 << 16) / 289);
+        // 500 patches back to back, then one after a gap.
+        let mut offsets: Vec<usize> = (0..500).map(|k| k * floats).collect();
+        offsets.push(501 * floats);
+        let batch = SurfaceBatch {
+            shape,
+            stride: GridStride::FULL,
+            offsets: &offsets,
+        };
+        let (base, runs) = batch.runs(502 * floats).unwrap();
+        assert_eq!(base, 0);
+        let c = cap as i32;
+        assert_eq!(
+            runs,
+            vec![
+                (0, cap),
+                (c * 289, cap),
+                (2 * c * 289, 500 - 2 * cap),
+                (501 * 289, 1)
+            ]
+        );
+        // A grid larger than the run length is a run of its own.
+        let big = GridShape {
+            rows: 512,
+            cols: 512,
+        };
+        assert_eq!(big.run_cap(), 1);
     }
 }

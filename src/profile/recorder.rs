@@ -22,6 +22,8 @@ pub struct FrameRecord {
     pub gpu_ms: Option<f64>,
     pub bytes_uploaded: u64,
     pub samples_touched: u64,
+    /// Drawn from a gesture's static layer (`--redraw retained`).
+    pub retained: bool,
 }
 
 impl FrameRecord {
@@ -155,6 +157,13 @@ impl Recorder {
     pub fn add_bytes(&mut self, bytes: u64) {
         if let Some(open) = &mut self.open {
             open.record.bytes_uploaded += bytes;
+        }
+    }
+
+    /// Marks the open frame as drawn from a static layer.
+    pub fn set_retained(&mut self, retained: bool) {
+        if let Some(open) = &mut self.open {
+            open.record.retained = retained;
         }
     }
 

@@ -9,16 +9,16 @@ use super::retained::{
     Gesture, LayerKey, Redraw, SplitCells, covers, moving_vertices, overlaps, sample_bounds,
     screen_rect, screen_rect_with, split_cells, touched_vertices, union_rect, vertex_bounds,
 };
-use super::style::{NetMode, Palette, ViewOptions, Wire};
+use super::style::{Highlight, NetMode, Palette, ViewOptions, Wire};
 use crate::editor::{
     Applied, ControlLayout, ControlsChange, Document, Handle, LOCAL_CURVE_SAMPLES,
     LOCAL_PATCH_SAMPLES, LocalEntry,
 };
 use crate::gpu::{
     FRAMES_IN_FLIGHT, Frame, GpuError, GpuResult, GridShape, GridStride, LayerPart, MapStyle,
-    Mirror, PointRun, PointStyle, PolylineStyle, Renderer, SurfaceBatch, SurfaceStyle,
+    Mirror, PointRun, PointStyle, PolylineStyle, Renderer, Restore, SurfaceBatch, SurfaceStyle,
 };
-use crate::model::{Index2, LocalPath};
+use crate::model::Index2;
 use crate::sampling::{DirtyRegion, DirtySet};
 use glam::DVec3;
 use std::collections::BTreeMap;
@@ -91,28 +91,6 @@ pub struct DrawReport {
     pub retained_of: u64,
 }
 
-/// Which handle the cursor is over and which one is selected (for highlighting).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct Highlight {
-    pub hovered: Option<Handle>,
-    pub selected: Option<Handle>,
-    /// A selected ERBS local curve/patch (drawn emphasised).
-    pub selected_local: Option<(usize, LocalPath<Index2>)>,
-    /// The object under the cursor (its controls show in [`NetMode::Focused`]).
-    pub hovered_object: Option<usize>,
-}
-
-impl Highlight {
-    /// Whether object `i` is selected or under the cursor.
-    #[must_use]
-    pub fn focuses(&self, i: usize) -> bool {
-        self.hovered.is_some_and(|h| h.object() == i)
-            || self.selected.is_some_and(|h| h.object() == i)
-            || self.selected_local.is_some_and(|(o, _)| o == i)
-            || self.hovered_object == Some(i)
-    }
-}
-
 /// The document's GPU side. Samples of all objects live in a few large *arena* mirrors
 /// (surfaces first, in document order, then curves), so a group of same-shaped surfaces is
 /// drawn with one multi-draw per level of detail; control structures have a mirror per object.
@@ -127,12 +105,19 @@ pub struct GpuScene {
     /// The curvature map's scalars, built by the first upload after the map changed.
     scalars: Option<MapScalars>,
     scratch: Vec<f32>,
+    /// Per arena, the frame slots not yet written since the arena was created.
+    unfilled: Vec<[bool; FRAMES_IN_FLIGHT]>,
     /// `--redraw`: whether gestures draw from a static layer.
     redraw: Redraw,
     /// The gesture in progress ([`GpuScene::set_gesture`]).
     gesture: Option<Gesture>,
     /// The static layer of the gesture, once built.
     layer: Option<Layer>,
+    /// The last gesture whose dynamic set was too much of the frame for a static layer to
+    /// pay (see [`worth_a_layer`]): its frames draw in full without trying again.
+    unworthy: Option<LayerKey>,
+    /// Test hook: build a layer for every gesture ([`GpuScene::set_layer_always`]).
+    layer_always: bool,
     /// Test hook: the dynamic set misses one chunk (a negative control).
     drop_chunk: bool,
     /// Test hook: the lines through moved control points are left out of the redrawn
@@ -172,7 +157,8 @@ struct Layer {
 const ZEBRA_STRIPES: f32 = 16.0;
 
 impl GpuScene {
-    /// Creates and fills every mirror (all slots).
+    /// Creates every mirror; the sample arenas are written by the first upload into each
+    /// frame slot, the control mirrors now.
     pub fn new(renderer: &mut Renderer, doc: &Document) -> GpuResult<Self> {
         let (places, sizes) = arena_layout(doc);
         let mut scene = Self {
@@ -183,9 +169,12 @@ impl GpuScene {
             map: None,
             scalars: None,
             scratch: Vec::new(),
+            unfilled: Vec::with_capacity(sizes.len()),
             redraw: Redraw::default(),
             gesture: None,
             layer: None,
+            unworthy: None,
+            layer_always: false,
             drop_chunk: false,
             drop_lines: false,
             moved_controls: DirtySet::default(),
@@ -207,21 +196,12 @@ impl GpuScene {
         places: &[Place],
         sizes: &[usize],
     ) -> GpuResult<()> {
+        // Arenas are written by the first upload into each slot (`unfilled`), so a slot that
+        // is never drawn (`render` draws one frame) is never touched, nor its pages resident.
         for (a, &len) in sizes.iter().enumerate() {
-            let mut data = vec![0.0f32; len.max(3)];
-            for (i, p) in places.iter().enumerate().filter(|(_, p)| p.arena == a) {
-                sample_floats(
-                    doc,
-                    i,
-                    0..doc.objects[i].sampled.grid().dims[0],
-                    &mut self.scratch,
-                );
-                data[p.offset..p.offset + self.scratch.len()].copy_from_slice(&self.scratch);
-            }
-            let mut mirror = renderer.create_mirror(&format!("samples {a}"), data.len())?;
-            let filled = renderer.fill_mirror(&mut mirror, 0, &data);
-            self.arenas.push(mirror);
-            filled?;
+            self.arenas
+                .push(renderer.create_mirror(&format!("samples {a}"), len.max(3))?);
+            self.unfilled.push([true; FRAMES_IN_FLIGHT]);
         }
         for (i, o) in doc.objects.iter().enumerate() {
             let data = vertex_floats(&o.controls.vertices);
@@ -352,6 +332,7 @@ impl GpuScene {
         let slot = frame.slot();
         let mut stats = UploadStats::default();
         stats.bytes += self.sync_scalars(frame, doc)?;
+        stats.bytes += self.fill_arenas(frame, doc)?;
         for (i, o) in self.objects.iter_mut().enumerate() {
             let ranges = o.dirty[slot].take();
             if !ranges.is_empty() {
@@ -407,6 +388,55 @@ impl GpuScene {
         Ok(stats)
     }
 
+    /// Writes every object's samples into this frame's slot of each arena not yet written
+    /// there (objects lie back to back, so that fills the arena), on every core: runs of
+    /// consecutive objects each go to a disjoint range of the slot. Returns the bytes written.
+    fn fill_arenas(&mut self, frame: &mut Frame<'_>, doc: &Document) -> GpuResult<usize> {
+        let slot = frame.slot();
+        let mut bytes = 0;
+        for (a, unfilled) in self.unfilled.iter_mut().enumerate() {
+            if !std::mem::take(&mut unfilled[slot]) {
+                continue;
+            }
+            // (object, float offset, floats) of the arena's objects, in order of offset.
+            let mut members: Vec<(usize, usize, usize)> = (0..self.objects.len())
+                .filter(|&i| self.objects[i].samples.arena == a)
+                .map(|i| {
+                    let [rows, cols] = doc.objects[i].sampled.grid().dims;
+                    let floats = rows * cols * floats_per_sample(doc, i);
+                    (i, self.objects[i].samples.offset, floats)
+                })
+                .collect();
+            members.sort_by_key(|m| m.1);
+            let runs = fill_runs(&members, crate::parallel::threads());
+            let ranges: Vec<std::ops::Range<usize>> = runs
+                .iter()
+                .map(|r| {
+                    let (first, last) = (members[r.start], members[r.end - 1]);
+                    first.1..last.1 + last.2
+                })
+                .collect();
+            bytes += ranges.iter().map(|r| r.len() * 4).sum::<usize>();
+            let mut w = frame.write_mirror(&mut self.arenas[a]);
+            let mut jobs: Vec<_> = w
+                .split(&ranges)?
+                .into_iter()
+                .zip(&runs)
+                .map(|(writer, run)| (writer, &members[run.clone()], Ok(())))
+                .collect();
+            crate::parallel::for_each_mut(&mut jobs, |(writer, run, result)| {
+                let mut scratch = Vec::new();
+                *result = run.iter().try_for_each(|&(i, offset, _)| {
+                    let rows = doc.objects[i].sampled.grid().dims[0];
+                    sample_floats(doc, i, 0..rows, &mut scratch);
+                    writer.write(offset, &scratch)
+                });
+            });
+            jobs.into_iter().try_for_each(|(_, _, result)| result)?;
+        }
+        Ok(bytes)
+    }
+
     /// How gestures redraw (`--redraw`); `Full` drops any static layer.
     pub fn set_redraw(&mut self, redraw: Redraw) {
         self.redraw = redraw;
@@ -442,6 +472,14 @@ impl GpuScene {
     pub fn set_drop_chunk(&mut self, drop: bool) {
         self.drop_chunk = drop;
         self.layer = None;
+    }
+
+    /// Test hook: every gesture builds a static layer, whether it pays or not (see
+    /// [`worth_a_layer`]), so exactness tests reach the retained path on small scenes.
+    #[doc(hidden)]
+    pub fn set_layer_always(&mut self, always: bool) {
+        self.layer_always = always;
+        self.unworthy = None;
     }
 
     /// Test hook, a negative control: retained frames leave the lines through moved control
@@ -537,6 +575,9 @@ impl GpuScene {
 
     /// The surfaces in draw order: per group, per stride (ascending), the members sharing it.
     fn surface_order(&mut self, doc: &Document, opts: &ViewOptions, lod: &Lod) -> Vec<Batch> {
+        if opts.lod {
+            self.measure_grids(doc);
+        }
         let mut order = Vec::new();
         for (g, group) in self.groups.iter().enumerate() {
             let mut by_stride: BTreeMap<(u32, u32), Vec<usize>> = BTreeMap::new();
@@ -563,6 +604,22 @@ impl GpuScene {
             }
         }
         order
+    }
+
+    /// Measures every surface not measured since its samples last changed, on every core:
+    /// after a load that is one pass over all the samples of the scene.
+    fn measure_grids(&mut self, doc: &Document) {
+        let stale: Vec<usize> = self
+            .groups
+            .iter()
+            .flat_map(|g| g.members.iter().copied())
+            .filter(|&i| self.objects[i].metrics.is_none())
+            .collect();
+        let measured =
+            crate::parallel::map(&stale, |&i| GridMetrics::new(doc.objects[i].sampled.grid()));
+        for (i, m) in stale.into_iter().zip(measured) {
+            self.objects[i].metrics = Some(m);
+        }
     }
 
     /// The surfaces `members` of batch `b` (shaded or mapped, then their isolines).
@@ -679,13 +736,31 @@ impl GpuScene {
             .as_ref()
             .is_some_and(|l| !l.stale && l.key == key);
         let restored = match &self.layer {
-            Some(l) if valid => frame.restore_static_layer(LayerPart::Lines, l.lines, None)?,
+            // Depth only inside the redrawn rectangle (restored with the surfaces' save
+            // there): every depth-tested draw of a retained frame stays inside it.
+            Some(l) if valid => {
+                frame.restore_static_layer(LayerPart::Lines, l.lines, None, Restore::Color)?
+            }
             _ => false,
         };
         if !restored {
             self.layer = None;
+            if self.unworthy.as_ref() == Some(&key) {
+                return Ok(false);
+            }
+            let support = doc.objects[g.object].sampled.support(g.target);
+            let cells = place.map(|(bi, _)| {
+                let shape = self.groups[order[bi].group].shape;
+                split_cells(shape, order[bi].stride, &support, self.drop_chunk)
+            });
+            let [w, h] = key.extent.map(u64::from);
+            if !self.layer_always && !worth_a_layer(cells.as_ref(), order, &self.groups, w * h) {
+                self.unworthy = Some(key);
+                return Ok(false);
+            }
+            self.unworthy = None;
             frame.keep_depth();
-            self.build_layer(frame, doc, opts, hl, order, place, key)?;
+            self.build_layer(frame, doc, opts, hl, order, place, key, (support, cells))?;
             if self.layer.is_none() {
                 return Ok(true);
             }
@@ -706,13 +781,9 @@ impl GpuScene {
         order: &[Batch],
         place: Option<(usize, usize)>,
         key: LayerKey,
+        (support, cells): (Vec<DirtyRegion>, Option<SplitCells>),
     ) -> GpuResult<()> {
         let g = key.gesture;
-        let support = doc.objects[g.object].sampled.support(g.target);
-        let cells = place.map(|(bi, _)| {
-            let shape = self.groups[order[bi].group].shape;
-            split_cells(shape, order[bi].stride, &support, self.drop_chunk)
-        });
         for (bi, b) in order.iter().enumerate() {
             match (place, &cells) {
                 (Some((pb, m)), Some(c)) if pb == bi => {
@@ -831,7 +902,8 @@ impl GpuScene {
         if r[2] == 0 || r[3] == 0 {
             return Ok(());
         }
-        if !frame.restore_static_layer(LayerPart::Surfaces, layer.surfaces, Some(r))? {
+        let what = Restore::ColorAndDepth;
+        if !frame.restore_static_layer(LayerPart::Surfaces, layer.surfaces, Some(r), what)? {
             return Err(GpuError::InvalidArgument(
                 "static layer lost within a frame".into(),
             ));
@@ -1292,6 +1364,54 @@ fn arena_layout(doc: &Document) -> (Vec<Place>, Vec<usize>) {
     (places, sizes)
 }
 
+/// Whether a static layer pays for a gesture whose dragged surface splits into `cells`
+/// (`None`: the gesture moves a curve, and every surface stays in the layer) on a target of
+/// `pixels`. Restoring the layer copies every pixel each frame (about 0.7 ms at 1280 × 720 on
+/// lavapipe, as much as drawing a few thousand surface triangles: docs/performance.md), so
+/// what stays in it must be a surface triangle per [`PIXELS_PER_KEPT_TRIANGLE`] pixels at
+/// least, and a quarter of the frame's triangles. Otherwise the frame is drawn in full: a
+/// scene of curves only, or an ERBS local patch whose support is the whole surface.
+fn worth_a_layer(
+    cells: Option<&SplitCells>,
+    order: &[Batch],
+    groups: &[SurfaceGroup],
+    pixels: u64,
+) -> bool {
+    let dynamic: u64 = cells.map_or(0, |c| {
+        c.dynamic.iter().map(|&(_, n)| u64::from(n) / 3).sum()
+    });
+    let all: u64 = order
+        .iter()
+        .map(|b| 2 * b.stride.cells(groups[b.group].shape) * b.members.len() as u64)
+        .sum();
+    let kept = all.saturating_sub(dynamic);
+    kept * PIXELS_PER_KEPT_TRIANGLE >= pixels && 4 * dynamic < 3 * all
+}
+
+/// A static layer must keep a surface triangle per this many pixels of its target to pay for
+/// its copy (see [`worth_a_layer`]): 3,600 triangles at 1280 × 720.
+const PIXELS_PER_KEPT_TRIANGLE: u64 = 256;
+
+/// Runs of consecutive `members` (object, offset, floats) for a parallel fill: about four
+/// per thread of similar float counts, so a thread that finishes early takes another.
+fn fill_runs(members: &[(usize, usize, usize)], threads: usize) -> Vec<std::ops::Range<usize>> {
+    let total: usize = members.iter().map(|m| m.2).sum();
+    let per = total.div_ceil((threads.max(1) * 4).max(1)).max(1);
+    let mut runs = Vec::new();
+    let (mut start, mut floats) = (0, 0);
+    for (k, m) in members.iter().enumerate() {
+        floats += m.2;
+        if floats >= per {
+            runs.push(start..k + 1);
+            (start, floats) = (k + 1, 0);
+        }
+    }
+    if start < members.len() {
+        runs.push(start..members.len());
+    }
+    runs
+}
+
 /// Surfaces grouped by arena, grid shape and colour (in order of first appearance).
 fn surface_groups(doc: &Document, places: &[Place]) -> Vec<SurfaceGroup> {
     let mut groups: Vec<SurfaceGroup> = Vec::new();
@@ -1389,4 +1509,24 @@ fn vertex_floats(vertices: &[DVec3]) -> Vec<f32> {
         .iter()
         .flat_map(|p| [p.x as f32, p.y as f32, p.z as f32])
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fill_runs;
+
+    #[test]
+    fn fill_runs_cover_the_members_in_order() {
+        let members: Vec<(usize, usize, usize)> = (0..10).map(|i| (i, i * 100, 100)).collect();
+        for threads in [1, 2, 3, 16] {
+            let runs = fill_runs(&members, threads);
+            assert_eq!(runs.first().map(|r| r.start), Some(0));
+            assert_eq!(runs.last().map(|r| r.end), Some(10));
+            assert!(runs.windows(2).all(|w| w[0].end == w[1].start));
+            assert!(runs.iter().all(|r| !r.is_empty()));
+        }
+        // One thread: four runs of similar size.
+        assert_eq!(fill_runs(&members, 1).len(), 4);
+        assert!(fill_runs(&[], 2).is_empty());
+    }
 }

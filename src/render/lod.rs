@@ -124,21 +124,30 @@ impl GridMetrics {
 }
 
 /// Largest spacing and, per stride, largest chord deviation along one line of samples.
+///
+/// Maxima are taken over squared distances and rooted once: the square root is monotone and
+/// correctly rounded, so the result is bit for bit the maximum of the distances, without a
+/// root per sample (this runs over every sample of every small patch when a scene loads).
 fn measure_line(points: &[DVec3], spacing: &mut f64, deviation: &mut [f64; STRIDES]) {
     let n = points.len();
-    for w in points.windows(2) {
-        *spacing = spacing.max(w[0].distance(w[1]));
-    }
+    let widest = points
+        .windows(2)
+        .fold(0.0f64, |m, w| m.max(w[0].distance_squared(w[1])));
+    *spacing = spacing.max(widest.sqrt());
     for (k, dev) in deviation.iter_mut().enumerate() {
         let s = 2usize << k;
-        let drawn = strided(n, s);
-        for w in drawn.windows(2) {
-            let (a, b) = (w[0], w[1]);
+        let mut farthest = 0.0f64;
+        // The chords of a stride-`s` mesh: between drawn samples 0, s, 2s, … and n − 1.
+        let mut a = 0;
+        while a + 1 < n {
+            let b = (a + s).min(n - 1);
             for (m, q) in points.iter().enumerate().take(b).skip(a + 1) {
                 let t = (m - a) as f64 / (b - a) as f64;
-                *dev = dev.max(q.distance(points[a].lerp(points[b], t)));
+                farthest = farthest.max(q.distance_squared(points[a].lerp(points[b], t)));
             }
+            a = b;
         }
+        *dev = dev.max(farthest.sqrt());
     }
 }
 

@@ -16,20 +16,27 @@ pub mod retained;
 pub mod style;
 
 pub use camera::{Bounds, OrbitCamera};
-pub use gpu_scene::{DrawReport, GpuScene, Highlight, UploadStats};
+pub use gpu_scene::{DrawReport, GpuScene, UploadStats};
 pub use lod::Lod;
 pub use map_mirror::MapView;
 pub use retained::{Gesture, Redraw};
-pub use style::{NetMode, Palette, ViewOptions, Wire};
+pub use style::{Highlight, NetMode, Palette, ViewOptions, Wire};
 
 use crate::gpu::ValidationMode;
 use crate::sampling::budget::Uses;
 
-/// What drawing (`render`, `view`, `bench`) keeps per object besides the samples: GPU mirrors
-/// and index buffers.
+/// What interactive drawing (`view`, `bench`) keeps per object besides the samples: GPU
+/// mirrors in every frame slot, index buffers.
 pub const DRAW_USES: Uses = Uses {
-    gpu: true,
+    gpu_slots: crate::gpu::FRAMES_IN_FLIGHT as u8,
     json_text: false,
+};
+
+/// What `render` keeps per object besides the samples: it draws one frame, so one slot of
+/// the GPU mirrors is ever written.
+pub const RENDER_USES: Uses = Uses {
+    gpu_slots: 1,
+    ..DRAW_USES
 };
 
 /// Validation layer policy for interactive commands: on in debug builds or with
@@ -44,5 +51,17 @@ pub fn validation_mode() -> ValidationMode {
         Some("0") => ValidationMode::Off,
         _ if cfg!(debug_assertions) => ValidationMode::IfAvailable,
         _ => ValidationMode::Off,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn the_budget_counts_the_run_length_the_renderer_draws() {
+        // `sampling` does not depend on `gpu`, so the constant is written twice.
+        assert_eq!(
+            crate::sampling::budget::RUN_VERTICES,
+            crate::gpu::RUN_VERTICES
+        );
     }
 }

@@ -2,13 +2,14 @@
 
 use super::analysis::{CurveEval, Osculating, badge_overlay, osculating_lines, osculating_overlay};
 use super::camera::OrbitCamera;
-use super::gpu_scene::{GpuScene, Highlight};
+use super::gpu_scene::GpuScene;
 use super::lod::Lod;
 use super::map_mirror::MapView;
 use super::maps::{
     LEGEND_STEP, LegendPlace, MapRange, MapScale, legend, map_scales, surface_families,
 };
 use super::overlays::overlay_lines;
+use super::style::Highlight;
 use super::style::{Palette, ViewOptions};
 use crate::editor::Document;
 use crate::gpu::{GpuResult, OffscreenDesc, Pixels, Renderer};

@@ -98,7 +98,7 @@ pub(crate) struct LayerKey {
     pub gesture: Gesture,
     /// Hovered and selected handles and locals: they colour and size points and nets drawn
     /// in the layer.
-    pub highlight: super::gpu_scene::Highlight,
+    pub highlight: super::style::Highlight,
     /// The stride the dragged surface is drawn at (frozen for the gesture).
     pub stride: Option<GridStride>,
 }

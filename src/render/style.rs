@@ -1,5 +1,8 @@
 //! What is shown and in which colours.
 
+use crate::editor::Handle;
+use crate::model::{Index2, LocalPath};
+
 /// Surface wireframe overlay.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Wire {
@@ -148,5 +151,27 @@ impl Palette {
             0.9 * (0.6 * c[2] + 0.4 * warm[2]),
             1.0,
         ]
+    }
+}
+
+/// Which handle the cursor is over and which one is selected (for highlighting).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Highlight {
+    pub hovered: Option<Handle>,
+    pub selected: Option<Handle>,
+    /// A selected ERBS local curve/patch (drawn emphasised).
+    pub selected_local: Option<(usize, LocalPath<Index2>)>,
+    /// The object under the cursor (its controls show in [`NetMode::Focused`]).
+    pub hovered_object: Option<usize>,
+}
+
+impl Highlight {
+    /// Whether object `i` is selected or under the cursor.
+    #[must_use]
+    pub fn focuses(&self, i: usize) -> bool {
+        self.hovered.is_some_and(|h| h.object() == i)
+            || self.selected.is_some_and(|h| h.object() == i)
+            || self.selected_local.is_some_and(|(o, _)| o == i)
+            || self.hovered_object == Some(i)
     }
 }

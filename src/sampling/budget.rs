@@ -5,7 +5,7 @@
 //!
 //! [`estimate`] is a pure function of an object's [`Extent`] (degrees, sample counts, rational
 //! or not, ERBS local counts), the [`SampleMode`] and what the command does with the samples
-//! ([`Uses`]). [`check_scene`] applies it to every object of a scene against a
+//! ([`Uses`]). [`check_extents`] applies it to every object of a scene against a
 //! [`MemoryBudget`] (by default half of physical memory; `--memory-limit` overrides).
 
 use super::object::SampleMode;
@@ -20,8 +20,19 @@ const F32: u128 = 4;
 /// A span index.
 const USIZE: u128 = std::mem::size_of::<usize>() as u128;
 /// Frames in flight, each with its own mirror (see `gpu::FRAMES_IN_FLIGHT`; `sampling` does not
-/// depend on `gpu`).
-const MIRROR_SLOTS: u128 = 2;
+/// depend on `gpu`): control mirrors are written in every one.
+const GPU_SLOTS_ALWAYS: u128 = 2;
+/// Per object and frame slot, its control structure's mirror: the Vulkan buffer, its
+/// allocation's bookkeeping and contents (lavapipe, measured on 32 × 32 teapots: 4 KiB an
+/// object over two slots).
+const CONTROL_MIRROR: u128 = 2048;
+/// Per object besides its samples and tables: the model, the sampler's structure, the control
+/// display and the name. Measured on bicubic Bézier patches: 2.5 KiB requested, 4 KiB resident
+/// with the allocator's headers. Small beside any object's samples, it is what a scene of many
+/// small objects adds up.
+const OBJECT_BYTES: u128 = 4096;
+/// Vertices one entry of a surface batch's multi-draw covers at most (`gpu::RUN_VERTICES`).
+pub const RUN_VERTICES: u64 = 1 << 16;
 /// Budget when physical memory cannot be read.
 pub const FALLBACK_BUDGET: u64 = 4 << 30;
 
@@ -145,8 +156,10 @@ fn erbs_surface_extent(s: &ErbsSurface, dims: [usize; 2]) -> Extent {
 /// What a command does with the samples besides keeping them.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Uses {
-    /// Per-frame GPU mirrors, upload scratch and index buffers (`render`, `view`, `bench`).
-    pub gpu: bool,
+    /// Frame slots whose GPU mirrors get written: 0 without a GPU (`sample`), 1 for `render`
+    /// (one frame), every slot for `view` and `bench`. A slot's mirror is written by the
+    /// first frame that uses it, so only those slots' pages become resident.
+    pub gpu_slots: u8,
     /// The whole `prespline sample` JSON text, built in memory so a failure prints nothing.
     pub json_text: bool,
 }
@@ -210,41 +223,91 @@ impl Estimate {
 /// Estimates the bytes pre-evaluating one object takes: per direction the Hermite tables
 /// (samples × derivative rows kept × (degree + 1) f64), the canonical grid (samples × partials
 /// × 24 B), homogeneous copies of rational objects, unit normals, ERBS blend weights and local
-/// sample buffers, and with `uses` the GPU mirrors and the JSON text.
+/// sample buffers, and with `uses` its GPU mirrors and the JSON text. What objects share (index
+/// buffers by grid shape) is [`shared_estimate`]'s.
 #[must_use]
 pub fn estimate(extent: &Extent, mode: SampleMode, uses: Uses) -> Estimate {
     let mut e = Estimate::default();
-    let surface = extent.is_surface();
-    // Highest derivative order per direction and vectors stored per sample.
-    let (g, stride) = match (mode, surface) {
-        (SampleMode::Derivatives(g), false) => (g, g + 1),
-        (SampleMode::Derivatives(g), true) => (g, (g + 1) * (g + 1)),
-        (SampleMode::Render, false) => (1, 2),
-        (SampleMode::Render, true) => (1, 3),
-        (SampleMode::Analysis, false) => (1, 2),
-        (SampleMode::Analysis, true) => (2, 6),
-    };
-    let (g, stride) = (g as u128, stride as u128);
-    let n = extent.sample_count();
-    let vectors = n * stride;
-    let orders = if surface {
-        format!("{stride} partials")
-    } else {
-        format!("{stride} derivative orders")
-    };
-    let samples_text = samples_text(&extent.samples);
+    let at = Layout::of(extent, mode);
+    e.add(
+        "object",
+        OBJECT_BYTES,
+        "model, sampler, control display and name".into(),
+    );
+    add_tables(&mut e, extent, &at);
+    add_samples(&mut e, extent, mode, &at);
+    if let Some(locals) = &extent.erbs_locals {
+        add_erbs(&mut e, extent, locals, &at);
+    }
+    if !extent.nested.is_empty() {
+        add_nested(&mut e, extent, mode, &at);
+    }
+    add_gpu(&mut e, mode, uses, &at);
+    if uses.json_text {
+        // "[x, y, z]" with up to 24 characters a number.
+        e.add(
+            "output text",
+            at.vectors * 80,
+            format!("{} × {} × ~80 characters", at.samples_text, at.orders),
+        );
+    }
+    e.parts.sort_by_key(|p| std::cmp::Reverse(p.bytes));
+    e
+}
 
-    // Hermite tables: per direction m × rows × (d+1) f64; an ERBS local's table covers its
-    // support, and every sample lies in the supports of two locals per direction.
+/// What an object's terms are counted in: the highest derivative order kept, the vectors per
+/// sample, the samples, and their wording for the refusal message.
+struct Layout {
+    surface: bool,
+    g: u128,
+    stride: u128,
+    n: u128,
+    vectors: u128,
+    orders: String,
+    samples_text: String,
+}
+
+impl Layout {
+    fn of(extent: &Extent, mode: SampleMode) -> Self {
+        let surface = extent.is_surface();
+        let (g, stride) = match (mode, surface) {
+            (SampleMode::Derivatives(g), false) => (g, g + 1),
+            (SampleMode::Derivatives(g), true) => (g, (g + 1) * (g + 1)),
+            (SampleMode::Render, false) => (1, 2),
+            (SampleMode::Render, true) => (1, 3),
+            (SampleMode::Analysis, false) => (1, 2),
+            (SampleMode::Analysis, true) => (2, 6),
+        };
+        let (g, stride) = (g as u128, stride as u128);
+        let n = extent.sample_count();
+        Layout {
+            surface,
+            g,
+            stride,
+            n,
+            vectors: n * stride,
+            orders: if surface {
+                format!("{stride} partials")
+            } else {
+                format!("{stride} derivative orders")
+            },
+            samples_text: samples_text(&extent.samples),
+        }
+    }
+}
+
+/// Hermite tables: per direction m × rows × (d+1) f64; an ERBS local's table covers its
+/// support, and every sample lies in the supports of two locals per direction.
+fn add_tables(e: &mut Estimate, extent: &Extent, at: &Layout) {
     let mut table_bytes = 0u128;
     let mut table_formula = Vec::new();
     for (dir, (&m, &d)) in extent.samples.iter().zip(&extent.degree).enumerate() {
         let (m, d) = (m as u128, d as u128);
-        let rows = g.min(d) + 1;
+        let rows = at.g.min(d) + 1;
         let copies = match &extent.erbs_locals {
             // A surface's local patch (k, l) has its own u table over its support rows: each
             // u support is repeated for every l.
-            Some(locals) if surface => 2 * locals[1 - dir] as u128,
+            Some(locals) if at.surface => 2 * locals[1 - dir] as u128,
             Some(_) => 2,
             None => 1,
         };
@@ -261,143 +324,174 @@ pub fn estimate(extent: &Extent, mode: SampleMode, uses: Uses) -> Estimate {
         ));
     }
     e.add("Hermite tables", table_bytes, table_formula.join(" + "));
+}
+
+/// The canonical grid, homogeneous copies, unit normals and curvatures.
+fn add_samples(e: &mut Estimate, extent: &Extent, mode: SampleMode, at: &Layout) {
+    let (n, text) = (at.n, &at.samples_text);
     e.add(
         "samples",
-        vectors * VEC3,
-        format!("{samples_text} × {orders} × 24 B"),
+        at.vectors * VEC3,
+        format!("{text} × {} × 24 B", at.orders),
     );
     if extent.rational {
         e.add(
             "homogeneous samples",
-            vectors * VEC4,
-            format!("{samples_text} × {orders} × 32 B"),
+            at.vectors * VEC4,
+            format!("{text} × {} × 32 B", at.orders),
         );
     }
-    if surface && matches!(mode, SampleMode::Render | SampleMode::Analysis) {
-        e.add("normals", n * VEC3, format!("{samples_text} × 24 B"));
+    if at.surface && matches!(mode, SampleMode::Render | SampleMode::Analysis) {
+        e.add("normals", n * VEC3, format!("{text} × 24 B"));
     }
-    if surface && mode == SampleMode::Analysis {
-        e.add(
-            "curvatures",
-            n * 2 * F64,
-            format!("{samples_text} × [K, H] × 16 B"),
-        );
+    if at.surface && mode == SampleMode::Analysis {
+        e.add("curvatures", n * 2 * F64, format!("{text} × [K, H] × 16 B"));
     }
-    if let Some(locals) = &extent.erbs_locals {
-        // Blend weights: per direction m × 2 × (g+1) f64. Local samples: every parent sample
-        // lies in two supports per direction, so 2 (curves) or 4 (surfaces) local copies.
-        let blend: u128 = extent
+}
+
+/// ERBS blend weights and local samples (curves) or blended bases (surfaces).
+fn add_erbs(e: &mut Estimate, extent: &Extent, locals: &[usize], at: &Layout) {
+    // Blend weights: per direction m × 2 × (g+1) f64. Local samples: every parent sample
+    // lies in two supports per direction, so 2 (curves) or 4 (surfaces) local copies.
+    let blend: u128 = extent
+        .samples
+        .iter()
+        .map(|&m| m as u128 * 2 * (at.g + 1) * F64)
+        .sum();
+    e.add(
+        "ERBS blend weights",
+        blend,
+        format!("{} × 2 × {} orders × 8 B", at.samples_text, at.g + 1),
+    );
+    if at.surface {
+        // Polynomial local patches keep no samples, only their blended bases: per
+        // direction each support row once per patch in the other direction, rows 0 and 1
+        // padded to 4 functions (ERBS locals of locals are levels of their own, sized as
+        // deep as the scene makes them, and not counted here).
+        let dense: u128 = extent
             .samples
             .iter()
-            .map(|&m| m as u128 * 2 * (g + 1) * F64)
+            .enumerate()
+            .map(|(dir, &m)| 2 * locals[1 - dir] as u128 * m as u128 * 2 * 4 * F64)
             .sum();
         e.add(
-            "ERBS blend weights",
-            blend,
-            format!("{samples_text} × 2 × {} orders × 8 B", g + 1),
+            "ERBS blended bases",
+            dense,
+            "per direction: 2 × samples × patches across × 2 orders × 4 functions × 8 B".into(),
         );
-        if surface {
-            // Polynomial local patches keep no samples, only their blended bases: per
-            // direction each support row once per patch in the other direction, rows 0 and 1
-            // padded to 4 functions (ERBS locals of locals are levels of their own, sized as
-            // deep as the scene makes them, and not counted here).
-            let dense: u128 = extent
-                .samples
-                .iter()
-                .enumerate()
-                .map(|(dir, &m)| 2 * locals[1 - dir] as u128 * m as u128 * 2 * 4 * F64)
-                .sum();
-            e.add(
-                "ERBS blended bases",
-                dense,
-                "per direction: 2 × samples × patches across × 2 orders × 4 functions × 8 B".into(),
-            );
-        } else {
-            e.add(
-                "ERBS local samples",
-                2 * vectors * VEC3,
-                format!(
-                    "2 × {samples_text} × {orders} × 24 B over {} locals",
-                    locals.iter().map(|&l| l as u128).product::<u128>()
-                ),
-            );
-        }
-    }
-    if !extent.nested.is_empty() {
-        // A nested level keeps what an ERBS object of its own would, less the normals and
-        // curvatures (only the top level has them).
-        let nested: u128 = extent
-            .nested
-            .iter()
-            .map(|x| {
-                let e = estimate(x, mode, Uses::default());
-                e.parts
-                    .iter()
-                    .filter(|p| !matches!(p.what, "normals" | "curvatures"))
-                    .map(|p| u128::from(p.bytes))
-                    .sum::<u128>()
-            })
-            .sum();
-        // A curve's nested local has no Hermite table nor local samples in its parent (its
-        // level holds them), which the parent's terms above counted for every local.
-        let replaced: u128 = if surface {
-            0
-        } else {
-            let (rows, d1) = (
-                g.min(extent.degree[0] as u128) + 1,
-                extent.degree[0] as u128 + 1,
-            );
-            extent
-                .nested
-                .iter()
-                .map(|x| x.sample_count() * (rows * d1 * F64 + F64 + USIZE + stride * VEC3))
-                .sum()
-        };
-        let nested = nested.saturating_sub(replaced);
+    } else {
         e.add(
-            "nested ERBS levels",
-            nested,
+            "ERBS local samples",
+            2 * at.vectors * VEC3,
             format!(
-                "{} ERBS locals at the samples in their supports",
-                extent.nested.len()
+                "2 × {} × {} × 24 B over {} locals",
+                at.samples_text,
+                at.orders,
+                locals.iter().map(|&l| l as u128).product::<u128>()
             ),
         );
     }
-    if uses.gpu {
-        // Per frame in flight a mirror of f32 vertices (surfaces: position + normal), plus the
-        // CPU scratch that fills it; surfaces also get triangle and wireframe index buffers
-        // (u32, 6 + 4 per sample) and their staging copies.
-        let floats: u128 = if surface { 6 } else { 3 };
-        e.add(
-            "GPU mirrors",
-            (MIRROR_SLOTS + 1) * n * floats * F32,
-            format!("{} × {samples_text} × {} B", MIRROR_SLOTS + 1, floats * F32),
+}
+
+/// ERBS locals that are ERBS themselves: a level each.
+fn add_nested(e: &mut Estimate, extent: &Extent, mode: SampleMode, at: &Layout) {
+    // A nested level keeps what an ERBS object of its own would, less the normals and
+    // curvatures (only the top level has them).
+    let nested: u128 = extent
+        .nested
+        .iter()
+        .map(|x| {
+            let e = estimate(x, mode, Uses::default());
+            e.parts
+                .iter()
+                .filter(|p| !matches!(p.what, "normals" | "curvatures" | "object"))
+                .map(|p| u128::from(p.bytes))
+                .sum::<u128>()
+        })
+        .sum();
+    // A curve's nested local has no Hermite table nor local samples in its parent (its
+    // level holds them), which the parent's terms above counted for every local.
+    let replaced: u128 = if at.surface {
+        0
+    } else {
+        let (rows, d1) = (
+            at.g.min(extent.degree[0] as u128) + 1,
+            extent.degree[0] as u128 + 1,
         );
-        if surface && mode == SampleMode::Analysis {
-            // The curvature map's scalar per vertex, mirrored like the vertices.
-            e.add(
-                "GPU map mirrors",
-                (MIRROR_SLOTS + 1) * n * F32,
-                format!("{} × {samples_text} × 4 B", MIRROR_SLOTS + 1),
-            );
-        }
-        if surface {
-            e.add(
-                "GPU index buffers",
-                2 * n * 10 * F32,
-                format!("2 × {samples_text} × 40 B"),
-            );
-        }
+        extent
+            .nested
+            .iter()
+            .map(|x| x.sample_count() * (rows * d1 * F64 + F64 + USIZE + at.stride * VEC3))
+            .sum()
+    };
+    e.add(
+        "nested ERBS levels",
+        nested.saturating_sub(replaced),
+        format!(
+            "{} ERBS locals at the samples in their supports",
+            extent.nested.len()
+        ),
+    );
+}
+
+/// The object's own GPU parts: per frame slot written a mirror of f32 vertices (surfaces:
+/// position + normal), and the curvature map's scalar per vertex likewise; the control
+/// structure's mirror.
+fn add_gpu(e: &mut Estimate, mode: SampleMode, uses: Uses, at: &Layout) {
+    if uses.gpu_slots == 0 {
+        return;
     }
-    if uses.json_text {
-        // "[x, y, z]" with up to 24 characters a number.
+    let slots = u128::from(uses.gpu_slots);
+    let floats: u128 = if at.surface { 6 } else { 3 };
+    let text = &at.samples_text;
+    e.add(
+        "GPU mirrors",
+        slots * at.n * floats * F32,
+        format!("{slots} × {text} × {} B", floats * F32),
+    );
+    if at.surface && mode == SampleMode::Analysis {
         e.add(
-            "output text",
-            vectors * 80,
-            format!("{samples_text} × {orders} × ~80 characters"),
+            "GPU map mirrors",
+            slots * at.n * F32,
+            format!("{slots} × {text} × 4 B"),
         );
     }
-    e.parts.sort_by_key(|p| std::cmp::Reverse(p.bytes));
+    // The control structure's mirror is written in every slot.
+    e.add(
+        "GPU control mirrors",
+        GPU_SLOTS_ALWAYS * CONTROL_MIRROR,
+        format!("{GPU_SLOTS_ALWAYS} × {CONTROL_MIRROR} B"),
+    );
+}
+
+/// Surfaces of one grid shape share their index buffers: triangles and isolines, six and
+/// about four u32 per vertex, in copies for runs of up to [`RUN_VERTICES`] vertices (the next
+/// power of two of the grids in such a run; one copy for a grid larger than that), and their
+/// staging copies while uploading. Counted once per shape of the scene's surfaces.
+#[must_use]
+pub fn shared_estimate(objects: &[(&str, Extent)], uses: Uses) -> Estimate {
+    let mut e = Estimate::default();
+    if uses.gpu_slots == 0 {
+        return e;
+    }
+    let mut shapes: std::collections::HashMap<(usize, usize), u128> = Default::default();
+    for (_, x) in objects.iter().filter(|(_, x)| x.is_surface()) {
+        *shapes.entry((x.samples[0], x.samples[1])).or_default() += 1;
+    }
+    let bytes: u128 = shapes
+        .iter()
+        .map(|(&(rows, cols), &count)| {
+            let vertices = (rows as u128 * cols as u128).max(1);
+            let cap = (u128::from(RUN_VERTICES) / vertices).max(1);
+            let copies = count.min(cap).next_power_of_two();
+            2 * copies * vertices * 10 * F32
+        })
+        .sum();
+    e.add(
+        "GPU index buffers",
+        bytes,
+        format!("{} grid shapes × 2 × copies × samples × 40 B", shapes.len()),
+    );
     e
 }
 
@@ -570,7 +664,7 @@ pub fn check_extents(
     uses: Uses,
     budget: &MemoryBudget,
 ) -> Result<u64, String> {
-    let mut total = 0u64;
+    let mut total = shared_estimate(objects, uses).bytes();
     let mut largest: Option<(usize, u64)> = None;
     for (i, (name, extent)) in objects.iter().enumerate() {
         let e = estimate(extent, mode, uses);
@@ -676,7 +770,7 @@ mod tests {
         assert_eq!(e.parts[1].bytes, 5_000_000 * 21 * 24);
         assert_eq!(
             e.bytes(),
-            5_000_000 * (21 * 61 * 8 + 16) + 5_000_000 * 21 * 24
+            5_000_000 * (21 * 61 * 8 + 16) + 5_000_000 * 21 * 24 + OBJECT_BYTES as u64
         );
         assert!(
             e.describe()
@@ -710,7 +804,7 @@ mod tests {
             &s,
             SampleMode::Render,
             Uses {
-                gpu: true,
+                gpu_slots: 3,
                 json_text: false,
             },
         );
@@ -732,7 +826,7 @@ mod tests {
             nested: Vec::new(),
         };
         let uses = Uses {
-            gpu: true,
+            gpu_slots: 3,
             json_text: false,
         };
         let n = 512 * 512;

@@ -409,6 +409,7 @@ impl App {
                 r.session
                     .record(&mut frame, true)
                     .map_err(|e| e.to_string())?;
+                rec.set_retained(r.session.hud.retained.is_some());
                 rec.phase_start(Phase::Submit);
                 frame.finish().map_err(|e| e.to_string())?;
             }

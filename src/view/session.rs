@@ -248,7 +248,6 @@ impl Session {
         self.stage.editor.set_budget(budget);
     }
 
-    /// Re-samples and uploads edited objects in full on every edit (`bench --naive`).
     /// How gestures redraw (`--redraw`).
     pub fn set_redraw(&mut self, redraw: crate::render::Redraw) {
         self.gpu.set_redraw(redraw);
@@ -267,6 +266,15 @@ impl Session {
         self.gpu.set_drop_lines(drop);
     }
 
+    /// Test hook: every gesture builds a static layer, even one whose dynamic set is most of
+    /// the frame (where the layer does not pay and frames are drawn in full otherwise), so
+    /// exactness tests reach the retained path on small scenes.
+    #[doc(hidden)]
+    pub fn set_layer_always(&mut self, always: bool) {
+        self.gpu.set_layer_always(always);
+    }
+
+    /// Re-samples and uploads edited objects in full on every edit (`bench --naive`).
     pub fn set_naive(&mut self, naive: bool) {
         self.stage.editor.naive = naive;
     }

@@ -279,6 +279,12 @@ fn bench_records_the_redraw_mode() {
             text.contains(&format!("\"redraw\":\"{expect}\"")),
             "summary.json lacks the mode: {text}"
         );
+        // And how many measured frames a static layer served: none with `full`.
+        let retained = summary["run"]["extra"]["retained_frames"].as_u64();
+        match expect {
+            "full" => assert_eq!(retained, Some(0), "{text}"),
+            _ => assert!(retained.is_some_and(|n| n > 0), "{text}"),
+        }
     }
     let r = prespline()
         .args(["bench", "--redraw", "partial"])

@@ -280,3 +280,75 @@ fn the_image_format_follows_the_extension() {
         assert!(!out.exists(), "{name} written after refusing");
     }
 }
+
+/// The ratio a `--memory-report` line ends with ("estimate / measured 0.978").
+fn report_ratio(stderr: &str) -> Option<f64> {
+    let line = stderr.lines().find(|l| l.starts_with("memory: estimate"))?;
+    line.rsplit(' ').next()?.parse().ok()
+}
+
+/// Whether an estimate / measured ratio agrees within `tol` (NaN never does).
+fn agrees(ratio: f64, tol: f64) -> bool {
+    (ratio - 1.0).abs() <= tol
+}
+
+/// The tolerance docs/performance.md states for the budget against the resident size.
+const RESIDENT_TOLERANCE: f64 = 0.15;
+
+/// Issue 23: the memory budget's estimate of a 16 × 16 teapot scene (8192 Bézier patches),
+/// GPU parts included, agrees with what `render` makes resident within 15 %.
+#[test]
+fn the_budget_estimate_agrees_with_the_resident_size_on_teapots() {
+    use glam::DVec3;
+    use prespline::model::Model;
+    use prespline::scene::Scene;
+    let teapot =
+        Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/teapot.json")).unwrap();
+    let n = 16;
+    let mut objects = Vec::new();
+    for k in 0..n * n {
+        let offset = DVec3::new((k % n) as f64 * 4.0, (k / n) as f64 * 4.0, 0.0);
+        for o in &teapot.objects {
+            let mut copy = o.clone();
+            copy.name = format!("t{k}_{}", o.name);
+            if let Model::Surface(s) = &mut copy.model {
+                s.map_points(|p| p + offset);
+            }
+            objects.push(copy);
+        }
+    }
+    let scratch = common::Scratch::new("cli-render-memory");
+    let scene = scratch.path().join("teapots256.json");
+    Scene { objects }.save(&scene).unwrap();
+    let r = prespline()
+        .arg("render")
+        .arg(&scene)
+        .arg("--out")
+        .arg(scratch.path().join("t.png"))
+        .args(["--size", "64x64", "--memory-report"])
+        // The validation layer's own bookkeeping per Vulkan object is not the scene's.
+        .env("PRESPLINE_VALIDATION", "0")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(r.status.success(), "{err}");
+    let ratio = report_ratio(&err).unwrap_or(f64::NAN);
+    eprintln!("{err}");
+    assert!(
+        agrees(ratio, RESIDENT_TOLERANCE),
+        "estimate / measured {ratio} is not within {RESIDENT_TOLERANCE}: {err}"
+    );
+}
+
+#[test]
+fn the_resident_comparison_fails_on_a_wrong_estimate() {
+    // Negative controls: an estimate 20 % low or high, and an unreadable report, fail it.
+    assert!(agrees(0.9, RESIDENT_TOLERANCE));
+    assert!(!agrees(0.8, RESIDENT_TOLERANCE));
+    assert!(!agrees(1.2, RESIDENT_TOLERANCE));
+    assert!(!agrees(f64::NAN, RESIDENT_TOLERANCE));
+    let line = "memory: estimate 1 B (1 B); measured 2 B (...); estimate / measured 0.500";
+    assert_eq!(report_ratio(line), Some(0.5));
+    assert!(!agrees(report_ratio(line).unwrap(), RESIDENT_TOLERANCE));
+    assert_eq!(report_ratio("wrote x.png"), None);
+}

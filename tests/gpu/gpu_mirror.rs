@@ -176,3 +176,58 @@ fn a_slot_missing_an_update_is_detected() {
     let (incremental, fresh) = incremental_vs_fresh(3, 10, false, true);
     assert!(incremental != fresh, "a stale slot went unnoticed");
 }
+
+/// A split writer refuses overlapping or out-of-range ranges and writes outside its range,
+/// each as an error, and its disjoint ranges written on threads give the same pixels as one
+/// fill.
+#[test]
+fn split_writers_fill_disjoint_ranges_and_refuse_the_rest() {
+    let (mut r, sink) = common::renderer_with(false);
+    let mut target = r
+        .create_offscreen(&OffscreenDesc {
+            width: W,
+            height: H,
+            samples: 0,
+        })
+        .expect("target");
+    let data = common::height_field(SHAPE, &BUMPS);
+    let mut mirror = r.create_mirror("split", data.len()).expect("mirror");
+    for _ in 0..FRAMES_IN_FLIGHT {
+        let mut frame = r.begin_offscreen(&mut target).expect("begin");
+        {
+            let mut w = frame.write_mirror(&mut mirror);
+            let n = data.len();
+            assert!(w.split(&[0..10, 5..20]).is_err(), "overlapping ranges");
+            assert!(w.split(&[0..1, 2..n + 1]).is_err(), "past the end");
+            let (a, b) = (n / 3, 2 * n / 3);
+            let mut parts = w.split(&[0..a, a..b, b..n]).expect("split");
+            assert!(
+                parts[0].write(a - 1, &[0.0, 0.0]).is_err(),
+                "outside its range"
+            );
+            std::thread::scope(|s| {
+                for part in &mut parts {
+                    let data = &data;
+                    s.spawn(move || {
+                        let range = part.range();
+                        part.write(range.start, &data[range]).expect("write");
+                    });
+                }
+            });
+        }
+        frame.finish().expect("finish");
+    }
+    let mut none = vec![Vec::new(); FRAMES_IN_FLIGHT];
+    render(&mut r, &mut target, &mut mirror, &mut none, &data);
+    let split = r.read_pixels(&target).expect("read");
+    let mut fresh = r.create_mirror("fresh", data.len()).expect("fresh mirror");
+    r.fill_mirror(&mut fresh, 0, &data).expect("fill fresh");
+    render(&mut r, &mut target, &mut fresh, &mut none, &data);
+    let filled = r.read_pixels(&target).expect("read fresh");
+    let diff = common::compare_images(&filled, &split, 0).unwrap();
+    assert_eq!(diff.differing, 0, "{} pixels differ", diff.differing);
+    r.destroy_mirror(mirror);
+    r.destroy_mirror(fresh);
+    r.destroy_offscreen(target).expect("destroy target");
+    common::teardown(r, sink);
+}

@@ -149,6 +149,11 @@ fn changing_the_level_of_detail_uploads_nothing_and_edits_update_full_rows() {
     }
     let mut scene = GpuScene::new(&mut r, ed.doc()).unwrap();
     let tol = default_tolerance(&r);
+    // The first frame into each slot writes the sample arenas there.
+    for _ in 0..prespline::gpu::FRAMES_IN_FLIGHT {
+        let (_, _, filled) = draw(&mut r, &mut scene, ed.doc(), &near, Some(tol));
+        assert!(filled > 0, "a slot's first frame writes the samples");
+    }
     let (_, a, first) = draw(&mut r, &mut scene, ed.doc(), &near, Some(tol));
     let (_, b, second) = draw(&mut r, &mut scene, ed.doc(), &far, Some(tol));
     let (_, c, third) = draw(&mut r, &mut scene, ed.doc(), &near, None);

@@ -253,3 +253,35 @@ fn a_missed_update_is_detected() {
     common::teardown(renderer, sink);
     assert_ne!(stale.rgba, fresh.rgba);
 }
+
+/// Issue 23: the sample arenas are filled on every core, each thread a run of consecutive
+/// objects; the image equals the one of a fill on one thread, bit for bit (the demo scene and
+/// 48 teapot patches, so a fill splits into many runs).
+#[test]
+fn mirror_fills_on_n_threads_equal_one_thread() {
+    let (mut renderer, sink) = common::renderer();
+    let mut scene = demo_scene();
+    let teapot =
+        Scene::load(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/teapot.json"))
+            .unwrap();
+    for k in 0..3 {
+        for o in teapot.objects.iter().take(16) {
+            let mut o = o.clone();
+            o.name = format!("{k}_{}", o.name);
+            scene.objects.push(o);
+        }
+    }
+    let ed = common::editor(&scene, None);
+    let shot = fixed_shot(ed.doc(), 320, 240);
+    let mut target = offscreen(&mut renderer, &shot);
+    let one = prespline::parallel::on_one_thread(|| {
+        fresh_render(&mut renderer, &mut target, ed.doc(), &shot)
+    });
+    prespline::parallel::set_threads(3);
+    let three = fresh_render(&mut renderer, &mut target, ed.doc(), &shot);
+    prespline::parallel::set_threads(0);
+    let diff = common::compare_images(&one, &three, 0).unwrap();
+    assert_eq!(diff.differing, 0, "{} pixels differ", diff.differing);
+    renderer.destroy_offscreen(target).unwrap();
+    common::teardown(renderer, sink);
+}

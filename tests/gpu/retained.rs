@@ -57,6 +57,9 @@ impl Pair {
             )
             .unwrap();
             session.set_redraw(redraw);
+            // Small test scenes: gestures whose support is most of the frame still take the
+            // retained path here (`a_layer_that_would_not_pay_is_skipped` covers the rule).
+            session.set_layer_always(true);
             session.set_map(map);
             runs.push(Run { session, target });
         }
@@ -469,6 +472,71 @@ fn lines_left_out_of_the_redrawn_rectangle_are_caught() {
         found.is_some(),
         "moved lines left in the static layer went unnoticed ({} retained frames)",
         pair.retained_frames
+    );
+    pair.finish();
+}
+
+/// Without the test hook, a gesture whose dynamic set is most of the frame's triangles draws
+/// in full (a layer would cost two image copies and save little): rotating the middle local
+/// patch of `examples/erbs_surface.json`, whose support is the whole surface, and dragging a
+/// point of a scene of curves only. A drag whose support is a small part of the frame still
+/// takes the retained path. All equal full.
+#[test]
+fn a_layer_that_would_not_pay_is_skipped() {
+    let mut rng = Rng::new(11);
+    let mut pair = Pair::new(&erbs_scene(), None);
+    pair.runs[0].session.set_layer_always(false);
+    check(&mut pair, &[vec![]], "first frame");
+    let middle = pair.runs[0]
+        .session
+        .doc()
+        .handles(0)
+        .into_iter()
+        .map(|(h, _)| h)
+        .find(|h| {
+            matches!(h, Handle::LocalPoint { local, .. }
+                if local.steps() == [prespline::model::Index2::Two(1, 1)])
+        })
+        .expect("a point of the middle local patch");
+    let before = pair.retained_frames;
+    let script = transform(&mut rng, middle, 5);
+    check(&mut pair, &script, "rotating the middle local patch");
+    assert_eq!(
+        pair.retained_frames, before,
+        "a gesture over the whole surface drew from a layer"
+    );
+    pair.finish();
+
+    let mut rng = Rng::new(3);
+    let scene = random_scene(&mut rng);
+    let mut pair = Pair::new(&scene, None);
+    pair.runs[0].session.set_layer_always(false);
+    let h = Handle::Point {
+        object: 2,
+        point: prespline::model::Index2::Two(2, 2),
+    };
+    let script = drag(&mut rng, h, false, 6);
+    check(&mut pair, &script, "a drag on a scene of several objects");
+    assert!(
+        pair.retained_frames > 0,
+        "a drag on one of several objects drew no frame from a layer"
+    );
+    pair.finish();
+
+    // Curves only: no surface would stay in a layer.
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/bezier_curve.json"
+    ))
+    .unwrap();
+    let mut pair = Pair::new(&parse_scene(&text).unwrap(), None);
+    pair.runs[0].session.set_layer_always(false);
+    let h = handle_of(&pair, &mut rng, 0);
+    let script = drag(&mut rng, h, false, 6);
+    check(&mut pair, &script, "a drag on a curve");
+    assert_eq!(
+        pair.retained_frames, 0,
+        "a curve-only scene drew from a layer"
     );
     pair.finish();
 }
