@@ -643,8 +643,8 @@ impl Shape for TensorSurface {
         far.distance()
     }
 
-    /// Polynomial surfaces refined in at most one direction: their lines along it
-    /// ([`lines_bound`]), without combining across.
+    /// Polynomial surfaces refined in at most one direction: their lines along it (see
+    /// `lines_bound`), without combining across.
     fn distance_bound(&self, other: &Self, at: &[Vec<f64>; 2]) -> f64 {
         let refined: Vec<usize> = (0..2).filter(|&d| !same_basis(self, other, d)).collect();
         match refined[..] {

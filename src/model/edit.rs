@@ -1,6 +1,6 @@
 //! The edit vocabulary every kind shares: what an edit acts on, the trait per-kind edits
 //! implement, and how a rejected edit is reported. The sum over kinds and the frame-merging of
-//! edits are the registry's ([`super::object`]).
+//! edits are the registry's (model/object.rs).
 
 use super::erbs::LocalPath;
 use super::index::Index2;

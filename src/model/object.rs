@@ -274,7 +274,7 @@ pub struct Edit {
 }
 
 /// Merges the edits of one frame so each touched target is updated once: consecutive edits of
-/// one target combine where their kind says so ([`KindEdit::merge`]); edits on different
+/// one target combine where their kind says so ([`KindEdit::merge`](super::KindEdit::merge)); edits on different
 /// targets commute, so targets are applied in first-touch order while edits on one target keep
 /// their order. A structural edit is a barrier: nothing moves across it (indices change there).
 #[must_use]

@@ -1,8 +1,8 @@
 //! The registered kinds and the closed sums over them: [`Model`], [`ModelRef`], [`ObjectEdit`]
-//! and [`SampledObject`], generated from the one list, [`registered_kinds!`], by [`kinds!`],
+//! and [`SampledObject`], generated from the one list, `registered_kinds!`, by `kinds!`,
 //! and the object-safe views of a kind ([`DynKind`], [`DynEdit`], [`DynSampler`]) through which
 //! the sums reach the [`Kind`] implementation inside. What the sums do is written against those
-//! views in [`super::object`]: nothing there names a kind.
+//! views in model/object.rs: nothing there names a kind.
 
 use super::controls::{ControlDisplay, Grip};
 use super::edit::{EditError, IntoObject, KindEdit, Target};
@@ -16,7 +16,7 @@ use glam::DVec3;
 use serde_json::{Map, Value};
 
 /// The registered kinds: `Variant(model type)` each. A new kind is one folder under model/ and
-/// one line here; [`kinds!`] generates the sums over these and everything reaches a kind
+/// one line here; `kinds!` generates the sums over these and everything reaches a kind
 /// through its [`Kind`] implementation.
 macro_rules! registered_kinds {
     ($then:ident) => {
