@@ -6,10 +6,12 @@ inline paths like `super::font::glyph_rows()`) is resolved to the file that defi
 paths through a mod.rs re-export (`pub use x::Y`) resolve to x's file. Comments and doc
 links are ignored; mod.rs's own `mod`/`pub use` lines are the facade, not edges.
 Usage: scripts/import-graph.py src gpu   (exit status 1 when there is a circle)
+       scripts/import-graph.py src       (the top-level modules: which imports which)
 """
 import os, re, sys
 
-root, top = sys.argv[1], sys.argv[2]   # e.g. src gpu
+root = sys.argv[1]
+top = sys.argv[2] if len(sys.argv) > 2 else None   # e.g. src gpu
 
 def mod_files():
     out = {}
@@ -24,7 +26,30 @@ def mod_files():
             out[tuple(rel)] = os.path.join(dp, f)
     return out
 
-MODS = mod_files()
+def top_level():
+    """Top-level module -> the top-level modules its files name through `crate::`."""
+    names = {f[:-3] if f.endswith('.rs') else f for f in os.listdir(root)
+             if f not in ('lib.rs', 'main.rs') and (f.endswith('.rs') or
+                                                    os.path.isdir(os.path.join(root, f)))}
+    g = {n: set() for n in names}
+    for n in names:
+        base = os.path.join(root, n)
+        files = [base + '.rs'] if os.path.isfile(base + '.rs') else [
+            os.path.join(dp, f) for dp, _, fs in os.walk(base) for f in fs if f.endswith('.rs')]
+        for f in files:
+            src = strip_comments(open(f).read())
+            paths = [e for m in re.finditer(r'\buse\s+([^;]+);', src) for e in expand(m.group(1))]
+            paths += re.findall(r'\bcrate::\w+', src)
+            for p in paths:
+                segs = p.replace(' ', '').split('::')
+                if len(segs) > 1 and segs[0] == 'crate' and segs[1] in names and segs[1] != n:
+                    g[n].add(segs[1])
+    return g
+
+if top is None:
+    MODS = {}
+else:
+    MODS = mod_files()
 
 def strip_comments(s):
     s = re.sub(r'/\*.*?\*/', '', s, flags=re.S)
@@ -163,8 +188,12 @@ def sccs(g):
         if v not in idx: visit(v)
     return out
 
-name = lambda m: '/'.join(m[1:]) or 'mod'
-g = edges()
+if top is None:
+    name = lambda m: m
+    g = top_level()
+else:
+    name = lambda m: '/'.join(m[1:]) or 'mod'
+    g = edges()
 for m in sorted(g):
     print(f"{name(m):22} -> {', '.join(sorted(name(t) for t in g[m]))}")
 cyc = [c for c in sccs(g) if len(c) > 1]

@@ -524,51 +524,63 @@ impl<'a> Lines<'a> {
         }
     }
 
-    /// The lines the basis at the k-th parameter combines, with their weights times `sign`.
-    fn terms<'s>(&'s self, basis: &ProbeBasis, k: usize, sign: f64, out: &mut Vec<Term<'s>>) {
-        let (first, n) = basis.get(k);
-        out.extend((first..).zip(n).map(|(i, &w)| {
-            let start = (i - self.first) * self.width;
-            (&self.points[start..start + self.width], sign * w)
-        }));
+    fn line(&self, i: usize) -> &[DVec3] {
+        let start = (i - self.first) * self.width;
+        &self.points[start..start + self.width]
     }
 }
 
-/// A line of a net and its weight in a combination.
-type Term<'a> = (&'a [DVec3], f64);
-
-/// Points combined per pass of [`add_squares`]: their coordinates fill three vector registers
+/// Points combined per pass of [`add_group`]: their coordinates fill three vector registers
 /// of eight lanes.
 const CHUNK: usize = 8;
 
-/// Adds the squares of Σ w·line, coordinate by coordinate, to `squares` (one sum per lane).
-/// One pass over the lines, a chunk of points at a time: the sums stay in registers.
-fn add_squares(terms: &[Term<'_>], width: usize, squares: &mut [f64; 3 * CHUNK]) {
+/// Most parameters compared in one pass of [`add_group`].
+const GROUP: usize = 6;
+
+/// Adds, for each of the `G` parameters from `k` on (which share their span in both nets),
+/// the squares of (new − old) line by line, coordinate by coordinate, to `squares`. One pass
+/// over the lines of the span: each chunk of a line is read once for every parameter, and the
+/// sums stay in registers.
+fn add_group<const G: usize>(
+    [old, new]: [(&Lines<'_>, &ProbeBasis); 2],
+    k: usize,
+    squares: &mut [f64; 3 * CHUNK],
+) {
+    let mut terms: Vec<(&[DVec3], [f64; G])> = Vec::new();
+    for ((lines, basis), sign) in [(new, 1.0), (old, -1.0)] {
+        let (first, _) = basis.get(k);
+        for l in 0..basis.per {
+            let w = std::array::from_fn(|g| sign * basis.get(k + g).1[l]);
+            terms.push((lines.line(first + l), w));
+        }
+    }
+    let width = old.0.width;
     let mut lanes = *squares;
     let whole = width - width % CHUNK;
     for x in (0..whole).step_by(CHUNK) {
-        let mut acc = [0.0; 3 * CHUNK];
-        for &(line, w) in terms {
+        let mut acc = [[0.0; 3 * CHUNK]; G];
+        for (line, w) in &terms {
             let mut coordinates = [0.0; 3 * CHUNK];
             for (c, p) in coordinates.chunks_exact_mut(3).zip(&line[x..x + CHUNK]) {
                 c.copy_from_slice(&p.to_array());
             }
-            for (a, c) in acc
-                .chunks_exact_mut(CHUNK)
-                .zip(coordinates.chunks_exact(CHUNK))
-            {
-                for (a, &c) in a.iter_mut().zip(c) {
+            for (acc, &w) in acc.iter_mut().zip(w) {
+                for (a, &c) in acc.iter_mut().zip(&coordinates) {
                     *a += c * w;
                 }
             }
         }
-        for (s, a) in lanes.iter_mut().zip(acc) {
-            *s += a * a;
+        for acc in acc {
+            for (s, a) in lanes.iter_mut().zip(acc) {
+                *s += a * a;
+            }
         }
     }
     for x in whole..width {
-        let a: DVec3 = terms.iter().map(|&(line, w)| line[x] * w).sum();
-        lanes[0] += a.length_squared();
+        for g in 0..G {
+            let a: DVec3 = terms.iter().map(|(line, w)| line[x] * w[g]).sum();
+            lanes[0] += a.length_squared();
+        }
     }
     *squares = lanes;
 }
@@ -584,13 +596,23 @@ fn lines_bound(old: &TensorSurface, new: &TensorSurface, dir: usize, at: &[f64])
         Lines::new(old, dir, bo.reach()),
         Lines::new(new, dir, bn.reach()),
     );
-    let mut terms = Vec::new();
+    let nets = [(&lo, &bo), (&ln, &bn)];
     let mut squares = [0.0; 3 * CHUNK];
-    for k in 0..at.len() {
-        terms.clear();
-        ln.terms(&bn, k, 1.0, &mut terms);
-        lo.terms(&bo, k, -1.0, &mut terms);
-        add_squares(&terms, lo.width, &mut squares);
+    let mut k = 0;
+    while k < at.len() {
+        let same = |j: usize| bo.first[j] == bo.first[k] && bn.first[j] == bn.first[k];
+        let g = (k..at.len().min(k + GROUP))
+            .take_while(|&j| same(j))
+            .count();
+        match g {
+            1 => add_group::<1>(nets, k, &mut squares),
+            2 => add_group::<2>(nets, k, &mut squares),
+            3 => add_group::<3>(nets, k, &mut squares),
+            4 => add_group::<4>(nets, k, &mut squares),
+            5 => add_group::<5>(nets, k, &mut squares),
+            _ => add_group::<GROUP>(nets, k, &mut squares),
+        }
+        k += g;
     }
     squares.iter().sum::<f64>().sqrt()
 }
@@ -621,8 +643,8 @@ impl Shape for TensorSurface {
         far.distance()
     }
 
-    /// Polynomial surfaces refined in at most one direction: their lines along it
-    /// ([`lines_bound`]), without combining across.
+    /// Polynomial surfaces refined in at most one direction: their lines along it (see
+    /// `lines_bound`), without combining across.
     fn distance_bound(&self, other: &Self, at: &[Vec<f64>; 2]) -> f64 {
         let refined: Vec<usize> = (0..2).filter(|&d| !same_basis(self, other, d)).collect();
         match refined[..] {

@@ -1,8 +1,9 @@
-//! The edit vocabulary shared by every layer: one trait per-kind edits implement, the sum over
-//! kinds, and the frame-merging of edits.
+//! The edit vocabulary every kind shares: what an edit acts on, the trait per-kind edits
+//! implement, and how a rejected edit is reported. The sum over kinds and the frame-merging of
+//! edits are the registry's (model/object.rs).
 
-use super::registry::{IntoObject, ObjectEdit};
-use super::{Index2, LocalPath};
+use super::erbs::LocalPath;
+use super::index::Index2;
 use crate::geom::shape::{SHAPE_TOLERANCE, ShapeChange};
 use std::fmt::Debug;
 
@@ -75,6 +76,19 @@ pub enum Target {
     Structure,
 }
 
+/// A kind's edit as one variant of the sum over kinds ([`ObjectEdit`](super::ObjectEdit)) and
+/// back: the registry implements it for each registered kind's edit, so this trait names the
+/// sum only through `Object`.
+pub trait IntoObject: Sized {
+    /// The sum over kinds.
+    type Object;
+
+    #[must_use]
+    fn wrap(self) -> Self::Object;
+
+    fn unwrap(e: &Self::Object) -> Option<&Self>;
+}
+
 /// An edit of one object kind. Implemented once per kind: this is the table of what each edit
 /// means, written in one place per kind instead of one `match` per layer.
 pub trait KindEdit: Clone + Debug + PartialEq + Sized + IntoObject {
@@ -116,58 +130,15 @@ pub trait KindEdit: Clone + Debug + PartialEq + Sized + IntoObject {
 
     /// The edit as an edit of any kind.
     #[must_use]
-    fn into_object(self) -> ObjectEdit {
+    fn into_object(self) -> Self::Object {
         self.wrap()
     }
 
     /// The edit if `e` is of this kind.
     #[must_use]
-    fn from_object(e: &ObjectEdit) -> Option<&Self> {
+    fn from_object(e: &Self::Object) -> Option<&Self> {
         Self::unwrap(e)
     }
-}
-
-/// One edit of one object (`object` indexes the scene's objects).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Edit {
-    pub object: usize,
-    pub edit: ObjectEdit,
-}
-
-/// Merges the edits of one frame so each touched target is updated once: consecutive edits of
-/// one target combine where their kind says so ([`KindEdit::merge`]); edits on different
-/// targets commute, so targets are applied in first-touch order while edits on one target keep
-/// their order. A structural edit is a barrier: nothing moves across it (indices change there).
-#[must_use]
-pub fn merge_edits(edits: &[Edit]) -> Vec<Edit> {
-    let mut out = Vec::with_capacity(edits.len());
-    let mut groups: Vec<((usize, Target), Vec<Edit>)> = Vec::new();
-    let flush = |groups: &mut Vec<((usize, Target), Vec<Edit>)>, out: &mut Vec<Edit>| {
-        out.extend(groups.drain(..).flat_map(|(_, g)| g));
-    };
-    for e in edits {
-        let target = e.edit.target();
-        if target == Target::Structure {
-            flush(&mut groups, &mut out);
-            out.push(e.clone());
-            continue;
-        }
-        let key = (e.object, target);
-        let group = match groups.iter().position(|(k, _)| *k == key) {
-            Some(i) => &mut groups[i].1,
-            None => {
-                groups.push((key, Vec::new()));
-                &mut groups.last_mut().expect("just pushed").1
-            }
-        };
-        let merged = group.last().and_then(|last| last.edit.merge(&e.edit));
-        match (merged, group.last_mut()) {
-            (Some(m), Some(last)) => last.edit = m,
-            _ => group.push(e.clone()),
-        }
-    }
-    flush(&mut groups, &mut out);
-    out
 }
 
 #[cfg(test)]

@@ -1,20 +1,34 @@
-//! The closed sums over the registered kinds: [`Model`], [`ModelRef`], [`ObjectEdit`] and
-//! [`SampledObject`], generated from the one list in `model/mod.rs` by [`kinds!`]. Everything
-//! they do goes through the [`Kind`](super::kind::Kind) implementation of the kind inside, via
-//! the object-safe views of `model::kind`: nothing here names a kind.
+//! The registered kinds and the closed sums over them: [`Model`], [`ModelRef`], [`ObjectEdit`]
+//! and [`SampledObject`], generated from the one list, `registered_kinds!`, by `kinds!`,
+//! and the object-safe views of a kind ([`DynKind`], [`DynEdit`], [`DynSampler`]) through which
+//! the sums reach the [`Kind`] implementation inside. What the sums do is written against those
+//! views in model/object.rs: nothing there names a kind.
 
-use super::edit::{EditError, Target};
-use super::kind::mode_of;
-use crate::sampling::{DirtyRegion, SampleGrid, SampleMode};
+use super::controls::{ControlDisplay, Grip};
+use super::edit::{EditError, IntoObject, KindEdit, Target};
+use super::erbs::LocalPath;
+use super::index::Index2;
+use super::kind::{Kind, Support};
+use crate::format::{At, SceneError};
+use crate::sampling::budget::Extent;
+use crate::sampling::{DirtyRegion, SampleGrid, SampleMode, Sampler, Tracked};
+use glam::DVec3;
+use serde_json::{Map, Value};
 
-/// A kind's edit as an [`ObjectEdit`] and back (implemented for each registered kind's edit;
-/// used through [`KindEdit::into_object`](super::KindEdit::into_object) and
-/// [`KindEdit::from_object`](super::KindEdit::from_object)).
-pub trait IntoObject: Sized {
-    #[must_use]
-    fn wrap(self) -> ObjectEdit;
-
-    fn unwrap(e: &ObjectEdit) -> Option<&Self>;
+/// The registered kinds: `Variant(model type)` each. A new kind is one folder under model/ and
+/// one line here; `kinds!` generates the sums over these and everything reaches a kind
+/// through its [`Kind`] implementation.
+macro_rules! registered_kinds {
+    ($then:ident) => {
+        $then! {
+            Curve(crate::model::CurveModel),
+            Surface(crate::model::SurfaceModel),
+            ErbsCurve(crate::model::ErbsCurveModel),
+            ErbsSurface(crate::model::ErbsSurfaceModel),
+            CatmullRom(crate::model::CatmullRomModel),
+            BezierSpline(crate::model::BezierSplineModel),
+        }
+    };
 }
 
 /// Declares the kinds: `Variant(ModelType)` each, once. Generates the four sums over them and
@@ -51,6 +65,8 @@ macro_rules! kinds {
 
         $(
             impl IntoObject for <$m as $crate::model::Kind>::Edit {
+                type Object = ObjectEdit;
+
                 fn wrap(self) -> ObjectEdit {
                     ObjectEdit::$v(self)
                 }
@@ -133,13 +149,13 @@ macro_rules! kinds {
 
             /// The model's kind.
             #[must_use]
-            pub fn kind(&self) -> &dyn $crate::model::kind::DynKind {
+            pub fn kind(&self) -> &dyn DynKind {
                 match self {
                     $(Model::$v(m) => m,)+
                 }
             }
 
-            fn kind_mut(&mut self) -> &mut dyn $crate::model::kind::DynKind {
+            pub(super) fn kind_mut(&mut self) -> &mut dyn DynKind {
                 match self {
                     $(Model::$v(m) => m,)+
                 }
@@ -156,7 +172,7 @@ macro_rules! kinds {
         impl<'a> ModelRef<'a> {
             /// The model's kind.
             #[must_use]
-            pub fn kind(&self) -> &'a dyn $crate::model::kind::DynKind {
+            pub fn kind(&self) -> &'a dyn DynKind {
                 match *self {
                     $(ModelRef::$v(m) => m,)+
                 }
@@ -165,7 +181,7 @@ macro_rules! kinds {
 
         impl ObjectEdit {
             /// The kind's edit inside (`None` for a replacement).
-            fn as_dyn(&self) -> Option<&dyn $crate::model::kind::DynEdit> {
+            pub(super) fn as_dyn(&self) -> Option<&dyn DynEdit> {
                 match self {
                     $(ObjectEdit::$v(e) => Some(e),)+
                     ObjectEdit::Replace(_) => None,
@@ -174,13 +190,13 @@ macro_rules! kinds {
         }
 
         impl SampledObject {
-            fn sampler(&self) -> &dyn $crate::model::kind::DynSampler {
+            pub(super) fn sampler(&self) -> &dyn DynSampler {
                 match self {
                     $(SampledObject::$v(s) => s,)+
                 }
             }
 
-            fn sampler_mut(&mut self) -> &mut dyn $crate::model::kind::DynSampler {
+            pub(super) fn sampler_mut(&mut self) -> &mut dyn DynSampler {
                 match self {
                     $(SampledObject::$v(s) => s,)+
                 }
@@ -191,329 +207,256 @@ macro_rules! kinds {
 
 registered_kinds!(kinds);
 
-impl Model {
-    /// The scene-file `type` string.
-    #[must_use]
-    pub fn type_name(&self) -> &'static str {
-        self.kind().type_name()
-    }
-
-    #[must_use]
-    pub fn is_surface(&self) -> bool {
-        self.kind().is_surface()
-    }
-
-    /// Sample grid dimensions: [m, 1] for curves, [mu, mv] for surfaces.
-    #[must_use]
-    pub fn sample_dims(&self) -> [usize; 2] {
-        self.kind().sample_dims()
-    }
-
-    /// Parameter domain per direction (one entry for curves).
-    #[must_use]
-    pub fn domain(&self) -> Vec<(f64, f64)> {
-        self.kind().domain()
-    }
-
-    /// Applies a validated edit of this object's kind (a kind mismatch is an error).
-    pub fn apply(&mut self, edit: &ObjectEdit) -> Result<(), EditError> {
-        self.apply_prepared(edit, None)
-    }
-
-    /// Applies an edit prepared against this model ([`ObjectEdit::prepare`]): the model it
-    /// leaves where the preparation computed one, else the edit itself.
-    pub fn apply_prepared(
-        &mut self,
-        edit: &ObjectEdit,
-        result: Option<Model>,
-    ) -> Result<(), EditError> {
-        match (edit, result) {
-            (_, Some(after)) => {
-                *self = after;
-                Ok(())
-            }
-            (ObjectEdit::Replace(new), None) => {
-                *self = (**new).clone();
-                Ok(())
-            }
-            (e, None) => self.kind_mut().apply(e),
-        }
-    }
+/// A [`Kind`] behind a reference, for code that holds a model of any kind.
+pub trait DynKind {
+    fn type_name(&self) -> &'static str;
+    fn is_surface(&self) -> bool;
+    fn sample_dims(&self) -> [usize; 2];
+    fn domain(&self) -> Vec<(f64, f64)>;
+    fn to_model(&self) -> Model;
+    fn sampled(&self, mode: SampleMode) -> SampledObject;
+    fn to_bspline_curve(&self) -> Option<Model>;
+    /// Applies an edit of this kind to the model (another kind's is an error).
+    fn apply(&mut self, edit: &ObjectEdit) -> Result<(), EditError>;
+    /// Checks an edit of this kind; a structural edit hands back the model it leaves
+    /// ([`KindEdit::prepare`]).
+    fn prepare(&self, edit: &ObjectEdit) -> Result<Option<Model>, EditError>;
+    fn inverse(&self, edit: &ObjectEdit) -> Result<ObjectEdit, EditError>;
+    fn controls(&self) -> ControlDisplay;
+    fn extent(&self) -> Extent;
+    fn write(&self, out: &mut String);
+    fn read_edit(&self, at: &At, obj: &Map<String, Value>) -> Result<ObjectEdit, SceneError>;
+    fn derivatives_at(
+        &self,
+        uv: [f64; 2],
+        order: usize,
+        list: &[(usize, usize)],
+        out: &mut [DVec3],
+    );
+    fn junctions(&self) -> Option<(Vec<f64>, bool)>;
+    fn control_point(&self, point: Index2) -> Option<DVec3>;
+    fn local_controls(&self, local: LocalPath<Index2>) -> Option<ControlDisplay>;
+    fn move_edit(&self, grip: Grip, delta: DVec3) -> Option<ObjectEdit>;
+    fn weight(&self, grip: Grip) -> Option<f64>;
+    fn weight_edit(&self, grip: Grip, weight: f64) -> Result<ObjectEdit, String>;
 }
 
-impl<'a> ModelRef<'a> {
-    #[must_use]
-    pub fn type_name(&self) -> &'static str {
-        self.kind().type_name()
-    }
-
-    #[must_use]
-    pub fn is_surface(&self) -> bool {
-        self.kind().is_surface()
-    }
-
-    #[must_use]
-    pub fn sample_dims(&self) -> [usize; 2] {
-        self.kind().sample_dims()
-    }
-
-    #[must_use]
-    pub fn domain(&self) -> Vec<(f64, f64)> {
-        self.kind().domain()
-    }
-
-    /// The equivalent B-spline curve (Catmull–Rom and Bézier splines: their Bézier chain), or
-    /// `None` for kinds that are not such a chain.
-    #[must_use]
-    pub fn to_bspline_curve(&self) -> Option<Model> {
-        self.kind().to_bspline_curve()
-    }
-
-    /// An owned copy.
-    #[must_use]
-    pub fn to_model(&self) -> Model {
-        self.kind().to_model()
-    }
+/// The error for an edit paired with a model of another kind.
+#[must_use]
+pub fn edit_kind_mismatch(e: &ObjectEdit, model_type: &str) -> EditError {
+    EditError::new(
+        "object",
+        format!("a {} edit does not apply to a {model_type}", e.kind_name()),
+    )
 }
 
-impl ObjectEdit {
-    #[must_use]
-    pub fn target(&self) -> Target {
-        self.as_dyn().map_or(Target::Structure, |e| e.target())
+impl<K> DynKind for K
+where
+    K: Kind,
+    K::Edit: IntoObject<Object = ObjectEdit>,
+    Model: From<K>,
+    SampledObject: From<Tracked<K::Sampler>>,
+{
+    fn type_name(&self) -> &'static str {
+        Kind::type_name(self)
     }
 
-    /// Whether the edit changes the object's structure (knots, degree, control counts).
-    #[must_use]
-    pub fn is_structural(&self) -> bool {
-        self.target() == Target::Structure
+    fn is_surface(&self) -> bool {
+        K::SURFACE
     }
 
-    /// The two as one edit, when they act on one target and combine.
-    #[must_use]
-    pub fn merge(&self, next: &ObjectEdit) -> Option<ObjectEdit> {
-        self.as_dyn()?.merge(next)
+    fn sample_dims(&self) -> [usize; 2] {
+        Kind::sample_dims(self)
     }
 
-    /// Checks the edit against a model (of its own kind).
-    pub fn validate(&self, model: ModelRef<'_>) -> Result<(), EditError> {
-        match self {
-            ObjectEdit::Replace(new) => check_replacement(new.as_ref().as_ref(), model),
-            e => model.kind().prepare(e).map(|_| ()),
-        }
+    fn domain(&self) -> Vec<(f64, f64)> {
+        Kind::domain(self)
     }
 
-    /// Checks the edit against a model (of its own kind) and computes what applying it takes
-    /// ([`KindEdit::prepare`](super::KindEdit::prepare)): the model a structural edit leaves,
-    /// computed once, or `None` for an edit applied in place. The budget reads the result,
-    /// and [`SampledObject::apply_prepared`] or [`Model::apply_prepared`] takes it.
-    pub fn prepare(&self, model: ModelRef<'_>) -> Result<Option<Model>, EditError> {
-        match self {
-            ObjectEdit::Replace(new) => {
-                check_replacement(new.as_ref().as_ref(), model)?;
-                Ok(Some((**new).clone()))
-            }
-            e => model.kind().prepare(e),
-        }
+    fn to_model(&self) -> Model {
+        Model::from(self.clone())
     }
 
-    /// The edit restoring `model` as it is before this edit, or an error on a kind mismatch.
-    pub fn inverse(&self, model: ModelRef<'_>) -> Result<ObjectEdit, EditError> {
-        match self {
-            ObjectEdit::Replace(_) => Ok(ObjectEdit::Replace(Box::new(model.to_model()))),
-            e => model.kind().inverse(e),
-        }
+    fn sampled(&self, mode: SampleMode) -> SampledObject {
+        SampledObject::from(Tracked::new(self.sampler(mode)))
     }
 
-    /// The kind's name for messages: "curve", "ERBS surface", "replacement"…
-    #[must_use]
-    pub fn kind_name(&self) -> &'static str {
-        self.as_dyn().map_or("replacement", |e| e.kind_label())
+    fn to_bspline_curve(&self) -> Option<Model> {
+        Kind::to_bspline_curve(self).map(Model::Curve)
     }
-}
 
-/// A replacement keeps the sample grid (curve or surface, and its counts), so samplers and GPU
-/// mirrors keep their size.
-fn check_replacement(new: ModelRef<'_>, old: ModelRef<'_>) -> Result<(), EditError> {
-    if new.is_surface() == old.is_surface() && new.sample_dims() == old.sample_dims() {
+    fn apply(&mut self, edit: &ObjectEdit) -> Result<(), EditError> {
+        let e = K::Edit::from_object(edit)
+            .ok_or_else(|| edit_kind_mismatch(edit, Kind::type_name(self)))?;
+        e.apply(self);
         Ok(())
-    } else {
-        Err(EditError::new(
-            "object",
-            format!(
-                "a {} with samples {:?} cannot replace a {} with samples {:?}",
-                new.type_name(),
-                new.sample_dims(),
-                old.type_name(),
-                old.sample_dims()
-            ),
-        ))
+    }
+
+    fn prepare(&self, edit: &ObjectEdit) -> Result<Option<Model>, EditError> {
+        let after = K::Edit::from_object(edit)
+            .ok_or_else(|| edit_kind_mismatch(edit, Kind::type_name(self)))?
+            .prepare(self)?;
+        Ok(after.map(Model::from))
+    }
+
+    fn inverse(&self, edit: &ObjectEdit) -> Result<ObjectEdit, EditError> {
+        let e = K::Edit::from_object(edit)
+            .ok_or_else(|| edit_kind_mismatch(edit, Kind::type_name(self)))?;
+        Ok(e.inverse(self).into_object())
+    }
+
+    fn controls(&self) -> ControlDisplay {
+        Kind::controls(self)
+    }
+
+    fn extent(&self) -> Extent {
+        Kind::extent(self)
+    }
+
+    fn write(&self, out: &mut String) {
+        Kind::write(self, out);
+    }
+
+    fn read_edit(&self, at: &At, obj: &Map<String, Value>) -> Result<ObjectEdit, SceneError> {
+        Kind::read_edit(self, at, obj).map(KindEdit::into_object)
+    }
+
+    fn derivatives_at(
+        &self,
+        uv: [f64; 2],
+        order: usize,
+        list: &[(usize, usize)],
+        out: &mut [DVec3],
+    ) {
+        Kind::derivatives_at(self, uv, order, list, out);
+    }
+
+    fn junctions(&self) -> Option<(Vec<f64>, bool)> {
+        Kind::junctions(self)
+    }
+
+    fn control_point(&self, point: Index2) -> Option<DVec3> {
+        Kind::control_point(self, point)
+    }
+
+    fn local_controls(&self, local: LocalPath<Index2>) -> Option<ControlDisplay> {
+        Kind::local_controls(self, local)
+    }
+
+    fn move_edit(&self, grip: Grip, delta: DVec3) -> Option<ObjectEdit> {
+        Kind::move_edit(self, grip, delta).map(KindEdit::into_object)
+    }
+
+    fn weight(&self, grip: Grip) -> Option<f64> {
+        Kind::weight(self, grip)
+    }
+
+    fn weight_edit(&self, grip: Grip, weight: f64) -> Result<ObjectEdit, String> {
+        Kind::weight_edit(self, grip, weight).map(KindEdit::into_object)
     }
 }
 
-impl SampledObject {
-    /// Pre-evaluates and fully samples `model`.
-    #[must_use]
-    pub fn new(model: &Model, mode: SampleMode) -> Self {
-        model.kind().sampled(mode)
+/// A [`KindEdit`] behind a reference.
+pub trait DynEdit {
+    /// The kind's name in messages.
+    fn kind_label(&self) -> &'static str;
+    fn target(&self) -> Target;
+    /// This edit followed by `next` as one, when both act on one target and combine.
+    fn merge(&self, next: &ObjectEdit) -> Option<ObjectEdit>;
+}
+
+impl<E> DynEdit for E
+where
+    E: KindEdit + IntoObject<Object = ObjectEdit>,
+    E::Model: Kind,
+{
+    fn kind_label(&self) -> &'static str {
+        <E::Model as Kind>::LABEL
     }
 
-    /// The sample mode this object was built with.
-    #[must_use]
-    pub fn mode(&self) -> SampleMode {
-        mode_of(self.grid())
+    fn target(&self) -> Target {
+        KindEdit::target(self)
     }
 
-    /// `None` disables the periodic exact rebuild (to measure raw drift in tests).
-    pub fn set_rebuild_interval(&mut self, every: Option<usize>) {
-        self.sampler_mut().set_interval(every);
+    fn merge(&self, next: &ObjectEdit) -> Option<ObjectEdit> {
+        let next = E::from_object(next)?;
+        KindEdit::merge(self, next).map(KindEdit::into_object)
+    }
+}
+
+/// A kind's tracked sampler behind a reference.
+pub trait DynSampler {
+    fn model(&self) -> ModelRef<'_>;
+    fn grid(&self) -> &SampleGrid;
+    fn params(&self) -> Vec<&[f64]>;
+    fn interval(&self) -> Option<usize>;
+    fn set_interval(&mut self, every: Option<usize>);
+    /// Applies an edit of the sampler's kind through the delta path. `result` is the model
+    /// the edit leaves where [`ObjectEdit::prepare`] computed it against this sampler's model
+    /// (a structural edit), and is taken as it is. Without one, the edit is prepared here:
+    /// edits arrive validated, and checking again costs a few comparisons and keeps a stale
+    /// index (say, after an undone refinement) from ever reaching the kernels.
+    fn apply(&mut self, edit: &ObjectEdit, result: Option<Model>)
+    -> Result<DirtyRegion, EditError>;
+    fn rebuild_touched(&mut self) -> DirtyRegion;
+    fn full(&mut self) -> DirtyRegion;
+    fn support(&self, target: Target) -> Vec<DirtyRegion>;
+}
+
+impl<S> DynSampler for Tracked<S>
+where
+    S: Sampler + Support,
+    S::Edit: KindEdit<Model = S::Model> + IntoObject<Object = ObjectEdit>,
+    S::Model: Kind<Edit = S::Edit> + TryFrom<Model, Error = Model>,
+    for<'a> ModelRef<'a>: From<&'a S::Model>,
+{
+    fn model(&self) -> ModelRef<'_> {
+        ModelRef::from(Sampler::model(self))
     }
 
-    /// The current model by reference (no copy).
-    #[must_use]
-    pub fn model(&self) -> ModelRef<'_> {
-        self.sampler().model()
+    fn grid(&self) -> &SampleGrid {
+        Sampler::grid(self)
     }
 
-    #[must_use]
-    pub fn type_name(&self) -> &'static str {
-        self.model().type_name()
+    fn params(&self) -> Vec<&[f64]> {
+        Sampler::params(self)
     }
 
-    #[must_use]
-    pub fn grid(&self) -> &SampleGrid {
-        self.sampler().grid()
+    fn interval(&self) -> Option<usize> {
+        self.interval
     }
 
-    /// The samples whose values edits of `target` can change ([`crate::model::kind::Support`]).
-    #[must_use]
-    pub fn support(&self, target: Target) -> Vec<DirtyRegion> {
-        self.sampler().support(target)
+    fn set_interval(&mut self, every: Option<usize>) {
+        self.interval = every;
     }
 
-    /// Sample parameters per direction.
-    #[must_use]
-    pub fn params(&self) -> Vec<&[f64]> {
-        self.sampler().params()
-    }
-
-    /// Applies an edit through the delta path; returns the samples it touched (including any
-    /// periodic rebuild's). An edit of another kind, or one that does not fit the model, is an
-    /// error and changes nothing.
-    pub fn apply(&mut self, edit: &ObjectEdit) -> Result<DirtyRegion, EditError> {
-        self.apply_prepared(edit, None)
-    }
-
-    /// [`SampledObject::apply`] of an edit prepared against this object's model
-    /// ([`ObjectEdit::prepare`]): `result`, the model a structural edit leaves, is taken as it
-    /// is, not computed or checked again.
-    pub fn apply_prepared(
+    fn apply(
         &mut self,
         edit: &ObjectEdit,
         result: Option<Model>,
     ) -> Result<DirtyRegion, EditError> {
-        if let ObjectEdit::Replace(model) = edit {
-            if result.is_none() {
-                edit.validate(self.model())?;
-            }
-            let interval = self.sampler().interval();
-            *self = SampledObject::new(result.as_ref().unwrap_or(model), self.mode());
-            self.set_rebuild_interval(interval);
-            let [rows, cols] = self.grid().dims;
-            return Ok(DirtyRegion::surface(0..rows, 0..cols));
-        }
-        self.sampler_mut().apply(edit, result)
-    }
-
-    /// Exact re-evaluation of everything touched since the last rebuild (drift reset).
-    pub fn rebuild_touched(&mut self) -> DirtyRegion {
-        self.sampler_mut().rebuild_touched()
-    }
-
-    /// Full sampling from the pre-evaluated data, as the constructor does.
-    pub fn rebuild_all(&mut self) -> DirtyRegion {
-        self.sampler_mut().full()
-    }
-
-    /// Samples in the grid (rows × cols).
-    #[must_use]
-    pub fn sample_count(&self) -> usize {
-        let [a, b] = self.grid().dims;
-        a * b
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::geom::{BSplineCurve, KnotVector, TensorSurface};
-    use crate::model::{
-        CurveEdit, CurveModel, KindEdit, PointEdit, SplineForm, SurfaceEdit, SurfaceModel,
-    };
-    use glam::DVec3;
-
-    /// A mirror that copies exactly the rows each edit reports, as the GPU mirrors do, must equal
-    /// the grid after every edit.
-    fn mirror_follows(obj: &mut SampledObject, edits: &[ObjectEdit]) {
-        let stride = obj.grid().stride();
-        let cols = obj.grid().dims[1];
-        let mut mirror = obj.grid().data.clone();
-        let bits = |v: &[DVec3]| -> Vec<[u64; 3]> {
-            v.iter().map(|p| p.to_array().map(f64::to_bits)).collect()
+        let model = Sampler::model(self);
+        let e = <S::Edit as KindEdit>::from_object(edit)
+            .ok_or_else(|| edit_kind_mismatch(edit, Kind::type_name(model)))?;
+        let after = match result {
+            Some(after) => Some(
+                S::Model::try_from(after)
+                    .map_err(|other| edit_kind_mismatch(edit, other.type_name()))?,
+            ),
+            None => e.prepare(model)?,
         };
-        for (k, e) in edits.iter().enumerate() {
-            let region = obj.apply(e).unwrap();
-            let rows = region.rows.start * cols * stride..region.rows.end * cols * stride;
-            mirror[rows.clone()].copy_from_slice(&obj.grid().data[rows]);
-            assert!(
-                bits(&mirror) == bits(&obj.grid().data),
-                "after edit {k}, a mirror fed the reported regions differs from the grid"
-            );
-        }
+        Ok(Sampler::apply_prepared(self, e, after))
     }
 
-    fn wiggle(k: usize) -> DVec3 {
-        let x = k as f64;
-        DVec3::new((x * 0.7).sin(), (x * 1.3).cos(), (x * 0.37).sin()) * 0.123_456_7
+    fn rebuild_touched(&mut self) -> DirtyRegion {
+        Tracked::rebuild_touched(self)
     }
 
-    #[test]
-    fn apply_reports_what_the_periodic_rebuild_rewrote() {
-        // Edits at both ends of a curve and a surface; every 3rd edit rebuilds everything touched
-        // since the last rebuild, which rewrites the other end's samples with exact values.
-        let n = 12;
-        let pts = (0..n).map(|i| DVec3::new(i as f64, 0.0, 0.0)).collect();
-        let knots = KnotVector::clamped_uniform(3, n, 0.0, 1.0).into_vec();
-        let c = BSplineCurve::new(3, knots.clone(), pts, None).unwrap();
-        let m = CurveModel::new(SplineForm::BSpline, c, 200).unwrap();
-        for mode in [SampleMode::Render, SampleMode::Derivatives(2)] {
-            let mut obj = SampledObject::new(&Model::Curve(m.clone()), mode);
-            obj.set_rebuild_interval(Some(3));
-            let edits: Vec<ObjectEdit> = (0..40)
-                .map(|k| {
-                    let point = if k % 2 == 0 { 1 } else { n - 2 };
-                    let delta = wiggle(k);
-                    CurveEdit::Point(PointEdit::Move { point, delta }).into_object()
-                })
-                .collect();
-            mirror_follows(&mut obj, &edits);
-        }
-        let pts = (0..n * n)
-            .map(|k| DVec3::new((k / n) as f64, (k % n) as f64, 0.0))
-            .collect();
-        let knots2 = KnotVector::clamped_uniform(2, n, 0.0, 1.0).into_vec();
-        let s = TensorSurface::bspline([3, 2], [knots, knots2], [n, n], pts, None).unwrap();
-        let m = SurfaceModel::new(SplineForm::BSpline, s, [40, 30]).unwrap();
-        for mode in [SampleMode::Render, SampleMode::Derivatives(1)] {
-            let mut obj = SampledObject::new(&Model::Surface(m.clone()), mode);
-            obj.set_rebuild_interval(Some(3));
-            let edits: Vec<ObjectEdit> = (0..40)
-                .map(|k| {
-                    let point = if k % 2 == 0 { [1, 1] } else { [n - 2, n - 2] };
-                    let delta = wiggle(k);
-                    SurfaceEdit::Point(PointEdit::Move { point, delta }).into_object()
-                })
-                .collect();
-            mirror_follows(&mut obj, &edits);
-        }
+    fn full(&mut self) -> DirtyRegion {
+        Sampler::full(self)
+    }
+
+    fn support(&self, target: Target) -> Vec<DirtyRegion> {
+        Support::support(self, target)
     }
 }

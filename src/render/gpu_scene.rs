@@ -568,7 +568,7 @@ impl GpuScene {
                 clipped_net(frame, o, &controls.vertices, [*rows, *cols], opts, hl, c)?;
                 continue;
             }
-            self.draw_controls(frame, i, o, &controls.layout, opts, hl, &palette)?;
+            ControlPass::new(i, &o.controls, opts, hl, &palette).draw(frame, &controls.layout)?;
         }
         Ok(())
     }
@@ -1003,177 +1003,6 @@ impl GpuScene {
         }
     }
 
-    #[allow(clippy::too_many_arguments)]
-    fn draw_controls(
-        &self,
-        frame: &mut Frame<'_>,
-        i: usize,
-        o: &ObjectGpu,
-        layout: &ControlLayout,
-        opts: &ViewOptions,
-        hl: &Highlight,
-        palette: &Palette,
-    ) -> GpuResult<()> {
-        let net = PolylineStyle {
-            color: palette.net,
-            width: 1.0,
-            depth_test: true,
-        };
-        let nets = net_shown(opts, hl, i);
-        let index_in = |h: Option<Handle>, f: &dyn Fn(Handle) -> Option<u32>| {
-            h.filter(|h| h.object() == i).and_then(f)
-        };
-        let points = |hov: Option<u32>, sel: Option<u32>| PointStyle {
-            color: palette.point,
-            size: opts.point_size,
-            hovered: hov,
-            selected: sel,
-            ..PointStyle::default()
-        };
-        match layout {
-            ControlLayout::Polygon { count } if nets => {
-                let run = PointRun::packed(0, *count);
-                polyline(frame, &o.controls, run, &net)?;
-                let pick = |h: Handle| match h {
-                    Handle::Point {
-                        point: Index2::One(k),
-                        ..
-                    } => Some(k as u32),
-                    _ => None,
-                };
-                frame.draw_points(
-                    &o.controls,
-                    run,
-                    &points(index_in(hl.hovered, &pick), index_in(hl.selected, &pick)),
-                )?;
-            }
-            ControlLayout::Net { rows, cols } if nets => {
-                control_net(frame, &o.controls, 0, *rows, *cols, &net)?;
-                let pick = |h: Handle| match h {
-                    Handle::Point {
-                        point: Index2::Two(a, b),
-                        ..
-                    } => Some((a * cols + b) as u32),
-                    _ => None,
-                };
-                let run = PointRun::packed(0, rows * cols);
-                frame.draw_points(
-                    &o.controls,
-                    run,
-                    &points(index_in(hl.hovered, &pick), index_in(hl.selected, &pick)),
-                )?;
-            }
-            ControlLayout::LocalCurves(entries) => {
-                for e in entries {
-                    let chosen = hl
-                        .selected_local
-                        .is_some_and(|(o, p)| o == i && e.path.starts_with(&p));
-                    if opts.local_curves || chosen {
-                        let color = if chosen {
-                            palette.selected_local
-                        } else {
-                            palette.local
-                        };
-                        let style = PolylineStyle {
-                            color,
-                            width: if chosen { 2.5 } else { 1.5 },
-                            depth_test: true,
-                        };
-                        polyline(
-                            frame,
-                            &o.controls,
-                            PointRun {
-                                offset: e.samples * 3,
-                                stride: 3,
-                                count: LOCAL_CURVE_SAMPLES,
-                            },
-                            &style,
-                        )?;
-                    }
-                    if nets || chosen {
-                        let run = PointRun {
-                            offset: e.points * 3,
-                            stride: 3,
-                            count: e.rows,
-                        };
-                        polyline(frame, &o.controls, run, &net)?;
-                        let pick = |h: Handle| match h {
-                            Handle::LocalPoint {
-                                local,
-                                point: Index2::One(q),
-                                ..
-                            } if local == e.path => Some(q as u32),
-                            _ => None,
-                        };
-                        frame.draw_points(
-                            &o.controls,
-                            run,
-                            &points(index_in(hl.hovered, &pick), index_in(hl.selected, &pick)),
-                        )?;
-                    }
-                }
-            }
-            ControlLayout::LocalPatches(entries) => {
-                let k = LOCAL_PATCH_SAMPLES as u32;
-                let chosen = |e: &LocalEntry| {
-                    hl.selected_local
-                        .is_some_and(|(o, p)| o == i && e.path.starts_with(&p))
-                };
-                // Outline and centre lines only: full wire grids of every patch bury the
-                // surface. All patches in one call, the selected ones on top in their colour.
-                let wire = |frame: &mut Frame<'_>, offsets: &[usize], color| {
-                    let batch = SurfaceBatch {
-                        shape: GridShape { rows: k, cols: k },
-                        stride: GridStride::FULL,
-                        offsets,
-                    };
-                    frame.draw_wire_batch(&o.controls, &batch, (k - 1) / 2, color)
-                };
-                if opts.local_curves {
-                    let offsets: Vec<usize> = entries
-                        .iter()
-                        .filter(|e| !chosen(e))
-                        .map(|e| e.samples * 3)
-                        .collect();
-                    wire(frame, &offsets, palette.local)?;
-                }
-                let selected: Vec<usize> = entries
-                    .iter()
-                    .filter(|e| chosen(e))
-                    .map(|e| e.samples * 3)
-                    .collect();
-                if !selected.is_empty() {
-                    wire(frame, &selected, palette.selected_local)?;
-                }
-                for e in entries {
-                    if nets || chosen(e) {
-                        control_net(frame, &o.controls, e.points * 3, e.rows, e.cols, &net)?;
-                        let pick = |h: Handle| match h {
-                            Handle::LocalPoint {
-                                local,
-                                point: Index2::Two(a, b),
-                                ..
-                            } if local == e.path => Some((a * e.cols + b) as u32),
-                            _ => None,
-                        };
-                        let run = PointRun {
-                            offset: e.points * 3,
-                            stride: 3,
-                            count: e.rows * e.cols,
-                        };
-                        frame.draw_points(
-                            &o.controls,
-                            run,
-                            &points(index_in(hl.hovered, &pick), index_in(hl.selected, &pick)),
-                        )?;
-                    }
-                }
-            }
-            _ => {}
-        }
-        Ok(())
-    }
-
     /// Gives every mirror back to the renderer.
     pub fn destroy(self, renderer: &mut Renderer) {
         if let Some(s) = self.scalars {
@@ -1185,6 +1014,225 @@ impl GpuScene {
         for o in self.objects {
             renderer.destroy_mirror(o.controls);
         }
+    }
+}
+
+/// Drawing one object's control display: its polygon or net, or its ERBS locals (display
+/// samples, control polygons and nets), with the hovered and selected points marked.
+struct ControlPass<'a> {
+    object: usize,
+    controls: &'a Mirror,
+    opts: &'a ViewOptions,
+    hl: &'a Highlight,
+    palette: &'a Palette,
+    /// The line style of control polygons and nets.
+    net: PolylineStyle,
+    /// Whether the object's polygon or net is shown (a chosen local's always is).
+    nets: bool,
+}
+
+impl<'a> ControlPass<'a> {
+    fn new(
+        object: usize,
+        controls: &'a Mirror,
+        opts: &'a ViewOptions,
+        hl: &'a Highlight,
+        palette: &'a Palette,
+    ) -> Self {
+        let net = PolylineStyle {
+            color: palette.net,
+            width: 1.0,
+            depth_test: true,
+        };
+        Self {
+            object,
+            controls,
+            opts,
+            hl,
+            palette,
+            net,
+            nets: net_shown(opts, hl, object),
+        }
+    }
+
+    fn draw(&self, frame: &mut Frame<'_>, layout: &ControlLayout) -> GpuResult<()> {
+        match layout {
+            ControlLayout::Polygon { count } if self.nets => self.polygon(frame, *count),
+            ControlLayout::Net { rows, cols } if self.nets => self.net(frame, *rows, *cols),
+            ControlLayout::LocalCurves(entries) => self.local_curves(frame, entries),
+            ControlLayout::LocalPatches(entries) => self.local_patches(frame, entries),
+            _ => Ok(()),
+        }
+    }
+
+    /// The control points in `run`, the hovered and the selected one marked: `pick` is a
+    /// handle's index in the run, where the handle is one of these points.
+    fn points(
+        &self,
+        frame: &mut Frame<'_>,
+        run: PointRun,
+        pick: impl Fn(Handle) -> Option<u32>,
+    ) -> GpuResult<()> {
+        let index_in = |h: Option<Handle>| h.filter(|h| h.object() == self.object).and_then(&pick);
+        let style = PointStyle {
+            color: self.palette.point,
+            size: self.opts.point_size,
+            hovered: index_in(self.hl.hovered),
+            selected: index_in(self.hl.selected),
+            ..PointStyle::default()
+        };
+        frame.draw_points(self.controls, run, &style)
+    }
+
+    /// A curve's control polygon and its points.
+    fn polygon(&self, frame: &mut Frame<'_>, count: usize) -> GpuResult<()> {
+        let run = PointRun::packed(0, count);
+        polyline(frame, self.controls, run, &self.net)?;
+        self.points(frame, run, |h| match h {
+            Handle::Point {
+                point: Index2::One(k),
+                ..
+            } => Some(k as u32),
+            _ => None,
+        })
+    }
+
+    /// A surface's control net and its points.
+    fn net(&self, frame: &mut Frame<'_>, rows: usize, cols: usize) -> GpuResult<()> {
+        control_net(frame, self.controls, 0, rows, cols, &self.net)?;
+        self.points(frame, PointRun::packed(0, rows * cols), |h| match h {
+            Handle::Point {
+                point: Index2::Two(a, b),
+                ..
+            } => Some((a * cols + b) as u32),
+            _ => None,
+        })
+    }
+
+    /// Whether a local is the selected local or lies inside it.
+    fn chosen(&self, e: &LocalEntry) -> bool {
+        self.hl
+            .selected_local
+            .is_some_and(|(o, p)| o == self.object && e.path.starts_with(&p))
+    }
+
+    /// An ERBS curve's polynomial locals: each one's display samples (where local curves are
+    /// shown, or it is chosen) and its control polygon.
+    fn local_curves(&self, frame: &mut Frame<'_>, entries: &[LocalEntry]) -> GpuResult<()> {
+        for e in entries {
+            let chosen = self.chosen(e);
+            if self.opts.local_curves || chosen {
+                self.local_curve(frame, e, chosen)?;
+            }
+            if self.nets || chosen {
+                self.local_polygon(frame, e)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// A local curve's display samples, wider and in the selection colour when chosen.
+    fn local_curve(&self, frame: &mut Frame<'_>, e: &LocalEntry, chosen: bool) -> GpuResult<()> {
+        let style = PolylineStyle {
+            color: if chosen {
+                self.palette.selected_local
+            } else {
+                self.palette.local
+            },
+            width: if chosen { 2.5 } else { 1.5 },
+            depth_test: true,
+        };
+        let run = PointRun {
+            offset: e.samples * 3,
+            stride: 3,
+            count: LOCAL_CURVE_SAMPLES,
+        };
+        polyline(frame, self.controls, run, &style)
+    }
+
+    /// A local curve's control polygon and its points.
+    fn local_polygon(&self, frame: &mut Frame<'_>, e: &LocalEntry) -> GpuResult<()> {
+        let run = PointRun {
+            offset: e.points * 3,
+            stride: 3,
+            count: e.rows,
+        };
+        polyline(frame, self.controls, run, &self.net)?;
+        self.points(frame, run, |h| match h {
+            Handle::LocalPoint {
+                local,
+                point: Index2::One(q),
+                ..
+            } if local == e.path => Some(q as u32),
+            _ => None,
+        })
+    }
+
+    /// An ERBS surface's polynomial local patches: their wires, then each shown one's control
+    /// net.
+    fn local_patches(&self, frame: &mut Frame<'_>, entries: &[LocalEntry]) -> GpuResult<()> {
+        self.patch_wires(frame, entries)?;
+        for e in entries {
+            if self.nets || self.chosen(e) {
+                self.local_net(frame, e)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Outline and centre lines only: full wire grids of every patch bury the surface. All
+    /// patches in one call (where local patches are shown), the chosen ones on top in their
+    /// colour.
+    fn patch_wires(&self, frame: &mut Frame<'_>, entries: &[LocalEntry]) -> GpuResult<()> {
+        let k = LOCAL_PATCH_SAMPLES as u32;
+        let wire = |frame: &mut Frame<'_>, offsets: &[usize], color| {
+            let batch = SurfaceBatch {
+                shape: GridShape { rows: k, cols: k },
+                stride: GridStride::FULL,
+                offsets,
+            };
+            frame.draw_wire_batch(self.controls, &batch, (k - 1) / 2, color)
+        };
+        let offsets = |chosen: bool| -> Vec<usize> {
+            entries
+                .iter()
+                .filter(|e| self.chosen(e) == chosen)
+                .map(|e| e.samples * 3)
+                .collect()
+        };
+        if self.opts.local_curves {
+            wire(frame, &offsets(false), self.palette.local)?;
+        }
+        let selected = offsets(true);
+        if !selected.is_empty() {
+            wire(frame, &selected, self.palette.selected_local)?;
+        }
+        Ok(())
+    }
+
+    /// A local patch's control net and its points.
+    fn local_net(&self, frame: &mut Frame<'_>, e: &LocalEntry) -> GpuResult<()> {
+        control_net(
+            frame,
+            self.controls,
+            e.points * 3,
+            e.rows,
+            e.cols,
+            &self.net,
+        )?;
+        let run = PointRun {
+            offset: e.points * 3,
+            stride: 3,
+            count: e.rows * e.cols,
+        };
+        self.points(frame, run, |h| match h {
+            Handle::LocalPoint {
+                local,
+                point: Index2::Two(a, b),
+                ..
+            } if local == e.path => Some((a * e.cols + b) as u32),
+            _ => None,
+        })
     }
 }
 

@@ -5,21 +5,14 @@
 //! points it changes ([`ChainEdit::chain_points`]), each touching only its segments' samples.
 
 pub mod file;
+mod kinds;
 pub mod sampler;
 
-use crate::format::{At, SceneError};
 use crate::geom::{BezierSpline, CatmullRom, GeomError};
-use crate::model::Kind;
-use crate::model::controls::{ControlDisplay, Grip};
 use crate::model::edit::{EditError, KindEdit, Target};
 use crate::model::points::{PointEdit, check_index, check_vector};
-use crate::model::registry::Model;
 use crate::model::{CurveModel, Index2, MAX_CURVE_SAMPLES, SplineForm, check_samples};
-use crate::sampling::SampleMode;
-use crate::sampling::budget::Extent;
 use glam::DVec3;
-use sampler::ChainCurveSampler;
-use serde_json::{Map, Value};
 
 /// A curve kind pre-evaluated as the B-spline of its Bézier chain.
 pub trait ChainModel: Clone + std::fmt::Debug {
@@ -321,174 +314,6 @@ impl ChainEdit for BezierSplineEdit {
             delta: DVec3::ONE,
         }
         .chain_points(m)
-    }
-}
-
-impl Kind for CatmullRomModel {
-    type Edit = CatmullRomEdit;
-    type Sampler = ChainCurveSampler<CatmullRomEdit>;
-    const SURFACE: bool = false;
-    const LABEL: &'static str = "Catmull–Rom";
-
-    const TYPES: &'static [&'static str] = &["catmull_rom"];
-
-    fn read(
-        _: &str,
-        at: &At,
-        obj: &Map<String, Value>,
-        common: &[&'static str],
-    ) -> Result<Self, SceneError> {
-        file::read_catmull_rom(at, obj, common)
-    }
-
-    fn write(&self, out: &mut String) {
-        file::write_catmull_rom(self, out);
-    }
-
-    fn read_edit(&self, at: &At, obj: &Map<String, Value>) -> Result<CatmullRomEdit, SceneError> {
-        file::read_catmull_rom_edit(at, obj)
-    }
-
-    fn type_name(&self) -> &'static str {
-        "catmull_rom"
-    }
-
-    fn sample_dims(&self) -> [usize; 2] {
-        [self.samples, 1]
-    }
-
-    fn domain(&self) -> Vec<(f64, f64)> {
-        vec![self.spline.domain()]
-    }
-
-    fn sampler(&self, mode: SampleMode) -> Self::Sampler {
-        ChainCurveSampler::new(self.clone(), mode.layout().0)
-    }
-
-    fn to_bspline_curve(&self) -> Option<Model> {
-        Some(Model::Curve(self.chain_form()))
-    }
-
-    fn derivatives_at(
-        &self,
-        [u, _]: [f64; 2],
-        order: usize,
-        _: &[(usize, usize)],
-        out: &mut [DVec3],
-    ) {
-        out.copy_from_slice(&self.chain_form().curve().derivatives(u, order));
-    }
-
-    fn junctions(&self) -> Option<(Vec<f64>, bool)> {
-        Some((self.spline.breakpoints(), self.spline.closed()))
-    }
-
-    /// Cubic segments.
-    fn extent(&self) -> Extent {
-        Extent::polynomial(&[self.samples], &[3], false)
-    }
-
-    /// The interpolated points.
-    fn controls(&self) -> ControlDisplay {
-        ControlDisplay::polygon(self.spline.points().to_vec())
-    }
-
-    fn move_edit(&self, grip: Grip, delta: DVec3) -> Option<CatmullRomEdit> {
-        let Grip::Point(Index2::One(point)) = grip else {
-            return None;
-        };
-        Some(CatmullRomEdit::Point(PointEdit::Move { point, delta }))
-    }
-
-    fn weight_edit(&self, _grip: Grip, _weight: f64) -> Result<Self::Edit, String> {
-        Err(format!(
-            "a {} has no weights: B converts it to a bspline_curve first",
-            self.type_name()
-        ))
-    }
-}
-
-impl Kind for BezierSplineModel {
-    type Edit = BezierSplineEdit;
-    type Sampler = ChainCurveSampler<BezierSplineEdit>;
-    const SURFACE: bool = false;
-    const LABEL: &'static str = "Bézier spline";
-
-    const TYPES: &'static [&'static str] = &["bezier_spline"];
-
-    fn read(
-        _: &str,
-        at: &At,
-        obj: &Map<String, Value>,
-        common: &[&'static str],
-    ) -> Result<Self, SceneError> {
-        file::read_bezier_spline(at, obj, common)
-    }
-
-    fn write(&self, out: &mut String) {
-        file::write_bezier_spline(self, out);
-    }
-
-    fn read_edit(&self, at: &At, obj: &Map<String, Value>) -> Result<BezierSplineEdit, SceneError> {
-        file::read_bezier_spline_edit(at, obj)
-    }
-
-    fn type_name(&self) -> &'static str {
-        "bezier_spline"
-    }
-
-    fn sample_dims(&self) -> [usize; 2] {
-        [self.samples, 1]
-    }
-
-    fn domain(&self) -> Vec<(f64, f64)> {
-        vec![self.spline.domain()]
-    }
-
-    fn sampler(&self, mode: SampleMode) -> Self::Sampler {
-        ChainCurveSampler::new(self.clone(), mode.layout().0)
-    }
-
-    fn to_bspline_curve(&self) -> Option<Model> {
-        Some(Model::Curve(self.chain_form()))
-    }
-
-    fn derivatives_at(
-        &self,
-        [u, _]: [f64; 2],
-        order: usize,
-        _: &[(usize, usize)],
-        out: &mut [DVec3],
-    ) {
-        out.copy_from_slice(&self.chain_form().curve().derivatives(u, order));
-    }
-
-    fn junctions(&self) -> Option<(Vec<f64>, bool)> {
-        Some((self.spline.knots().to_vec(), false))
-    }
-
-    fn extent(&self) -> Extent {
-        Extent::polynomial(&[self.samples], &[self.spline.degree()], false)
-    }
-
-    /// Bézier points, or the de Boor polygon of splines edited through it (their Bézier points
-    /// are drawn as an overlay).
-    fn controls(&self) -> ControlDisplay {
-        ControlDisplay::polygon(self.spline.handles())
-    }
-
-    fn move_edit(&self, grip: Grip, delta: DVec3) -> Option<BezierSplineEdit> {
-        let Grip::Point(Index2::One(point)) = grip else {
-            return None;
-        };
-        Some(BezierSplineEdit::Move { point, delta })
-    }
-
-    fn weight_edit(&self, _grip: Grip, _weight: f64) -> Result<Self::Edit, String> {
-        Err(format!(
-            "a {} has no weights: B converts it to a bspline_curve first",
-            self.type_name()
-        ))
     }
 }
 

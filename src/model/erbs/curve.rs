@@ -1,22 +1,13 @@
 //! The ERBS curve kind: its model and what its edits need of it.
 
-use super::controls::curve_controls;
-use super::curve_sampler::ErbsCurveSampler;
 use super::*;
-use crate::format::{At, SceneError};
 use crate::geom::erbs::{ErbsCurve, LocalCurve};
 use crate::geom::shape::{ShapeChange, erbs_knot_probes, erbs_probes, shape_change};
 use crate::geom::{BFunctionKind, GeomError};
-use crate::model::Index2;
-use crate::model::Kind;
-use crate::model::controls::{ControlDisplay, Grip};
 use crate::model::edit::EditError;
 use crate::model::{MAX_CURVE_SAMPLES, check_samples};
-use crate::sampling::SampleMode;
-use crate::sampling::budget::Extent;
 use crate::sampling::budget::check_build;
 use glam::{DMat4, DVec3};
-use serde_json::{Map, Value};
 use std::fmt::Debug;
 
 /// An ERBS curve with its sample count.
@@ -40,85 +31,6 @@ impl ErbsCurveModel {
     #[must_use]
     pub fn samples(&self) -> usize {
         self.samples
-    }
-}
-
-impl Kind for ErbsCurveModel {
-    type Edit = ErbsCurveEdit;
-    type Sampler = ErbsCurveSampler;
-    const SURFACE: bool = false;
-    const LABEL: &'static str = "ERBS curve";
-
-    const TYPES: &'static [&'static str] = &["erbs_curve"];
-
-    fn read(
-        _: &str,
-        at: &At,
-        obj: &Map<String, Value>,
-        common: &[&'static str],
-    ) -> Result<Self, SceneError> {
-        super::file::read_curve(at, obj, common)
-    }
-
-    fn write(&self, out: &mut String) {
-        super::file::write_erbs_curve(out, &self.curve);
-    }
-
-    fn read_edit(&self, at: &At, obj: &Map<String, Value>) -> Result<ErbsCurveEdit, SceneError> {
-        super::file::read_curve_edit(at, obj)
-    }
-
-    fn type_name(&self) -> &'static str {
-        "erbs_curve"
-    }
-
-    fn sample_dims(&self) -> [usize; 2] {
-        [self.samples, 1]
-    }
-
-    fn domain(&self) -> Vec<(f64, f64)> {
-        vec![self.curve.domain()]
-    }
-
-    fn sampler(&self, mode: SampleMode) -> ErbsCurveSampler {
-        ErbsCurveSampler::new(self.clone(), mode.layout().0)
-    }
-
-    fn derivatives_at(
-        &self,
-        [u, _]: [f64; 2],
-        order: usize,
-        _: &[(usize, usize)],
-        out: &mut [DVec3],
-    ) {
-        out.copy_from_slice(&self.curve.derivatives(u, order));
-    }
-
-    fn extent(&self) -> Extent {
-        Extent::erbs_curve(&self.curve, self.samples)
-    }
-
-    fn controls(&self) -> ControlDisplay {
-        curve_controls(&self.curve, None)
-    }
-
-    fn local_controls(&self, local: LocalPath<Index2>) -> Option<ControlDisplay> {
-        Some(curve_controls(&self.curve, Some(local)))
-    }
-
-    fn move_edit(&self, grip: Grip, delta: DVec3) -> Option<ErbsCurveEdit> {
-        let Grip::LocalPoint {
-            local,
-            point: Index2::One(point),
-        } = grip
-        else {
-            return None;
-        };
-        Some(ErbsCurveEdit::Local(LocalEdit::MovePoint {
-            local: local.to_curve()?,
-            point,
-            delta,
-        }))
     }
 }
 

@@ -12,6 +12,7 @@ pub mod surface_sampler;
 
 mod curve;
 mod edit;
+mod kinds;
 mod path;
 mod surface;
 

@@ -1,22 +1,13 @@
 //! The ERBS surface kind: its model and what its edits need of it.
 
-use super::controls::patch_controls;
-use super::surface_sampler::ErbsSurfaceSampler;
 use super::*;
-use crate::format::{At, SceneError};
 use crate::geom::erbs::{ErbsSurface, LocalPatch};
 use crate::geom::shape::{ShapeChange, erbs_knot_probes, erbs_probes, shape_change};
 use crate::geom::{BFunctionKind, GeomError};
-use crate::model::Index2;
-use crate::model::Kind;
 use crate::model::check_surface_samples;
-use crate::model::controls::{ControlDisplay, Grip};
 use crate::model::edit::EditError;
-use crate::sampling::SampleMode;
-use crate::sampling::budget::Extent;
 use crate::sampling::budget::check_build;
 use glam::{DMat4, DVec3};
-use serde_json::{Map, Value};
 use std::fmt::Debug;
 
 /// An ERBS surface with its sample counts [mu, mv].
@@ -40,89 +31,6 @@ impl ErbsSurfaceModel {
     #[must_use]
     pub fn samples(&self) -> [usize; 2] {
         self.samples
-    }
-}
-
-impl Kind for ErbsSurfaceModel {
-    type Edit = ErbsSurfaceEdit;
-    type Sampler = ErbsSurfaceSampler;
-    const SURFACE: bool = true;
-    const LABEL: &'static str = "ERBS surface";
-
-    const TYPES: &'static [&'static str] = &["erbs_surface"];
-
-    fn read(
-        _: &str,
-        at: &At,
-        obj: &Map<String, Value>,
-        common: &[&'static str],
-    ) -> Result<Self, SceneError> {
-        super::file::read_surface(at, obj, common)
-    }
-
-    fn write(&self, out: &mut String) {
-        super::file::write_erbs_surface(out, &self.surface);
-    }
-
-    fn read_edit(&self, at: &At, obj: &Map<String, Value>) -> Result<ErbsSurfaceEdit, SceneError> {
-        super::file::read_surface_edit(at, obj)
-    }
-
-    fn type_name(&self) -> &'static str {
-        "erbs_surface"
-    }
-
-    fn sample_dims(&self) -> [usize; 2] {
-        self.samples
-    }
-
-    fn domain(&self) -> Vec<(f64, f64)> {
-        self.surface.domain().to_vec()
-    }
-
-    fn sampler(&self, mode: SampleMode) -> ErbsSurfaceSampler {
-        let (_, set, normals) = mode.layout();
-        ErbsSurfaceSampler::new(self.clone(), set, normals)
-    }
-
-    fn derivatives_at(
-        &self,
-        [u, v]: [f64; 2],
-        order: usize,
-        list: &[(usize, usize)],
-        out: &mut [DVec3],
-    ) {
-        let p = self.surface.derivatives(u, v, order);
-        for (slot, &(a, b)) in list.iter().enumerate() {
-            out[slot] = p.get(a, b);
-        }
-    }
-
-    fn extent(&self) -> Extent {
-        Extent::erbs_surface(&self.surface, self.samples)
-    }
-
-    fn controls(&self) -> ControlDisplay {
-        patch_controls(&self.surface, None)
-    }
-
-    fn local_controls(&self, local: LocalPath<Index2>) -> Option<ControlDisplay> {
-        Some(patch_controls(&self.surface, Some(local)))
-    }
-
-    fn move_edit(&self, grip: Grip, delta: DVec3) -> Option<ErbsSurfaceEdit> {
-        let Grip::LocalPoint {
-            local,
-            point: Index2::Two(a, b),
-        } = grip
-        else {
-            return None;
-        };
-        Some(ErbsSurfaceEdit::Local(LocalEdit::MovePoint {
-            local: local.to_surface()?,
-            point: [a, b],
-            delta,
-        }))
     }
 }
 

@@ -1,19 +1,10 @@
 //! Bézier, B-spline and NURBS curves: the model and its edits.
 
-use super::curve_sampler::SplineCurveSampler;
-use crate::format::{At, SceneError};
 use crate::geom::shape::{insertion_window, shape_kept, span_probes};
 use crate::geom::{BSplineCurve, GeomError, KnotVector};
-use crate::model::Index2;
-use crate::model::Kind;
-use crate::model::controls::{ControlDisplay, Grip};
 use crate::model::edit::{EditError, KindEdit, Target, check_shape_kept};
 use crate::model::points::PointEdit;
 use crate::model::{MAX_CURVE_SAMPLES, MAX_DEGREE, SplineForm, check_samples};
-use crate::sampling::SampleMode;
-use crate::sampling::budget::Extent;
-use glam::DVec3;
-use serde_json::{Map, Value};
 
 /// A Bézier or B-spline (NURBS with weights) curve with its sample count.
 #[derive(Debug, Clone, PartialEq)]
@@ -55,99 +46,6 @@ impl CurveModel {
     #[must_use]
     pub fn samples(&self) -> usize {
         self.samples
-    }
-}
-
-impl Kind for CurveModel {
-    type Edit = CurveEdit;
-    type Sampler = SplineCurveSampler;
-    const SURFACE: bool = false;
-    const LABEL: &'static str = "curve";
-
-    const TYPES: &'static [&'static str] = super::file::CURVE_TYPES;
-
-    fn read(
-        ty: &str,
-        at: &At,
-        obj: &Map<String, Value>,
-        common: &[&'static str],
-    ) -> Result<Self, SceneError> {
-        super::file::read_curve(ty, at, obj, common)
-    }
-
-    fn write(&self, out: &mut String) {
-        super::file::write_curve(self, out);
-    }
-
-    fn read_edit(&self, at: &At, obj: &Map<String, Value>) -> Result<CurveEdit, SceneError> {
-        super::file::read_curve_edit(at, obj)
-    }
-
-    fn type_name(&self) -> &'static str {
-        match self.form {
-            SplineForm::Bezier => "bezier_curve",
-            SplineForm::BSpline => "bspline_curve",
-        }
-    }
-
-    fn sample_dims(&self) -> [usize; 2] {
-        [self.samples, 1]
-    }
-
-    fn domain(&self) -> Vec<(f64, f64)> {
-        vec![self.curve.domain()]
-    }
-
-    fn sampler(&self, mode: SampleMode) -> SplineCurveSampler {
-        SplineCurveSampler::new(self.clone(), mode.layout().0)
-    }
-
-    fn derivatives_at(
-        &self,
-        [u, _]: [f64; 2],
-        order: usize,
-        _: &[(usize, usize)],
-        out: &mut [DVec3],
-    ) {
-        out.copy_from_slice(&self.curve.derivatives(u, order));
-    }
-
-    fn extent(&self) -> Extent {
-        let c = &self.curve;
-        Extent::polynomial(&[self.samples], &[c.degree()], c.is_rational())
-    }
-
-    fn controls(&self) -> ControlDisplay {
-        ControlDisplay::polygon(self.curve.points().to_vec())
-    }
-
-    fn control_point(&self, point: Index2) -> Option<DVec3> {
-        let Index2::One(k) = point else { return None };
-        self.curve.points().get(k).copied()
-    }
-
-    fn move_edit(&self, grip: Grip, delta: DVec3) -> Option<CurveEdit> {
-        let Grip::Point(Index2::One(point)) = grip else {
-            return None;
-        };
-        Some(CurveEdit::Point(PointEdit::Move { point, delta }))
-    }
-
-    fn weight(&self, grip: Grip) -> Option<f64> {
-        let Grip::Point(Index2::One(k)) = grip else {
-            return None;
-        };
-        self.curve.points().get(k)?;
-        Some(self.curve.weights().map_or(1.0, |w| w[k]))
-    }
-
-    fn weight_edit(&self, grip: Grip, weight: f64) -> Result<CurveEdit, String> {
-        match grip {
-            Grip::Point(Index2::One(point)) => {
-                Ok(CurveEdit::Point(PointEdit::Weight { point, weight }))
-            }
-            _ => Err(format!("a {} has no such control point", self.type_name())),
-        }
     }
 }
 

@@ -4,7 +4,9 @@
 pub mod curve;
 pub mod curve_sampler;
 pub mod file;
+pub mod form;
 #[cfg(test)]
 mod kernel_tests;
+mod kinds;
 pub mod surface;
 pub mod surface_sampler;

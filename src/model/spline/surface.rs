@@ -1,20 +1,12 @@
 //! Tensor-product Bézier, B-spline and NURBS surfaces: the model and its edits.
 
 use super::curve::{check_elevation, check_insertion, check_restore, replace};
-use super::surface_sampler::SplineSurfaceSampler;
-use crate::format::{At, SceneError};
 use crate::geom::shape::{greville, insertion_window, shape_kept, span_probes};
 use crate::geom::{KnotVector, TensorSurface};
-use crate::model::Index2;
-use crate::model::Kind;
-use crate::model::controls::{ControlDisplay, Grip};
 use crate::model::edit::{EditError, KindEdit, Target, check_shape_kept};
 use crate::model::points::PointEdit;
 use crate::model::{SplineForm, check_surface_samples};
-use crate::sampling::SampleMode;
-use crate::sampling::budget::Extent;
 use glam::DVec3;
-use serde_json::{Map, Value};
 
 /// A Bézier or B-spline (NURBS with weights) surface with its sample counts [mu, mv].
 #[derive(Debug, Clone, PartialEq)]
@@ -64,110 +56,6 @@ impl SurfaceModel {
     /// [`SurfaceEdit`].
     pub fn map_points(&mut self, f: impl Fn(DVec3) -> DVec3) {
         self.surface.map_points(f);
-    }
-}
-
-impl Kind for SurfaceModel {
-    type Edit = SurfaceEdit;
-    type Sampler = SplineSurfaceSampler;
-    const SURFACE: bool = true;
-    const LABEL: &'static str = "surface";
-
-    const TYPES: &'static [&'static str] = super::file::SURFACE_TYPES;
-
-    fn read(
-        ty: &str,
-        at: &At,
-        obj: &Map<String, Value>,
-        common: &[&'static str],
-    ) -> Result<Self, SceneError> {
-        super::file::read_surface(ty, at, obj, common)
-    }
-
-    fn write(&self, out: &mut String) {
-        super::file::write_surface(self, out);
-    }
-
-    fn read_edit(&self, at: &At, obj: &Map<String, Value>) -> Result<SurfaceEdit, SceneError> {
-        super::file::read_surface_edit(at, obj)
-    }
-
-    fn type_name(&self) -> &'static str {
-        match self.form {
-            SplineForm::Bezier => "bezier_surface",
-            SplineForm::BSpline => "bspline_surface",
-        }
-    }
-
-    fn sample_dims(&self) -> [usize; 2] {
-        self.samples
-    }
-
-    fn domain(&self) -> Vec<(f64, f64)> {
-        self.surface.domain().to_vec()
-    }
-
-    fn sampler(&self, mode: SampleMode) -> SplineSurfaceSampler {
-        let (_, set, normals) = mode.layout();
-        SplineSurfaceSampler::new(self.clone(), set, normals)
-    }
-
-    fn derivatives_at(
-        &self,
-        [u, v]: [f64; 2],
-        order: usize,
-        list: &[(usize, usize)],
-        out: &mut [DVec3],
-    ) {
-        let p = self.surface.derivatives(u, v, order);
-        for (slot, &(a, b)) in list.iter().enumerate() {
-            out[slot] = p.get(a, b);
-        }
-    }
-
-    fn extent(&self) -> Extent {
-        let s = &self.surface;
-        Extent::polynomial(&self.samples, &s.degree(), s.is_rational())
-    }
-
-    fn controls(&self) -> ControlDisplay {
-        ControlDisplay::net(self.surface.count(), self.surface.points().to_vec())
-    }
-
-    fn control_point(&self, point: Index2) -> Option<DVec3> {
-        let Index2::Two(i, j) = point else {
-            return None;
-        };
-        let [rows, cols] = self.surface.count();
-        (i < rows && j < cols).then(|| self.surface.point(i, j))
-    }
-
-    fn move_edit(&self, grip: Grip, delta: DVec3) -> Option<SurfaceEdit> {
-        let Grip::Point(Index2::Two(i, j)) = grip else {
-            return None;
-        };
-        Some(SurfaceEdit::Point(PointEdit::Move {
-            point: [i, j],
-            delta,
-        }))
-    }
-
-    fn weight(&self, grip: Grip) -> Option<f64> {
-        let Grip::Point(Index2::Two(i, j)) = grip else {
-            return None;
-        };
-        let [rows, cols] = self.surface.count();
-        (i < rows && j < cols).then(|| self.surface.weights().map_or(1.0, |w| w[i * cols + j]))
-    }
-
-    fn weight_edit(&self, grip: Grip, weight: f64) -> Result<SurfaceEdit, String> {
-        match grip {
-            Grip::Point(Index2::Two(i, j)) => Ok(SurfaceEdit::Point(PointEdit::Weight {
-                point: [i, j],
-                weight,
-            })),
-            _ => Err(format!("a {} has no such control point", self.type_name())),
-        }
     }
 }
 

@@ -1,0 +1,184 @@
+//! The chain kinds' entries in the table of kinds: what ties each model to its sampler (the
+//! B-spline of its Bézier chain), its scene-file fields and its control polygon.
+
+use super::file;
+use super::sampler::ChainCurveSampler;
+use super::{BezierSplineEdit, BezierSplineModel, CatmullRomEdit, CatmullRomModel, ChainModel};
+use crate::format::{At, SceneError};
+use crate::model::controls::{ControlDisplay, Grip};
+use crate::model::index::Index2;
+use crate::model::kind::Kind;
+use crate::model::points::PointEdit;
+use crate::model::spline::curve::CurveModel;
+use crate::sampling::SampleMode;
+use crate::sampling::budget::Extent;
+use glam::DVec3;
+use serde_json::{Map, Value};
+
+impl Kind for CatmullRomModel {
+    type Edit = CatmullRomEdit;
+    type Sampler = ChainCurveSampler<CatmullRomEdit>;
+    const SURFACE: bool = false;
+    const LABEL: &'static str = "Catmull–Rom";
+
+    const TYPES: &'static [&'static str] = &["catmull_rom"];
+
+    fn read(
+        _: &str,
+        at: &At,
+        obj: &Map<String, Value>,
+        common: &[&'static str],
+    ) -> Result<Self, SceneError> {
+        file::read_catmull_rom(at, obj, common)
+    }
+
+    fn write(&self, out: &mut String) {
+        file::write_catmull_rom(self, out);
+    }
+
+    fn read_edit(&self, at: &At, obj: &Map<String, Value>) -> Result<CatmullRomEdit, SceneError> {
+        file::read_catmull_rom_edit(at, obj)
+    }
+
+    fn type_name(&self) -> &'static str {
+        "catmull_rom"
+    }
+
+    fn sample_dims(&self) -> [usize; 2] {
+        [self.samples(), 1]
+    }
+
+    fn domain(&self) -> Vec<(f64, f64)> {
+        vec![self.spline().domain()]
+    }
+
+    fn sampler(&self, mode: SampleMode) -> Self::Sampler {
+        ChainCurveSampler::new(self.clone(), mode.layout().0)
+    }
+
+    fn to_bspline_curve(&self) -> Option<CurveModel> {
+        Some(self.chain_form())
+    }
+
+    fn derivatives_at(
+        &self,
+        [u, _]: [f64; 2],
+        order: usize,
+        _: &[(usize, usize)],
+        out: &mut [DVec3],
+    ) {
+        out.copy_from_slice(&self.chain_form().curve().derivatives(u, order));
+    }
+
+    fn junctions(&self) -> Option<(Vec<f64>, bool)> {
+        Some((self.spline().breakpoints(), self.spline().closed()))
+    }
+
+    /// Cubic segments.
+    fn extent(&self) -> Extent {
+        Extent::polynomial(&[self.samples()], &[3], false)
+    }
+
+    /// The interpolated points.
+    fn controls(&self) -> ControlDisplay {
+        ControlDisplay::polygon(self.spline().points().to_vec())
+    }
+
+    fn move_edit(&self, grip: Grip, delta: DVec3) -> Option<CatmullRomEdit> {
+        let Grip::Point(Index2::One(point)) = grip else {
+            return None;
+        };
+        Some(CatmullRomEdit::Point(PointEdit::Move { point, delta }))
+    }
+
+    fn weight_edit(&self, _grip: Grip, _weight: f64) -> Result<Self::Edit, String> {
+        Err(format!(
+            "a {} has no weights: B converts it to a bspline_curve first",
+            self.type_name()
+        ))
+    }
+}
+
+impl Kind for BezierSplineModel {
+    type Edit = BezierSplineEdit;
+    type Sampler = ChainCurveSampler<BezierSplineEdit>;
+    const SURFACE: bool = false;
+    const LABEL: &'static str = "Bézier spline";
+
+    const TYPES: &'static [&'static str] = &["bezier_spline"];
+
+    fn read(
+        _: &str,
+        at: &At,
+        obj: &Map<String, Value>,
+        common: &[&'static str],
+    ) -> Result<Self, SceneError> {
+        file::read_bezier_spline(at, obj, common)
+    }
+
+    fn write(&self, out: &mut String) {
+        file::write_bezier_spline(self, out);
+    }
+
+    fn read_edit(&self, at: &At, obj: &Map<String, Value>) -> Result<BezierSplineEdit, SceneError> {
+        file::read_bezier_spline_edit(at, obj)
+    }
+
+    fn type_name(&self) -> &'static str {
+        "bezier_spline"
+    }
+
+    fn sample_dims(&self) -> [usize; 2] {
+        [self.samples(), 1]
+    }
+
+    fn domain(&self) -> Vec<(f64, f64)> {
+        vec![self.spline().domain()]
+    }
+
+    fn sampler(&self, mode: SampleMode) -> Self::Sampler {
+        ChainCurveSampler::new(self.clone(), mode.layout().0)
+    }
+
+    fn to_bspline_curve(&self) -> Option<CurveModel> {
+        Some(self.chain_form())
+    }
+
+    fn derivatives_at(
+        &self,
+        [u, _]: [f64; 2],
+        order: usize,
+        _: &[(usize, usize)],
+        out: &mut [DVec3],
+    ) {
+        out.copy_from_slice(&self.chain_form().curve().derivatives(u, order));
+    }
+
+    fn junctions(&self) -> Option<(Vec<f64>, bool)> {
+        Some((self.spline().knots().to_vec(), false))
+    }
+
+    fn extent(&self) -> Extent {
+        Extent::polynomial(&[self.samples()], &[self.spline().degree()], false)
+    }
+
+    /// Bézier points, or the de Boor polygon of splines edited through it (their Bézier points
+    /// are drawn as an overlay).
+    fn controls(&self) -> ControlDisplay {
+        ControlDisplay::polygon(self.spline().handles())
+    }
+
+    fn move_edit(&self, grip: Grip, delta: DVec3) -> Option<BezierSplineEdit> {
+        let Grip::Point(Index2::One(point)) = grip else {
+            return None;
+        };
+        Some(BezierSplineEdit::Move { point, delta })
+    }
+
+    fn weight_edit(&self, _grip: Grip, _weight: f64) -> Result<Self::Edit, String> {
+        Err(format!(
+            "a {} has no weights: B converts it to a bspline_curve first",
+            self.type_name()
+        ))
+    }
+}
