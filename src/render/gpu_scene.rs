@@ -105,6 +105,8 @@ pub struct GpuScene {
     /// The curvature map's scalars, built by the first upload after the map changed.
     scalars: Option<MapScalars>,
     scratch: Vec<f32>,
+    /// Some surface's LOD metrics were dropped since [`GpuScene::measure_grids`] last ran.
+    unmeasured: bool,
     /// Per arena, the frame slots not yet written since the arena was created.
     unfilled: Vec<[bool; FRAMES_IN_FLIGHT]>,
     /// `--redraw`: whether gestures draw from a static layer.
@@ -170,6 +172,7 @@ impl GpuScene {
             scalars: None,
             scratch: Vec::new(),
             unfilled: Vec::with_capacity(sizes.len()),
+            unmeasured: true,
             redraw: Redraw::default(),
             gesture: None,
             layer: None,
@@ -342,6 +345,7 @@ impl GpuScene {
                 if self.gesture.is_none_or(|g| g.object != i) {
                     o.lod = None;
                     o.metrics = None;
+                    self.unmeasured = true;
                 }
                 o.bounds = None;
                 let cols = doc.objects[i].sampled.grid().dims[1];
@@ -460,6 +464,7 @@ impl GpuScene {
         if let Some(o) = self.gesture.and_then(|g| self.objects.get_mut(g.object)) {
             o.lod = None;
             o.metrics = None;
+            self.unmeasured = true;
         }
         self.gesture = gesture;
         self.layer = None;
@@ -609,6 +614,10 @@ impl GpuScene {
     /// Measures every surface not measured since its samples last changed, on every core:
     /// after a load that is one pass over all the samples of the scene.
     fn measure_grids(&mut self, doc: &Document) {
+        // Most frames change no samples: skip the pass over every object then.
+        if !std::mem::take(&mut self.unmeasured) {
+            return;
+        }
         let stale: Vec<usize> = self
             .groups
             .iter()
