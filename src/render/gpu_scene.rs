@@ -521,7 +521,7 @@ impl GpuScene {
             report.full_triangles += 2 * GridStride::FULL.cells(shape) * n;
         }
         let before = frame.stats().surface_triangles;
-        if self.draw_retained(frame, doc, opts, hl, &order)? {
+        if self.draw_retained(frame, doc, opts, hl, &order, report.triangles)? {
             report.retained = true;
             report.retained_of = report.triangles;
             report.triangles = frame.stats().surface_triangles - before;
@@ -705,7 +705,8 @@ impl GpuScene {
     /// Draws the frame's surfaces and lines from the static layer when a gesture allows it:
     /// restores a valid layer or builds one, then draws the dynamic set. `false`: nothing was
     /// drawn, draw everything (no gesture, `--redraw full`, isolines on, or a target without
-    /// a layer).
+    /// a layer). `triangles`: the surface triangles of a full redraw of `order`.
+    #[allow(clippy::too_many_arguments)]
     fn draw_retained(
         &mut self,
         frame: &mut Frame<'_>,
@@ -713,6 +714,7 @@ impl GpuScene {
         opts: &ViewOptions,
         hl: &Highlight,
         order: &[Batch],
+        triangles: u64,
     ) -> GpuResult<bool> {
         let Some(g) = self.gesture.filter(|_| self.redraw == Redraw::Retained) else {
             self.layer = None;
@@ -763,7 +765,7 @@ impl GpuScene {
                 split_cells(shape, order[bi].stride, &support, self.drop_chunk)
             });
             let [w, h] = key.extent.map(u64::from);
-            if !self.layer_always && !worth_a_layer(cells.as_ref(), order, &self.groups, w * h) {
+            if !self.layer_always && !worth_a_layer(cells.as_ref(), triangles, w * h) {
                 self.unworthy = Some(key);
                 return Ok(false);
             }
@@ -1422,25 +1424,16 @@ fn arena_layout(doc: &Document) -> (Vec<Place>, Vec<usize>) {
 }
 
 /// Whether a static layer pays for a gesture whose dragged surface splits into `cells`
-/// (`None`: the gesture moves a curve, and every surface stays in the layer) on a target of
-/// `pixels`. Restoring the layer copies every pixel each frame (about 0.7 ms at 1280 × 720 on
+/// (`None`: the gesture moves a curve, and every surface stays in the layer) in a frame of
+/// `all` surface triangles on a target of `pixels`. Restoring the layer copies every pixel each frame (about 0.7 ms at 1280 × 720 on
 /// lavapipe, as much as drawing a few thousand surface triangles: docs/performance.md), so
 /// what stays in it must be a surface triangle per [`PIXELS_PER_KEPT_TRIANGLE`] pixels at
 /// least, and a quarter of the frame's triangles. Otherwise the frame is drawn in full: a
 /// scene of curves only, or an ERBS local patch whose support is the whole surface.
-fn worth_a_layer(
-    cells: Option<&SplitCells>,
-    order: &[Batch],
-    groups: &[SurfaceGroup],
-    pixels: u64,
-) -> bool {
+fn worth_a_layer(cells: Option<&SplitCells>, all: u64, pixels: u64) -> bool {
     let dynamic: u64 = cells.map_or(0, |c| {
         c.dynamic.iter().map(|&(_, n)| u64::from(n) / 3).sum()
     });
-    let all: u64 = order
-        .iter()
-        .map(|b| 2 * b.stride.cells(groups[b.group].shape) * b.members.len() as u64)
-        .sum();
     let kept = all.saturating_sub(dynamic);
     kept * PIXELS_PER_KEPT_TRIANGLE >= pixels && 4 * dynamic < 3 * all
 }
