@@ -1563,7 +1563,32 @@ fn vertex_floats(vertices: &[DVec3]) -> Vec<f32> {
 
 #[cfg(test)]
 mod tests {
-    use super::fill_runs;
+    use super::{SplitCells, fill_runs, worth_a_layer};
+
+    /// Split cells whose dynamic part is `triangles` triangles.
+    fn dynamic(triangles: u32) -> SplitCells {
+        SplitCells {
+            dynamic: vec![(0, 3 * triangles)],
+            fixed: Vec::new(),
+            chunks: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn a_layer_pays_only_for_enough_kept_triangles_and_a_small_dynamic_set() {
+        let pixels = 1280 * 720;
+        // Plenty kept, a tenth dynamic: a layer.
+        assert!(worth_a_layer(Some(&dynamic(10_000)), 100_000, pixels));
+        // A curve moving over many surface triangles: a layer.
+        assert!(worth_a_layer(None, 100_000, pixels));
+        // Curves only: nothing would stay in the layer.
+        assert!(!worth_a_layer(None, 0, pixels));
+        // A small dynamic set, but too few triangles kept for the copy.
+        assert!(!worth_a_layer(Some(&dynamic(100)), 1_000, pixels));
+        // Enough kept, but the dynamic set is most of the frame.
+        assert!(!worth_a_layer(Some(&dynamic(80_000)), 100_000, pixels));
+        assert!(!worth_a_layer(Some(&dynamic(100_000)), 100_000, pixels));
+    }
 
     #[test]
     fn fill_runs_cover_the_members_in_order() {
