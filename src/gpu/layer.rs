@@ -2,6 +2,10 @@
 //! that a frame can save its attachments into mid-frame and a later frame can start from,
 //! instead of clearing ([`Frame::save_static_layer`], [`Frame::restore_static_layer`]).
 //!
+//! The restore is an image copy rather than a full-screen draw: on lavapipe a copy is a row
+//! `memcpy`, while a full-screen quad runs the JIT fragment path over every pixel, over 5× the
+//! cost before it reads a texel (docs/performance.md, "Copy or full-screen draw").
+//!
 //! Only single-sampled targets have one: a multisampled depth buffer cannot be resolved into a
 //! layer that restores bit for bit, and lavapipe, where redrawing costs most, renders MSAA 1.
 //!
