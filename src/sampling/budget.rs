@@ -297,7 +297,9 @@ impl Layout {
 }
 
 /// Hermite tables: per direction m × rows × (d+1) f64; an ERBS local's table covers its
-/// support, and every sample lies in the supports of two locals per direction.
+/// support, and every sample lies in the supports of two locals per direction. Counted per
+/// object: B-spline objects with equal knots and sample counts share one table
+/// (`HermiteTable::shared`), which the extent cannot see, so for them this is an upper bound.
 fn add_tables(e: &mut Estimate, extent: &Extent, at: &Layout) {
     let mut table_bytes = 0u128;
     let mut table_formula = Vec::new();

@@ -11,12 +11,13 @@ use crate::sampling::rational::QuotientRule;
 use crate::sampling::tables::axis::{HermiteTable, dot};
 use glam::{DVec3, DVec4};
 use std::ops::Range;
+use std::sync::Arc;
 
 /// A curve with its pre-evaluation data and canonical samples c^(r)(S_j), r ≤ g.
 #[derive(Debug, Clone)]
 pub struct SplineCurveSampler {
     model: CurveModel,
-    table: HermiteTable,
+    table: Arc<HermiteTable>,
     grid: SampleGrid,
     /// Homogeneous samples of (w·c, w) for rational curves, same layout as the grid.
     hom: Option<Vec<DVec4>>,
@@ -28,7 +29,7 @@ impl SplineCurveSampler {
     pub fn new(model: CurveModel, order: usize) -> Self {
         let curve = model.curve();
         let n = curve.points().len();
-        let table = HermiteTable::new(curve.knots(), curve.degree(), n, model.samples(), order);
+        let table = HermiteTable::shared(curve.knots(), curve.degree(), n, model.samples(), order);
         let set = PartialSet::Curve(order);
         let grid = SampleGrid::new([model.samples(), 1], set.clone(), false);
         let mut s = Self {
@@ -115,7 +116,7 @@ impl SplineCurveSampler {
     /// shape (and so every sample) is unchanged.
     fn retabulate(&mut self) {
         let c = self.model.curve();
-        self.table = self.table.refit(c.knots(), c.degree(), c.points().len());
+        self.table = Arc::new(self.table.refit(c.knots(), c.degree(), c.points().len()));
     }
 
     fn add_polynomial(&mut self, k: usize, delta: DVec3) {

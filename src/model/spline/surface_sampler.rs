@@ -15,13 +15,14 @@ use crate::sampling::rational::QuotientRule;
 use crate::sampling::tables::axis::{HermiteTable, dot};
 use glam::{DVec3, DVec4};
 use std::ops::Range;
+use std::sync::Arc;
 
 /// A surface with per-direction pre-evaluation data (storage grows with mu + mv, not mu·mv) and
 /// its canonical samples.
 #[derive(Debug, Clone)]
 pub struct SplineSurfaceSampler {
     model: SurfaceModel,
-    tables: [HermiteTable; 2],
+    tables: [Arc<HermiteTable>; 2],
     grid: SampleGrid,
     /// (a, b) of each slot, cached.
     partials: Vec<(usize, usize)>,
@@ -41,8 +42,8 @@ impl SplineSurfaceSampler {
         let [du, dv] = surface.degree();
         let [ku, kv] = surface.knots();
         let tables = [
-            HermiteTable::new(ku, du, nu, samples[0], g),
-            HermiteTable::new(kv, dv, nv, samples[1], g),
+            HermiteTable::shared(ku, du, nu, samples[0], g),
+            HermiteTable::shared(kv, dv, nv, samples[1], g),
         ];
         let grid = SampleGrid::new(samples, set.clone(), normals);
         let partials = set.list();
@@ -225,7 +226,8 @@ impl SplineSurfaceSampler {
         for dir in 0..2 {
             let t = &self.tables[dir];
             if !t.tabulates(&s.knots()[dir], s.degree()[dir], s.count()[dir]) {
-                self.tables[dir] = t.refit(&s.knots()[dir], s.degree()[dir], s.count()[dir]);
+                self.tables[dir] =
+                    Arc::new(t.refit(&s.knots()[dir], s.degree()[dir], s.count()[dir]));
             }
         }
     }
@@ -342,7 +344,7 @@ impl crate::model::kind::Support for SplineSurfaceSampler {
 
 /// The sample parameters of both directions.
 #[must_use]
-fn params(tables: &[HermiteTable; 2]) -> [&[f64]; 2] {
+fn params(tables: &[Arc<HermiteTable>; 2]) -> [&[f64]; 2] {
     [tables[0].params.as_slice(), tables[1].params.as_slice()]
 }
 

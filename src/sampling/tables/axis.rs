@@ -3,7 +3,9 @@
 use crate::geom::basis::hermite_rows_into;
 use crate::geom::knots::{KnotVector, uniform_params};
 use crate::geom::point::binomial;
+use std::collections::HashMap;
 use std::ops::Range;
+use std::sync::{Arc, Mutex, OnceLock, PoisonError, Weak};
 
 /// Pre-evaluated basis data for one direction: sample parameters S, the span of each sample,
 /// the rows 0..=g of the B-spline-Hermite matrix at each sample, and per control point the index
@@ -35,6 +37,47 @@ impl HermiteTable {
         let (a, b) = knots.domain(degree, n);
         let params = uniform_params(a, b, samples);
         Self::at_params(knots, degree, n, params, order)
+    }
+
+    /// [`HermiteTable::new`], shared with every live object that asked for the same knots,
+    /// degree, count, sample count and order. The patches of a CAD model mostly share their
+    /// knot vectors (every patch of the Utah teapot has the same two), and a table is never
+    /// changed once built (a refinement builds a new one), so sharing saves its memory and its
+    /// construction and leaves every value bit for bit what a fresh build gives.
+    #[must_use]
+    pub fn shared(
+        knots: &KnotVector,
+        degree: usize,
+        n: usize,
+        samples: usize,
+        order: usize,
+    ) -> Arc<Self> {
+        let key = TableKey {
+            knots: knots.iter().map(|k| k.to_bits()).collect(),
+            shape: [degree, n, samples, order],
+        };
+        let lock = || {
+            SHARED
+                .get_or_init(Mutex::default)
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner)
+        };
+        if let Some(table) = lock().tables.get(&key).and_then(Weak::upgrade) {
+            return table;
+        }
+        // Built outside the lock, so objects pre-evaluated on other cores do not wait; two
+        // cores building the same table build equal ones, and the first stored is kept.
+        let built = Arc::new(Self::new(knots, degree, n, samples, order));
+        let mut shared = lock();
+        let table = match shared.tables.get(&key).and_then(Weak::upgrade) {
+            Some(table) => table,
+            None => {
+                shared.tables.insert(key, Arc::downgrade(&built));
+                built
+            }
+        };
+        shared.forget_dead();
+        table
     }
 
     /// Pre-evaluation at given parameters (non-decreasing, inside the domain).
@@ -273,9 +316,79 @@ where
     acc
 }
 
+/// What a shared table is built from: the knots' bits and (degree, count, samples, order).
+#[derive(Debug, PartialEq, Eq, Hash)]
+struct TableKey {
+    knots: Vec<u64>,
+    shape: [usize; 4],
+}
+
+/// The tables [`HermiteTable::shared`] handed out, held weakly: a table lives as long as an
+/// object uses it.
+#[derive(Default)]
+struct SharedTables {
+    tables: HashMap<TableKey, Weak<HermiteTable>>,
+    /// Entries at the last sweep of dead ones; the next sweep waits until the map doubles, so
+    /// sweeping costs O(1) per insertion amortised.
+    swept: usize,
+}
+
+impl SharedTables {
+    fn forget_dead(&mut self) {
+        if self.tables.len() >= 2 * self.swept.max(32) {
+            self.tables.retain(|_, t| t.strong_count() > 0);
+            self.swept = self.tables.len();
+        }
+    }
+}
+
+static SHARED: OnceLock<Mutex<SharedTables>> = OnceLock::new();
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Equal inputs share one table while it lives; any differing input gets its own; a
+    /// table nobody holds is rebuilt, equal to a fresh build.
+    #[test]
+    fn tables_are_shared_by_equal_inputs_only() {
+        // Knots no other test uses, so tables of tests running alongside cannot interfere.
+        let knots = KnotVector::clamped_uniform(3, 7, 0.125, 0.9375);
+        let a = HermiteTable::shared(&knots, 3, 7, 33, 2);
+        let b = HermiteTable::shared(&knots, 3, 7, 33, 2);
+        assert!(Arc::ptr_eq(&a, &b), "equal inputs share");
+        let moved = KnotVector::clamped_uniform(3, 7, 0.125, 0.9376);
+        let differing = [
+            HermiteTable::shared(&moved, 3, 7, 33, 2),
+            HermiteTable::shared(&knots, 3, 7, 34, 2),
+            HermiteTable::shared(&knots, 3, 7, 33, 1),
+        ];
+        for d in &differing {
+            assert!(
+                !Arc::ptr_eq(&a, d),
+                "a differing input builds its own table"
+            );
+        }
+        let fresh = HermiteTable::new(&knots, 3, 7, 33, 2);
+        let same = |t: &HermiteTable| {
+            t.params == fresh.params
+                && t.spans == fresh.spans
+                && t.m
+                    .iter()
+                    .map(|x| x.to_bits())
+                    .eq(fresh.m.iter().map(|x| x.to_bits()))
+                && t.ranges == fresh.ranges
+        };
+        assert!(same(&a));
+        assert!(
+            !same(&differing[1]),
+            "negative control: the comparison sees a difference"
+        );
+        let weak = Arc::downgrade(&a);
+        drop((a, b));
+        assert!(weak.upgrade().is_none(), "the cache holds no table alive");
+        assert!(same(&HermiteTable::shared(&knots, 3, 7, 33, 2)));
+    }
 
     #[test]
     fn paper_example_ranges_cover_pieces_two_to_five() {
