@@ -210,7 +210,7 @@ impl Document {
             for p in g.data.iter().step_by(g.stride()) {
                 b.include(*p);
             }
-            for (_, p) in o.controls.grips() {
+            for p in o.controls.grip_points() {
                 b.include(p);
             }
             b

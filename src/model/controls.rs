@@ -139,6 +139,21 @@ impl ControlDisplay {
     }
 }
 
+impl ControlDisplay {
+    /// The positions of [`ControlDisplay::grips`], in the same order, without building the
+    /// grips (a net can have millions of points; bounds need only where they are).
+    pub fn grip_points(&self) -> impl Iterator<Item = DVec3> + '_ {
+        let ranges: Box<dyn Iterator<Item = std::ops::Range<usize>> + '_> = match &self.layout {
+            ControlLayout::Polygon { count } => Box::new(std::iter::once(0..*count)),
+            ControlLayout::Net { rows, cols } => Box::new(std::iter::once(0..rows * cols)),
+            ControlLayout::LocalCurves(entries) | ControlLayout::LocalPatches(entries) => {
+                Box::new(entries.iter().map(|e| e.points..e.points + e.rows * e.cols))
+            }
+        };
+        ranges.flat_map(|r| self.vertices[r].iter().copied())
+    }
+}
+
 /// Display sample vertices of one local in `layout`.
 pub(super) fn display_samples(layout: &ControlLayout) -> usize {
     match layout {

@@ -57,10 +57,12 @@ macro_rules! kinds {
             Replace(Box<Model>),
         }
 
-        /// A scene object with pre-evaluation data and its canonical sample grid.
+        /// A scene object with pre-evaluation data and its canonical sample grid. Boxed: the
+        /// kinds' samplers differ in size by hundreds of bytes, and a scene of many small
+        /// objects should not pay the largest kind's size for each.
         #[derive(Debug, Clone)]
         pub enum SampledObject {
-            $($v($crate::sampling::Tracked<<$m as $crate::model::Kind>::Sampler>),)+
+            $($v(Box<$crate::sampling::Tracked<<$m as $crate::model::Kind>::Sampler>>),)+
         }
 
         $(
@@ -107,7 +109,7 @@ macro_rules! kinds {
                 for SampledObject
             {
                 fn from(s: $crate::sampling::Tracked<<$m as $crate::model::Kind>::Sampler>) -> Self {
-                    SampledObject::$v(s)
+                    SampledObject::$v(Box::new(s))
                 }
             }
         )+
@@ -192,13 +194,13 @@ macro_rules! kinds {
         impl SampledObject {
             pub(super) fn sampler(&self) -> &dyn DynSampler {
                 match self {
-                    $(SampledObject::$v(s) => s,)+
+                    $(SampledObject::$v(s) => s.as_ref(),)+
                 }
             }
 
             pub(super) fn sampler_mut(&mut self) -> &mut dyn DynSampler {
                 match self {
-                    $(SampledObject::$v(s) => s,)+
+                    $(SampledObject::$v(s) => s.as_mut(),)+
                 }
             }
         }

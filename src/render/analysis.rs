@@ -162,8 +162,13 @@ pub fn curve_pieces(model: ModelRef<'_>, params: &[f64]) -> Vec<std::ops::Range<
     let curve = c.curve();
     let d = curve.degree();
     let (a, b) = curve.domain();
-    let may_tear = |t: f64| t > a && t < b && curve.knots().multiplicity(t) > d;
-    if !curve.knots().breakpoints(a, b).into_iter().any(may_tear) {
+    // One pass over the runs of equal knots: a curve read from a file can have millions, and
+    // asking each breakpoint for its multiplicity would scan them all per breakpoint.
+    let tears = curve
+        .knots()
+        .chunk_by(|x, y| x == y)
+        .any(|run| run.len() > d && run[0] > a && run[0] < b);
+    if !tears {
         return whole;
     }
     let mut cuts: Vec<usize> = curve_joins(model)

@@ -57,7 +57,7 @@ pub fn framing_points(doc: &Document, nets: impl Fn(usize) -> bool) -> Vec<DVec3
     let samples: usize = (0..doc.objects.len()).map(count).sum();
     let handles: Vec<DVec3> = (0..doc.objects.len())
         .filter(|&i| nets(i))
-        .flat_map(|i| doc.handles(i).into_iter().map(|(_, p)| p))
+        .flat_map(|i| doc.objects[i].controls.grip_points())
         .collect();
     let every = (samples + handles.len()).div_ceil(MAX).max(1);
     let mut points: Vec<DVec3> = handles.into_iter().step_by(every).collect();

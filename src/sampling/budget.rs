@@ -17,6 +17,8 @@ const F64: u128 = 8;
 const VEC3: u128 = 24;
 const VEC4: u128 = 32;
 const F32: u128 = 4;
+/// A point: three f64.
+const DVEC3: u128 = 24;
 /// A span index.
 const USIZE: u128 = std::mem::size_of::<usize>() as u128;
 /// Frames in flight, each with its own mirror (see `gpu::FRAMES_IN_FLIGHT`; `sampling` does not
@@ -31,6 +33,10 @@ const CONTROL_MIRROR: u128 = 2048;
 /// with the allocator's headers. Small beside any object's samples, it is what a scene of many
 /// small objects adds up.
 const OBJECT_BYTES: u128 = 4096;
+/// Of [`OBJECT_BYTES`], what does not grow with the control points (those are
+/// [`Extent::control_bytes`]): an object costs at least `OBJECT_BYTES`, and its structure
+/// plus its control bytes where those are more.
+const OBJECT_STRUCTURE: u128 = 3072;
 /// Vertices one entry of a surface batch's multi-draw covers at most (`gpu::RUN_VERTICES`).
 pub const RUN_VERTICES: u64 = 1 << 16;
 /// Budget when physical memory cannot be read.
@@ -50,6 +56,16 @@ pub struct Extent {
     /// ERBS locals that are ERBS themselves: each a level of its own, pre-evaluated at the
     /// parent's samples inside its support (its `samples`).
     pub nested: Vec<Extent>,
+    /// Vertices of the object's control display (a net's points; an ERBS object's local
+    /// display samples and points), each mirrored to the GPU in every frame slot.
+    pub control_vertices: usize,
+    /// Host bytes that grow with the object's control points: the model's points, weights and
+    /// knots, the sampler's per-point ranges and the control display, as the kind counts them
+    /// (a curve read from a file can have millions of points).
+    pub control_bytes: u128,
+    /// Identifies the object's Hermite tables where objects with equal knots and sample
+    /// counts share them (`HermiteTable::shared`): a scene counts each such key's tables once.
+    pub shared_tables: Option<u64>,
 }
 
 impl Extent {
@@ -62,7 +78,45 @@ impl Extent {
             rational,
             erbs_locals: None,
             nested: Vec::new(),
+            control_vertices: 0,
+            control_bytes: 0,
+            shared_tables: None,
         }
+    }
+
+    /// This extent with its control display's `vertices` and the host `bytes` that grow with
+    /// the control points ([`Extent::control_bytes`]).
+    #[must_use]
+    pub fn with_controls(mut self, vertices: usize, bytes: u128) -> Self {
+        self.control_vertices = vertices;
+        self.control_bytes = bytes;
+        self
+    }
+
+    /// This extent with tables shared under `key` (a hash of what the tables are built from,
+    /// equal exactly when the tables are).
+    #[must_use]
+    pub fn with_shared_tables(mut self, key: u64) -> Self {
+        self.shared_tables = Some(key);
+        self
+    }
+
+    /// [`Extent::with_controls`] for a B-spline net of `points` control points with `knots`
+    /// knots in all and `directions` Hermite tables: the model's points (and weights), the
+    /// display's copy of them, the knots and each table's per-point influence range.
+    #[must_use]
+    pub fn with_net(self, points: usize, knots: usize, directions: usize, rational: bool) -> Self {
+        let per_point = 2 * DVEC3 + if rational { F64 } else { 0 };
+        let per_range = 2 * USIZE;
+        // A surface's tables hold one range per row and per column; bounded by the points.
+        let ranges = if directions == 1 {
+            points as u128
+        } else {
+            (points as u128).min(2 * (points as f64).sqrt().ceil() as u128 + 2)
+        };
+        // The knots twice: the model's and the copy each table keeps to tell a refinement.
+        let bytes = points as u128 * per_point + 2 * knots as u128 * F64 + ranges * per_range;
+        self.with_controls(points, bytes)
     }
 
     /// An ERBS curve sampled `m` times.
@@ -119,6 +173,9 @@ fn erbs_curve_extent(c: &ErbsCurve, m: usize) -> Extent {
         rational: false,
         erbs_locals: Some(vec![locals.len()]),
         nested,
+        control_vertices: 0,
+        control_bytes: 0,
+        shared_tables: None,
     }
 }
 
@@ -150,6 +207,9 @@ fn erbs_surface_extent(s: &ErbsSurface, dims: [usize; 2]) -> Extent {
         rational: false,
         erbs_locals: Some(s.count().to_vec()),
         nested,
+        control_vertices: 0,
+        control_bytes: 0,
+        shared_tables: None,
     }
 }
 
@@ -187,6 +247,15 @@ impl Estimate {
     pub fn bytes(&self) -> u64 {
         self.parts
             .iter()
+            .fold(0u64, |s, p| s.saturating_add(p.bytes))
+    }
+
+    /// Bytes of the part named `what` (0 when there is none).
+    #[must_use]
+    pub fn part_bytes(&self, what: &str) -> u64 {
+        self.parts
+            .iter()
+            .filter(|p| p.what == what)
             .fold(0u64, |s, p| s.saturating_add(p.bytes))
     }
 
@@ -231,8 +300,11 @@ pub fn estimate(extent: &Extent, mode: SampleMode, uses: Uses) -> Estimate {
     let at = Layout::of(extent, mode);
     e.add(
         "object",
-        OBJECT_BYTES,
-        "model, sampler, control display and name".into(),
+        OBJECT_BYTES.max(OBJECT_STRUCTURE + extent.control_bytes),
+        format!(
+            "model, sampler, control display ({} vertices) and name",
+            extent.control_vertices
+        ),
     );
     add_tables(&mut e, extent, &at);
     add_samples(&mut e, extent, mode, &at);
@@ -242,7 +314,7 @@ pub fn estimate(extent: &Extent, mode: SampleMode, uses: Uses) -> Estimate {
     if !extent.nested.is_empty() {
         add_nested(&mut e, extent, mode, &at);
     }
-    add_gpu(&mut e, mode, uses, &at);
+    add_gpu(&mut e, extent, mode, uses, &at);
     if uses.json_text {
         // "[x, y, z]" with up to 24 characters a number.
         e.add(
@@ -381,6 +453,24 @@ fn add_erbs(e: &mut Estimate, extent: &Extent, locals: &[usize], at: &Layout) {
             dense,
             "per direction: 2 × samples × patches across × 2 orders × 4 functions × 8 B".into(),
         );
+        // Each polynomial patch's own structure, whatever its samples: its two tables' headers
+        // and knots, its net and the dense kernels' padded copy of it (what a scene of many
+        // patches with few samples each is made of).
+        use super::tables::axis::HermiteTable;
+        use super::tables::erbs_patch::{DensePatch, SplinePatch};
+        let size = |bytes: usize| bytes as u128;
+        let (du, dv) = (extent.degree[0] as u128 + 1, extent.degree[1] as u128 + 1);
+        let per_patch = size(std::mem::size_of::<SplinePatch>())
+            + 2 * size(std::mem::size_of::<HermiteTable>())
+            + size(std::mem::size_of::<DensePatch>())
+            + du * dv * VEC3
+            + 2 * (du + dv) * F64;
+        let patches = locals[0] as u128 * locals[1] as u128;
+        e.add(
+            "ERBS local patch structure",
+            patches * per_patch,
+            format!("{patches} patches × {per_patch} B"),
+        );
     } else {
         e.add(
             "ERBS local samples",
@@ -439,7 +529,7 @@ fn add_nested(e: &mut Estimate, extent: &Extent, mode: SampleMode, at: &Layout) 
 /// The object's own GPU parts: per frame slot written a mirror of f32 vertices (surfaces:
 /// position + normal), and the curvature map's scalar per vertex likewise; the control
 /// structure's mirror.
-fn add_gpu(e: &mut Estimate, mode: SampleMode, uses: Uses, at: &Layout) {
+fn add_gpu(e: &mut Estimate, extent: &Extent, mode: SampleMode, uses: Uses, at: &Layout) {
     if uses.gpu_slots == 0 {
         return;
     }
@@ -458,11 +548,13 @@ fn add_gpu(e: &mut Estimate, mode: SampleMode, uses: Uses, at: &Layout) {
             format!("{slots} × {text} × 4 B"),
         );
     }
-    // The control structure's mirror is written in every slot.
+    // The control structure's mirror is written in every slot: at least a small buffer's
+    // cost, and three f32 per vertex where a display has many.
+    let mirror = CONTROL_MIRROR.max(extent.control_vertices as u128 * 3 * F32);
     e.add(
         "GPU control mirrors",
-        GPU_SLOTS_ALWAYS * CONTROL_MIRROR,
-        format!("{GPU_SLOTS_ALWAYS} × {CONTROL_MIRROR} B"),
+        GPU_SLOTS_ALWAYS * mirror,
+        format!("{GPU_SLOTS_ALWAYS} × {mirror} B"),
     );
 }
 
@@ -668,9 +760,15 @@ pub fn check_extents(
 ) -> Result<u64, String> {
     let mut total = shared_estimate(objects, uses).bytes();
     let mut largest: Option<(usize, u64)> = None;
+    let mut tables_seen = std::collections::HashSet::new();
     for (i, (name, extent)) in objects.iter().enumerate() {
         let e = estimate(extent, mode, uses);
         let bytes = e.bytes();
+        // Tables another object already holds are not allocated again.
+        let shared = match extent.shared_tables {
+            Some(key) if !tables_seen.insert(key) => e.part_bytes("Hermite tables"),
+            _ => 0,
+        };
         if bytes > budget.bytes {
             return Err(format!(
                 "object '{name}' (objects[{i}]): needs about {} to pre-evaluate ({}), over the memory budget of {}",
@@ -679,7 +777,7 @@ pub fn check_extents(
                 budget.describe()
             ));
         }
-        total = total.saturating_add(bytes);
+        total = total.saturating_add(bytes - shared);
         if largest.is_none_or(|(_, b)| bytes > b) {
             largest = Some((i, bytes));
         }
@@ -755,6 +853,9 @@ mod tests {
             rational: false,
             erbs_locals: None,
             nested: Vec::new(),
+            control_vertices: 0,
+            control_bytes: 0,
+            shared_tables: None,
         }
     }
 
@@ -801,6 +902,9 @@ mod tests {
             rational: true,
             erbs_locals: None,
             nested: Vec::new(),
+            control_vertices: 0,
+            control_bytes: 0,
+            shared_tables: None,
         };
         let e = estimate(
             &s,
@@ -826,6 +930,9 @@ mod tests {
             rational: false,
             erbs_locals: None,
             nested: Vec::new(),
+            control_vertices: 0,
+            control_bytes: 0,
+            shared_tables: None,
         };
         let uses = Uses {
             gpu_slots: 3,

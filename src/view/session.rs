@@ -716,7 +716,12 @@ fn toggle(flag: &mut bool) {
 /// All control nets for small scenes; for scenes with many control points (the demo with the
 /// teapot's 512) only the focused object's, so the picture is not buried under points.
 fn default_nets(doc: &Document) -> NetMode {
-    if doc.all_handles().len() <= 400 {
+    let handles: usize = doc
+        .objects
+        .iter()
+        .map(|o| o.controls.grip_points().take(401).count())
+        .sum();
+    if handles <= 400 {
         NetMode::All
     } else {
         NetMode::Focused

@@ -164,6 +164,53 @@ fn erbs_surface_estimate_matches_allocated_bytes() {
     }
 }
 
+/// Many locals and few samples: the control display (48 samples and the points of each
+/// local curve, 81 position and normal pairs and the net of each local patch) outweighs the
+/// samples, so the estimate must count it.
+#[test]
+fn many_small_locals_estimate_matches_allocated_bytes() {
+    let curve = parse_scene(
+        r#"{"objects":[{"name":"e","type":"erbs_curve","samples":10,"from":{"type":"bezier_curve","points":[[0,0,0],[1,1,0],[2,0,1]]},"local_curves":5000,"local_degree":3}]}"#,
+    )
+    .unwrap();
+    let surface = parse_scene(
+        r#"{"objects":[{"name":"s","type":"erbs_surface","samples":[4,4],"from":{"type":"bezier_surface","points":[[[0,0,0],[1,0,0]],[[0,1,0],[1,1,1]]]},"local_patches":[60,60],"local_degree":[2,2]}]}"#,
+    )
+    .unwrap();
+    for (what, scene) in [
+        ("5000 local curves", curve),
+        ("60 × 60 local patches", surface),
+    ] {
+        for (name, mode) in MODES {
+            let (e, held) = estimate_and_held(&scene, mode);
+            assert_close(&format!("{what}, {name}"), e, held, ERBS_TOLERANCE);
+        }
+    }
+}
+
+/// A control polygon of 200,000 points sampled 101 times: the points, knots, display and
+/// table ranges are the object.
+#[test]
+fn a_long_control_polygon_estimate_matches_allocated_bytes() {
+    let n = 200_000;
+    let points: Vec<String> = (0..n)
+        .map(|i| format!("[{},{},0]", i as f64 * 1e-3, (i % 7) as f64 * 1e-2))
+        .collect();
+    let knots: Vec<String> = std::iter::once(0)
+        .chain(0..n)
+        .chain(std::iter::once(n - 1))
+        .map(|k| k.to_string())
+        .collect();
+    let scene = parse_scene(&format!(
+        r#"{{"objects":[{{"name":"c","type":"bspline_curve","degree":1,"samples":101,"knots":[{}],"points":[{}]}}]}}"#,
+        knots.join(","),
+        points.join(",")
+    ))
+    .unwrap();
+    let (e, held) = estimate_and_held(&scene, SampleMode::Render);
+    assert_close("200,000-point polygon, render", e, held, 0.15);
+}
+
 #[test]
 fn teapot_scene_estimate_matches_allocated_bytes() {
     let teapot =

@@ -156,3 +156,75 @@ fn bench_frame_counts_pass_the_budget() {
         &["--frames 1000000000000", "memory budget"],
     );
 }
+
+/// An ERBS curve of 1.5 million locals: the model fits the build budget, but every command
+/// also builds the control display (48 samples and the points of each local, about 1.2 KiB
+/// a local), which the estimate once left out: under a 4 GiB address space the process
+/// aborted. Now the display is in the estimate, so a 1 GiB budget refuses it in one line,
+/// naming the control display.
+#[test]
+fn many_erbs_locals_count_their_control_display() {
+    let dir = Scratch::new("budget-counts");
+    dir.file(
+        "scene.json",
+        &ERBS_CURVE_FROM.replace("1000000000000", "1500000"),
+    );
+    for args in [
+        &["sample", "scene.json", "--memory-limit", "1G"][..],
+        &[
+            "render",
+            "scene.json",
+            "--size",
+            "8x8",
+            "--out",
+            "x.png",
+            "--memory-limit",
+            "1G",
+        ],
+    ] {
+        expect_one_line(
+            &dir,
+            args,
+            &["object 'e'", "control display (", "over the memory budget"],
+        );
+    }
+}
+
+/// A curve with 300,000 control points read from an OBJ file: its model, display, knots and
+/// table ranges grow with the points (about 20 MiB), which an 8 MiB budget must refuse; the
+/// estimate once counted 4 KiB per object whatever its points and let it through.
+#[test]
+fn control_points_from_a_file_count_in_the_budget() {
+    let dir = Scratch::new("budget-counts");
+    let n = 300_000;
+    let mut obj = String::with_capacity(n * 24);
+    for i in 0..n {
+        obj.push_str(&format!(
+            "v {} {} 0\n",
+            i as f64 * 1e-3,
+            (i % 7) as f64 * 1e-2
+        ));
+    }
+    obj.push_str(&format!("cstype bspline\ndeg 1\ncurv 0 {}", n - 1));
+    for i in 1..=n {
+        obj.push_str(&format!(" {i}"));
+    }
+    obj.push_str("\nparm u 0");
+    for k in 0..n {
+        obj.push_str(&format!(" {k}"));
+    }
+    obj.push_str(&format!(" {}\nend\n", n - 1));
+    dir.file("long.obj", &obj);
+    expect_one_line(
+        &dir,
+        &["sample", "long.obj", "--memory-limit", "8M"],
+        &[
+            "control display (300000 vertices)",
+            "8.0 MiB (--memory-limit)",
+        ],
+    );
+    // Negative control: a budget that holds it samples it.
+    let (code, stdout, stderr) = run_limited(&dir, &["sample", "long.obj", "--memory-limit", "1G"]);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(stdout.starts_with("{\"objects\""));
+}

@@ -76,7 +76,7 @@ impl Kind for CatmullRomModel {
 
     /// Cubic segments.
     fn extent(&self) -> Extent {
-        Extent::polynomial(&[self.samples()], &[3], false)
+        chain_extent(self.samples(), 3, self.spline().points().len())
     }
 
     /// The interpolated points.
@@ -159,7 +159,8 @@ impl Kind for BezierSplineModel {
     }
 
     fn extent(&self) -> Extent {
-        Extent::polynomial(&[self.samples()], &[self.spline().degree()], false)
+        let s = self.spline();
+        chain_extent(self.samples(), s.degree(), s.handles().len())
     }
 
     /// Bézier points, or the de Boor polygon of splines edited through it (their Bézier points
@@ -181,4 +182,18 @@ impl Kind for BezierSplineModel {
             self.type_name()
         ))
     }
+}
+
+/// A chain of degree-`degree` Bézier segments through `handles` user points: the sampler
+/// pre-evaluates the chain's B-spline, about `degree` chain points per handle, besides the
+/// handles the model and the display keep.
+fn chain_extent(samples: usize, degree: usize, handles: usize) -> Extent {
+    let chain = Extent::polynomial(&[samples], &[degree], false).with_net(
+        degree.max(1) * handles,
+        (degree.max(1) + 1) * handles,
+        1,
+        false,
+    );
+    let (vertices, bytes) = (handles, chain.control_bytes + 2 * 24 * handles as u128);
+    chain.with_controls(vertices, bytes)
 }

@@ -10,38 +10,30 @@ use crate::model::controls::{
 use crate::model::{Index2, LocalPath};
 use glam::DVec3;
 
-/// One polynomial local curve's display: its path, control points and samples over its support.
-struct LocalCurveDisplay {
-    path: LocalPath<Index2>,
-    points: Vec<DVec3>,
-    samples: Vec<DVec3>,
-}
-
-/// One polynomial local patch's display: its path, net and (position, normal) grid.
-struct LocalPatchDisplay {
-    path: LocalPath<Index2>,
-    rows: usize,
-    cols: usize,
-    points: Vec<DVec3>,
-    grid: Vec<(DVec3, DVec3)>,
-}
-
-fn local_curves(locals: &[LocalCurveDisplay]) -> ControlDisplay {
-    let mut vertices = Vec::new();
-    let mut entries = Vec::with_capacity(locals.len());
-    for l in locals {
+/// The display of the given polynomial local curves, in one exactly sized vertex list: per
+/// local its [`LOCAL_CURVE_SAMPLES`] samples over its support, then every local's control
+/// points (a scene can hold millions of locals, so nothing is built twice).
+fn local_curves(leaves: &[(LocalPath<Index2>, &GeomLocalCurve)]) -> ControlDisplay {
+    let mut vertices = Vec::with_capacity(curve_display_vertices(leaves.iter().map(|(_, l)| *l)));
+    let mut entries = Vec::with_capacity(leaves.len());
+    for &(path, l) in leaves {
         entries.push(LocalEntry {
-            path: l.path,
+            path,
             samples: vertices.len(),
             points: 0,
-            rows: l.points.len(),
+            rows: points(l).len(),
             cols: 1,
         });
-        vertices.extend_from_slice(&l.samples);
+        let (a, b) = l.domain();
+        vertices.extend(
+            uniform_params(a, b, LOCAL_CURVE_SAMPLES)
+                .into_iter()
+                .map(|t| l.eval(t)),
+        );
     }
-    for (l, e) in locals.iter().zip(entries.iter_mut()) {
+    for (&(_, l), e) in leaves.iter().zip(entries.iter_mut()) {
         e.points = vertices.len();
-        vertices.extend_from_slice(&l.points);
+        vertices.extend_from_slice(points(l));
     }
     ControlDisplay {
         layout: ControlLayout::LocalCurves(entries),
@@ -49,30 +41,93 @@ fn local_curves(locals: &[LocalCurveDisplay]) -> ControlDisplay {
     }
 }
 
-fn local_patches(patches: &[LocalPatchDisplay]) -> ControlDisplay {
-    let mut vertices = Vec::new();
-    let mut entries = Vec::with_capacity(patches.len());
-    for p in patches {
+/// As [`local_curves`] for local patches: per patch a [`LOCAL_PATCH_SAMPLES`]² grid of
+/// (position, normal) pairs, then every patch's net.
+fn local_patches(leaves: &[(LocalPath<Index2>, &GeomLocalPatch)]) -> ControlDisplay {
+    let mut vertices = Vec::with_capacity(patch_display_vertices(leaves.iter().map(|(_, p)| *p)));
+    let mut entries = Vec::with_capacity(leaves.len());
+    for &(path, p) in leaves {
+        let Some(surface) = spline(p) else { continue };
+        let [rows, cols] = surface.count();
         entries.push(LocalEntry {
-            path: p.path,
+            path,
             samples: vertices.len(),
             points: 0,
-            rows: p.rows,
-            cols: p.cols,
+            rows,
+            cols,
         });
-        for &(pos, n) in &p.grid {
-            vertices.push(pos);
-            vertices.push(n);
+        let [(u0, u1), (v0, v1)] = surface.domain();
+        let vs = uniform_params(v0, v1, LOCAL_PATCH_SAMPLES);
+        for u in uniform_params(u0, u1, LOCAL_PATCH_SAMPLES) {
+            for &v in &vs {
+                vertices.push(surface.eval(u, v));
+                vertices.push(surface.normal(u, v));
+            }
         }
     }
-    for (p, e) in patches.iter().zip(entries.iter_mut()) {
-        e.points = vertices.len();
-        vertices.extend_from_slice(&p.points);
+    let mut e = entries.iter_mut();
+    for surface in leaves.iter().filter_map(|(_, p)| spline(p)) {
+        let entry = e.next().expect("one entry per spline patch");
+        entry.points = vertices.len();
+        vertices.extend_from_slice(surface.points());
     }
     ControlDisplay {
         layout: ControlLayout::LocalPatches(entries),
         vertices,
     }
+}
+
+fn points(l: &GeomLocalCurve) -> &[DVec3] {
+    l.points().unwrap_or(&[])
+}
+
+fn spline(p: &GeomLocalPatch) -> Option<&crate::geom::TensorSurface> {
+    match p {
+        GeomLocalPatch::Spline { surface, .. } => Some(surface),
+        GeomLocalPatch::Erbs(_) => None,
+    }
+}
+
+/// The vertices [`local_curves`] makes for these locals (what the memory budget counts).
+fn curve_display_vertices<'a>(leaves: impl Iterator<Item = &'a GeomLocalCurve>) -> usize {
+    leaves.map(|l| LOCAL_CURVE_SAMPLES + points(l).len()).sum()
+}
+
+/// The vertices [`local_patches`] makes for these patches.
+fn patch_display_vertices<'a>(leaves: impl Iterator<Item = &'a GeomLocalPatch>) -> usize {
+    leaves
+        .filter_map(spline)
+        .map(|s| 2 * LOCAL_PATCH_SAMPLES * LOCAL_PATCH_SAMPLES + s.points().len())
+        .sum()
+}
+
+/// Vertices and host bytes of an ERBS curve's control display, before it is built.
+#[must_use]
+pub fn curve_display_size(c: &ErbsCurve) -> (usize, u128) {
+    let leaves = each_curve_leaf(c, None);
+    display_size(
+        curve_display_vertices(leaves.iter().map(|(_, l)| *l)),
+        leaves.len(),
+    )
+}
+
+/// Vertices and host bytes of an ERBS surface's control display, before it is built.
+#[must_use]
+pub fn patch_display_size(s: &ErbsSurface) -> (usize, u128) {
+    let leaves = each_patch_leaf(s, None);
+    display_size(
+        patch_display_vertices(leaves.iter().map(|(_, p)| *p)),
+        leaves.len(),
+    )
+}
+
+/// Host bytes of a display of `vertices` vertices and `entries` locals, and while it is
+/// built the list of leaves it is built from.
+fn display_size(vertices: usize, entries: usize) -> (usize, u128) {
+    let leaf = std::mem::size_of::<(LocalPath<Index2>, &GeomLocalCurve)>();
+    let bytes = vertices as u128 * std::mem::size_of::<DVec3>() as u128
+        + entries as u128 * (std::mem::size_of::<LocalEntry>() + leaf) as u128;
+    (vertices, bytes)
 }
 
 /// Every polynomial local of an ERBS curve at any depth with its path, in depth-first path
@@ -167,59 +222,14 @@ fn collect_patch_leaves<'a>(
     }
 }
 
-fn curve_leaves(c: &ErbsCurve, under: Option<LocalPath<Index2>>) -> Vec<LocalCurveDisplay> {
-    each_curve_leaf(c, under)
-        .into_iter()
-        .map(|(path, l)| {
-            let (a, b) = l.domain();
-            let samples = uniform_params(a, b, LOCAL_CURVE_SAMPLES)
-                .into_iter()
-                .map(|t| l.eval(t))
-                .collect();
-            LocalCurveDisplay {
-                path,
-                points: l.points().unwrap_or(&[]).to_vec(),
-                samples,
-            }
-        })
-        .collect()
-}
-
-fn patch_leaves(s: &ErbsSurface, under: Option<LocalPath<Index2>>) -> Vec<LocalPatchDisplay> {
-    each_patch_leaf(s, under)
-        .into_iter()
-        .filter_map(|(path, p)| {
-            let GeomLocalPatch::Spline { surface, .. } = p else {
-                return None;
-            };
-            let [rows, cols] = surface.count();
-            let [(u0, u1), (v0, v1)] = surface.domain();
-            let us = uniform_params(u0, u1, LOCAL_PATCH_SAMPLES);
-            let vs = uniform_params(v0, v1, LOCAL_PATCH_SAMPLES);
-            let grid = us
-                .iter()
-                .flat_map(|&u| vs.iter().map(move |&v| (u, v)))
-                .map(|(u, v)| (surface.eval(u, v), surface.normal(u, v)))
-                .collect();
-            Some(LocalPatchDisplay {
-                path,
-                rows,
-                cols,
-                points: surface.points().to_vec(),
-                grid,
-            })
-        })
-        .collect()
-}
-
 /// The display of an ERBS curve's polynomial locals (those at or below `under` if given).
 #[must_use]
 pub fn curve_controls(c: &ErbsCurve, under: Option<LocalPath<Index2>>) -> ControlDisplay {
-    local_curves(&curve_leaves(c, under))
+    local_curves(&each_curve_leaf(c, under))
 }
 
 /// The display of an ERBS surface's polynomial local patches (at or below `under` if given).
 #[must_use]
 pub fn patch_controls(s: &ErbsSurface, under: Option<LocalPath<Index2>>) -> ControlDisplay {
-    local_patches(&patch_leaves(s, under))
+    local_patches(&each_patch_leaf(s, under))
 }

@@ -1,7 +1,7 @@
 //! The ERBS kinds' entries in the table of kinds: what ties each model to its sampler, its
 //! scene-file fields and its control display (every polynomial local at any depth).
 
-use super::controls::{curve_controls, patch_controls};
+use super::controls::{curve_controls, curve_display_size, patch_controls, patch_display_size};
 use super::curve_sampler::ErbsCurveSampler;
 use super::file;
 use super::surface_sampler::ErbsSurfaceSampler;
@@ -9,6 +9,7 @@ use super::{
     ErbsCurveEdit, ErbsCurveModel, ErbsSurfaceEdit, ErbsSurfaceModel, LocalEdit, LocalPath,
 };
 use crate::format::{At, SceneError};
+use crate::geom::{ErbsCurve, ErbsSurface};
 use crate::model::controls::{ControlDisplay, Grip};
 use crate::model::index::Index2;
 use crate::model::kind::Kind;
@@ -69,7 +70,12 @@ impl Kind for ErbsCurveModel {
     }
 
     fn extent(&self) -> Extent {
-        Extent::erbs_curve(self.curve(), self.samples())
+        let c = self.curve();
+        let (vertices, display) = curve_display_size(c);
+        let extent = Extent::erbs_curve(c, self.samples());
+        // The sampler's copy of the model: its locals with their points.
+        let model = ErbsCurve::from_curve_bytes(c.local_curves().len(), extent.degree[0]);
+        extent.with_controls(vertices, display + model)
     }
 
     fn controls(&self) -> ControlDisplay {
@@ -152,7 +158,12 @@ impl Kind for ErbsSurfaceModel {
     }
 
     fn extent(&self) -> Extent {
-        Extent::erbs_surface(self.surface(), self.samples())
+        let s = self.surface();
+        let (vertices, display) = patch_display_size(s);
+        let extent = Extent::erbs_surface(s, self.samples());
+        let model =
+            ErbsSurface::from_surface_bytes(s.count(), [extent.degree[0], extent.degree[1]]);
+        extent.with_controls(vertices, display + model)
     }
 
     fn controls(&self) -> ControlDisplay {

@@ -73,7 +73,10 @@ impl Kind for CurveModel {
 
     fn extent(&self) -> Extent {
         let c = self.curve();
+        let n = c.points().len();
         Extent::polynomial(&[self.samples()], &[c.degree()], c.is_rational())
+            .with_net(n, c.knots().len(), 1, c.is_rational())
+            .with_shared_tables(table_key(&[(c.knots(), c.degree(), n, self.samples())]))
     }
 
     fn controls(&self) -> ControlDisplay {
@@ -170,7 +173,11 @@ impl Kind for SurfaceModel {
 
     fn extent(&self) -> Extent {
         let s = self.surface();
+        let [ku, kv] = s.knots();
+        let ([du, dv], [nu, nv], [mu, mv]) = (s.degree(), s.count(), self.samples());
         Extent::polynomial(&self.samples(), &s.degree(), s.is_rational())
+            .with_net(s.points().len(), ku.len() + kv.len(), 2, s.is_rational())
+            .with_shared_tables(table_key(&[(ku, du, nu, mu), (kv, dv, nv, mv)]))
     }
 
     fn controls(&self) -> ControlDisplay {
@@ -212,4 +219,16 @@ impl Kind for SurfaceModel {
             _ => Err(format!("a {} has no such control point", self.type_name())),
         }
     }
+}
+
+/// What a B-spline object's Hermite tables are built from, hashed: objects with equal keys
+/// share their tables (`HermiteTable::shared`), which the memory budget counts once.
+fn table_key(directions: &[(&[f64], usize, usize, usize)]) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    for &(knots, degree, count, samples) in directions {
+        knots.iter().for_each(|k| k.to_bits().hash(&mut h));
+        (degree, count, samples).hash(&mut h);
+    }
+    h.finish()
 }
