@@ -536,7 +536,7 @@ fn curves_with_a_gap_are_drawn_apart() {
         );
     }
     let (pieces, pieces_lit, ends_lit, bridge_lit) = ink(&scene("[0, 0, 1, 2, 3, 3]", 41));
-    assert_eq!(pieces, [0..41]);
+    assert_eq!((pieces.len(), pieces.first()), (1, Some(&(0..41))));
     assert!(
         pieces_lit.iter().chain(&ends_lit).all(|&n| n > 0),
         "{pieces_lit:?} {ends_lit:?}"
@@ -686,7 +686,7 @@ fn six_separate_surfaces() -> Scene {
             let mut o = bumps.clone();
             o["name"] = serde_json::json!(format!("Surface.{:03}", k + 1));
             let (dx, dy) = (8.0 * (k % 3) as f64 - 8.0, 8.0 * (k / 3) as f64 - 4.0);
-            let height = 2f64.powi(k as i32 - 3);
+            let height = 2f64.powi(k - 3);
             for row in o["points"].as_array_mut().unwrap() {
                 for p in row.as_array_mut().unwrap() {
                     let [x, y, z] = [0, 1, 2].map(|c| p[c].as_f64().unwrap());
