@@ -146,12 +146,12 @@ enum Command {
         #[arg(long, default_value = "retained", value_parser = Redraw::parse, value_name = "retained|full")]
         redraw: Redraw,
     },
-    /// Render a scene headless (no display needed) into a PNG image.
+    /// Render a scene headless (no display needed) into a PNG or JPEG image (by the extension).
     Render {
         /// Scene file (JSON, or Wavefront OBJ by its .obj extension).
         scene: PathBuf,
-        /// Output image (PNG).
-        #[arg(long, short = 'o', value_name = "IMAGE.png")]
+        /// Output image: PNG for .png, JPEG for .jpg or .jpeg; other extensions are refused.
+        #[arg(long, short = 'o', value_name = "IMAGE.png|IMAGE.jpg")]
         out: PathBuf,
         /// Image size.
         #[arg(long, default_value = "1280x720", value_parser = cli::render::parse_size, value_name = "WxH")]
@@ -202,7 +202,7 @@ enum Command {
 #[derive(Args, Clone)]
 struct SamplesArgs {
     /// Sample counts: N for every curve, NxM for every surface; repeat for both
-    /// (e.g. --samples 400 --samples 64x64).
+    /// (e.g. --samples 400 --samples 64x64). A count the scene has no object for is noted.
     #[arg(long, value_name = "N|NxM", value_parser = SamplesArg::parse)]
     samples: Vec<SamplesArg>,
 }
@@ -236,8 +236,10 @@ impl MemoryArgs {
 #[derive(Args, Clone, Copy)]
 struct MapRangeArgs {
     /// Colour scale of curvature maps: per-object (each surface its own symmetric range from
-    /// the 90th percentile of |value|; patches named NAME_0, NAME_1, … share one), shared (one
-    /// range over every surface) or MIN,MAX (fixed: MIN blue, MAX red, white halfway).
+    /// the 90th percentile of |value|; the patches of one model share one: surfaces named
+    /// NAME_0, NAME_1, … whose bounding boxes touch, directly or through each other; see
+    /// docs/viewer.md, "Analysis"), shared (one range over every surface) or MIN,MAX (fixed:
+    /// MIN blue, MAX red, white halfway).
     #[arg(long, value_name = "shared|per-object|MIN,MAX", default_value = "per-object", value_parser = MapRange::parse, allow_hyphen_values = true)]
     map_range: MapRange,
 }

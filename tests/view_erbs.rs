@@ -508,40 +508,50 @@ fn script_move_to_a_missing_nested_local_fails_with_one_line() {
     );
 }
 
-/// Catmull–Rom: I, E and Shift+W refuse at the key press, each with its reason and the way out
-/// (B converts to a bspline_curve); nothing changes and no tool is left waiting for Enter.
+/// Catmull–Rom and Bézier splines: I, E and Shift+W refuse at the key press, each with its
+/// reason and the way out (B converts to a bspline_curve); nothing changes and no tool is left
+/// waiting for Enter.
 #[test]
 fn catmull_rom_refuses_knots_elevation_and_weights_at_the_key_press() {
-    let mut h = Headless::new(
-        r#"{"objects": [{"name": "cr", "type": "catmull_rom", "points": [[0,0,0],[1,1,0],[2,0,0],[3,1,0]], "samples": 64}]}"#,
-    );
-    h.click(Handle::Point {
-        object: 0,
-        point: Index2::One(1),
-    });
-    let before = h.session.to_scene();
-    for (key, shift) in [
-        (Key::Char('i'), false),
-        (Key::Char('e'), false),
-        (Key::Char('w'), true),
+    let catmull_rom = r#"{"objects": [{"name": "cr", "type": "catmull_rom", "points": [[0,0,0],[1,1,0],[2,0,0],[3,1,0]], "samples": 64}]}"#;
+    let bezier_spline = r#"{"objects": [{"name": "bz", "type": "bezier_spline", "degree": 3, "knots": [0, 1, 2], "points": [[0,0,0],[0.5,1,0],[1,1,0],[1.5,0,0],[2,-1,0],[2.5,-1,0],[3,0,0]], "continuity": "C0", "samples": 64}]}"#;
+    for (scene, kind) in [
+        (catmull_rom, "catmull_rom"),
+        (bezier_spline, "bezier_spline"),
     ] {
-        h.session.perform(Action::Key {
-            key,
-            mods: Modifiers {
-                shift,
-                ..Modifiers::default()
-            },
+        let mut h = Headless::new(scene);
+        h.click(Handle::Point {
+            object: 0,
+            point: Index2::One(1),
         });
-        let status = h.session.status().to_string();
-        assert!(
-            status.contains("catmull_rom") && status.contains("B converts it to a bspline_curve"),
-            "{key:?}: {status}"
-        );
-        // Enter must not run a tool the key press refused.
-        h.key(Key::Enter, false);
-        assert_eq!(h.session.status(), status, "{key:?}: Enter did something");
+        let before = h.session.to_scene();
+        for (key, shift) in [
+            (Key::Char('i'), false),
+            (Key::Char('e'), false),
+            (Key::Char('w'), true),
+        ] {
+            h.session.perform(Action::Key {
+                key,
+                mods: Modifiers {
+                    shift,
+                    ..Modifiers::default()
+                },
+            });
+            let status = h.session.status().to_string();
+            assert!(
+                status.contains(kind) && status.contains("B converts it to a bspline_curve"),
+                "{kind}, {key:?}: {status}"
+            );
+            // Enter must not run a tool the key press refused.
+            h.key(Key::Enter, false);
+            assert_eq!(
+                h.session.status(),
+                status,
+                "{kind}, {key:?}: Enter did something"
+            );
+        }
+        assert_eq!(h.session.to_scene(), before, "{kind}");
+        assert_eq!(h.session.undo_depth(), (0, 0), "{kind}");
+        h.finish();
     }
-    assert_eq!(h.session.to_scene(), before);
-    assert_eq!(h.session.undo_depth(), (0, 0));
-    h.finish();
 }

@@ -99,7 +99,37 @@ impl SampleOverride {
     }
 }
 
-/// Loads a scene file of either format; OBJ warnings go to stderr as `FILE:LINE: warning: …`.
+impl SampleOverride {
+    /// A note for each given count that no object of `scene` (loaded from `file`) takes:
+    /// `--samples N` sets curves only and `NxM` surfaces only, so `--samples 5` on a scene of
+    /// surfaces would otherwise change nothing without a word.
+    #[must_use]
+    pub fn unused_notes(&self, scene: &Scene, file: &str) -> Vec<String> {
+        let surfaces = scene
+            .objects
+            .iter()
+            .filter(|o| o.model.is_surface())
+            .count();
+        let curves = scene.objects.len() - surfaces;
+        let mut notes = Vec::new();
+        if let Some(n) = self.curve.filter(|_| curves == 0) {
+            notes.push(format!(
+                "note: --samples {n} sets the sample count of curves, and {file} has none \
+                 (surfaces take NxM: --samples {n}x{n})"
+            ));
+        }
+        if let Some([u, v]) = self.surface.filter(|_| surfaces == 0) {
+            notes.push(format!(
+                "note: --samples {u}x{v} sets the sample count of surfaces, and {file} has none \
+                 (curves take N: --samples {u})"
+            ));
+        }
+        notes
+    }
+}
+
+/// Loads a scene file of either format; OBJ warnings go to stderr as `FILE:LINE: warning: …`,
+/// then a note for a `--samples` count the scene has no object for.
 pub fn load_scene(path: &Path, samples: &SampleOverride) -> Result<Scene, CliError> {
     let mut scene = match Format::of(path) {
         Some(Format::Obj) => {
@@ -112,6 +142,10 @@ pub fn load_scene(path: &Path, samples: &SampleOverride) -> Result<Scene, CliErr
         _ => Scene::load(path).map_err(|e| CliError::in_file(path, e))?,
     };
     samples.apply(&mut scene)?;
+    let shown = path.display().to_string();
+    for note in samples.unused_notes(&scene, &crate::scene::escape_controls(&shown)) {
+        eprintln!("{note}");
+    }
     Ok(scene)
 }
 

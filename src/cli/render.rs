@@ -1,4 +1,4 @@
-//! `prespline render`: draws a scene headless into a PNG file.
+//! `prespline render`: draws a scene headless into a PNG or JPEG file (by the extension).
 
 use super::CliError;
 use super::files::{SampleOverride, load_scene};
@@ -127,7 +127,7 @@ pub struct MemoryProbe {
     pub before: Resident,
 }
 
-/// Renders `doc` headless and writes `out` (PNG); returns a one-line summary, and with
+/// Renders `doc` headless and writes `out` (PNG or JPEG, by its extension); returns a one-line summary, and with
 /// `probe` the `--memory-report` line.
 #[allow(clippy::too_many_arguments)]
 pub fn run(

@@ -147,13 +147,39 @@ pub fn curve_joins(model: ModelRef<'_>) -> Vec<Join> {
         .collect()
 }
 
-/// The runs of sample indices a curve is drawn as: one run, or for a B-spline curve whose
-/// interior knot of multiplicity ≥ degree + 1 leaves a gap (C⁻¹, the "gap" badge), one run per
-/// connected piece, so no line bridges the gap. `params` are the curve's sample parameters;
-/// a sample at the gap's knot belongs to the piece on its right (the evaluator's right limit).
+/// One connected piece of a drawn curve: a run of its samples and, where the piece meets a gap,
+/// the end points the samples miss.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CurvePiece {
+    /// The samples drawn as one polyline.
+    pub samples: std::ops::Range<usize>,
+    /// The right limit c(t+) at the gap the piece starts at, where no sample lies exactly on
+    /// that knot (the first sample comes later).
+    pub start: Option<DVec3>,
+    /// The left limit c(t−) at the gap the piece ends at: no sample reaches it, since a sample
+    /// at the knot is the right limit and belongs to the next piece.
+    pub end: Option<DVec3>,
+}
+
+impl CurvePiece {
+    /// The piece of every sample, with nothing to add.
+    fn whole(samples: usize) -> Self {
+        Self {
+            samples: 0..samples,
+            start: None,
+            end: None,
+        }
+    }
+}
+
+/// The pieces a curve is drawn as: one, or for a B-spline curve whose interior knot of
+/// multiplicity ≥ degree + 1 leaves a gap (C⁻¹, the "gap" badge), one per connected piece, so
+/// no line bridges the gap and each piece still reaches its ends. `params` are the curve's
+/// sample parameters; a sample at the gap's knot belongs to the piece on its right (the
+/// evaluator's right limit).
 #[must_use]
-pub fn curve_pieces(model: ModelRef<'_>, params: &[f64]) -> Vec<std::ops::Range<usize>> {
-    let whole: Vec<_> = std::iter::once(0..params.len()).collect();
+pub fn curve_pieces(model: ModelRef<'_>, params: &[f64]) -> Vec<CurvePiece> {
+    let whole = vec![CurvePiece::whole(params.len())];
     // Only B-spline, Bézier and NURBS curves can tear: chains share their junction points and
     // ERBS curves blend smoothly.
     let ModelRef::Curve(c) = model else {
@@ -171,18 +197,28 @@ pub fn curve_pieces(model: ModelRef<'_>, params: &[f64]) -> Vec<std::ops::Range<
     if !tears {
         return whole;
     }
-    let mut cuts: Vec<usize> = curve_joins(model)
+    let mut gaps: Vec<f64> = curve_joins(model)
         .iter()
         .filter(|j| !j.class.connected)
-        .map(|j| params.partition_point(|&p| p < j.t))
+        .map(|j| j.t)
         .collect();
-    cuts.dedup();
-    let mut start = 0;
-    let mut pieces = Vec::with_capacity(cuts.len() + 1);
-    for cut in cuts.into_iter().chain([params.len()]) {
-        pieces.push(start..cut);
-        start = cut;
+    gaps.dedup();
+    let mut pieces = Vec::with_capacity(gaps.len() + 1);
+    let mut piece = CurvePiece::whole(0);
+    for t in gaps {
+        let cut = params.partition_point(|&p| p < t);
+        piece.samples.end = cut;
+        piece.end = Some(curve.one_sided_derivatives(t, 0, true)[0]);
+        pieces.push(piece);
+        let on_knot = params.get(cut) == Some(&t);
+        piece = CurvePiece {
+            samples: cut..cut,
+            start: (!on_knot).then(|| curve.one_sided_derivatives(t, 0, false)[0]),
+            end: None,
+        };
     }
+    piece.samples.end = params.len();
+    pieces.push(piece);
     pieces
 }
 

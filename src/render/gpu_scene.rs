@@ -2,7 +2,7 @@
 //! structures, with per-frame-slot dirty tracking so each slot receives exactly the rows changed
 //! since it was last written.
 
-use super::analysis::curve_pieces;
+use super::analysis::{CurvePiece, curve_pieces};
 use super::lod::{GridMetrics, Lod};
 use super::map_mirror::{MapScalars, MapView, SurfaceSlot};
 use super::retained::{
@@ -558,11 +558,12 @@ impl GpuScene {
                 let sampled = &doc.objects[i].sampled;
                 for piece in curve_pieces(sampled.model(), sampled.params()[0]) {
                     let run = PointRun {
-                        offset: o.samples.offset + 3 * piece.start,
+                        offset: o.samples.offset + 3 * piece.samples.start,
                         stride: 3,
-                        count: piece.len(),
+                        count: piece.samples.len(),
                     };
                     polyline(frame, &self.arenas[o.samples.arena], run, &style)?;
+                    piece_ends(frame, grid, &piece, &style)?;
                 }
             }
             let controls = &doc.objects[i].controls;
@@ -1523,6 +1524,34 @@ fn polyline(
     } else {
         Ok(())
     }
+}
+
+/// The segments from a curve piece's end points that no sample reaches (the one-sided limits
+/// at a gap) to its first and last samples, or between them when it has no sample.
+fn piece_ends(
+    frame: &mut Frame<'_>,
+    grid: &crate::sampling::SampleGrid,
+    piece: &CurvePiece,
+    style: &PolylineStyle,
+) -> GpuResult<()> {
+    // The samples as the mirror holds them (f32 of the f64), so each segment meets its run.
+    let f = |p: DVec3| [p.x as f32, p.y as f32, p.z as f32];
+    let sample = |j: usize| f(grid.data[j * grid.stride()]);
+    let first = piece.start.map(f);
+    let last = piece.end.map(f);
+    let samples = &piece.samples;
+    let segments: [Option<[[f32; 3]; 2]>; 2] = if samples.is_empty() {
+        [first.zip(last).map(|(a, b)| [a, b]), None]
+    } else {
+        [
+            first.map(|a| [a, sample(samples.start)]),
+            last.map(|b| [sample(samples.end - 1), b]),
+        ]
+    };
+    for segment in segments.into_iter().flatten() {
+        frame.draw_polyline_immediate(&segment, style)?;
+    }
+    Ok(())
 }
 
 /// f32 vertices of sample rows `rows` of object `i`: (position, normal) for surfaces, position

@@ -6,7 +6,8 @@ use super::gpu_scene::GpuScene;
 use super::lod::Lod;
 use super::map_mirror::MapView;
 use super::maps::{
-    LEGEND_STEP, LegendPlace, MapRange, MapScale, legend, map_scales, surface_families,
+    LEGEND_STEP, LegendPlace, MapRange, MapScale, legend, legend_note, legend_note_height,
+    legend_note_text, map_scales, surface_families,
 };
 use super::overlays::overlay_lines;
 use super::style::Highlight;
@@ -149,8 +150,8 @@ fn record(
 }
 
 /// The legends of a still image: one per surface family ([`surface_families`]), named, when
-/// each has its own scale (as many as fit, top to bottom in scene order); one for all of them
-/// otherwise.
+/// each has its own scale (as many as fit, top to bottom in scene order, and above them a note
+/// of how many families and surfaces had no room); one for all of them otherwise.
 fn legends(
     doc: &Document,
     view: &MapView,
@@ -172,13 +173,33 @@ fn legends(
         let scale = scale.unwrap_or(MapScale::symmetric(1.0));
         return legend(view.map, scale, font, place(None, 0));
     }
-    let fit = (((height - 64.0) / LEGEND_STEP).floor().max(1.0) as usize).min(families.len());
-    families[..fit]
+    let shown = legends_shown(families.len(), height, legend_note_height(font));
+    let mut v: Vec<_> = families[..shown]
         .iter()
         .enumerate()
         .flat_map(|(k, (name, members))| {
             let scale = view.scales[members[0]];
-            legend(view.map, scale, font, place(Some(name), fit - 1 - k))
+            legend(view.map, scale, font, place(Some(name), shown - 1 - k))
         })
-        .collect()
+        .collect();
+    if shown < families.len() {
+        let hidden = &families[shown..];
+        let surfaces = hidden.iter().map(|(_, m)| m.len()).sum();
+        let note = legend_note_text(hidden.len(), surfaces);
+        v.extend(legend_note(&note, font, place(None, shown)));
+    }
+    v
+}
+
+/// How many of `families` legends a still image `height` pixels high shows: all that fit
+/// (at least one); when some do not, as many as leave room for the note (`note` pixels high)
+/// saying so above them.
+#[must_use]
+pub fn legends_shown(families: usize, height: f32, note: f32) -> usize {
+    let room = height - 64.0;
+    let fit = ((room / LEGEND_STEP).floor().max(1.0) as usize).min(families);
+    if fit == families {
+        return fit;
+    }
+    ((room - note) / LEGEND_STEP).floor().max(0.0) as usize
 }

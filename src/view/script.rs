@@ -62,7 +62,7 @@ pub enum Action {
     },
     MoveBy(f64, f64),
     Type(String),
-    /// A PNG of the view (with the HUD when the flag is set).
+    /// A PNG or JPEG (by the extension) of the view (with the HUD when the flag is set).
     Screenshot(PathBuf, bool),
     Quit,
 }
@@ -421,6 +421,63 @@ mod tests {
                 "{text}: {e}"
             );
         }
+    }
+
+    /// A screenshot's format comes from its extension, checked when the script is loaded:
+    /// .png, .jpg and .jpeg (any case) are taken; .gif, .bmp and no extension are refused in
+    /// one line naming the event and the path, before the window opens.
+    #[test]
+    fn screenshots_take_png_or_jpeg_and_refuse_other_extensions_at_load() {
+        for ok in ["a.png", "b.jpg", "c.JPEG", "dir/d.Png"] {
+            let text = format!(r#"[{{"frame": 1, "screenshot": "{ok}", "hud": true}}]"#);
+            let events = parse(&text).unwrap_or_else(|e| panic!("{ok}: {e}"));
+            assert_eq!(
+                events[0].action,
+                Action::Screenshot(PathBuf::from(ok), true)
+            );
+        }
+        for (bad, needle) in [
+            (
+                "b.gif",
+                "b.gif: cannot write .gif images (use .png, .jpg or .jpeg)",
+            ),
+            ("b.bmp", "cannot write .bmp images"),
+            ("shot", "shot: the image needs an extension"),
+        ] {
+            let text =
+                format!(r#"[{{"frame": 1, "key": "m"}}, {{"frame": 2, "screenshot": "{bad}"}}]"#);
+            let e = parse(&text).expect_err(bad);
+            assert!(e.starts_with("event 1: 'screenshot': "), "{bad}: {e}");
+            assert!(e.contains(needle), "{bad}: {e}");
+            assert!(!e.contains('\n'), "{bad}: one line, got {e:?}");
+        }
+    }
+
+    /// The example script of docs/viewer.md ("Example") parses against the demo scene, so the
+    /// documentation cannot drift from the format.
+    #[test]
+    fn the_example_in_the_viewer_docs_parses() {
+        let doc = include_str!("../../docs/viewer.md");
+        let example = doc
+            .split_once("### Example")
+            .expect("docs/viewer.md has an Example section")
+            .1;
+        let json = example
+            .split_once("```json\n")
+            .and_then(|(_, rest)| rest.split_once("```"))
+            .expect("the Example section has a JSON block")
+            .0;
+        let events = parse(json).unwrap_or_else(|e| panic!("docs/viewer.md example: {e}"));
+        assert_eq!(events.len(), 27);
+        assert!(events.iter().any(|e| e.action == Action::Quit));
+        let shots = events
+            .iter()
+            .filter(|e| matches!(e.action, Action::Screenshot(..)))
+            .count();
+        assert_eq!(shots, 2, "edited.png and undone.png");
+        // Negative control: a misspelt action in the same block is refused.
+        let bad = json.replacen("\"press\"", "\"pres\"", 1);
+        assert!(parse(&bad).unwrap_err().contains("unknown action 'pres'"));
     }
 
     #[test]

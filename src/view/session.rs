@@ -21,7 +21,7 @@ use crate::render::analysis::{
 use crate::render::lod::Lod;
 use crate::render::map_mirror::MapView;
 use crate::render::maps::{
-    LegendPlace, MapRange, MapScale, SurfaceMap, legend, map_scales, surface_families,
+    LegendPlace, MapRange, MapScale, SurfaceMap, legend, map_scales_of, surface_families,
 };
 use crate::render::overlays::overlay_lines;
 use crate::render::{
@@ -60,6 +60,9 @@ pub struct Session {
     /// Each object's colour scale of the analysis map (refitted when a map is chosen and after
     /// each gesture that changed samples).
     map_scales: Vec<MapScale>,
+    /// The surface families the scales were fitted to ([`surface_families`]), kept with them:
+    /// finding them walks every sample, too much for every frame.
+    map_families: Vec<(String, Vec<usize>)>,
     /// A scripted action that could not run (see [`Session::take_script_error`]).
     script_error: Option<String>,
 }
@@ -109,6 +112,7 @@ impl Session {
             autosave: None,
             osculating: false,
             map_scales: Vec::new(),
+            map_families: Vec::new(),
             script_error: None,
         })
     }
@@ -633,7 +637,9 @@ impl Session {
     fn refit_map(&mut self) {
         if let Some(map) = self.options.analysis.filter(|m| m.needs_curvature()) {
             self.stage.editor.apply_queued();
-            self.map_scales = map_scales(self.stage.doc(), map, self.options.map_range);
+            self.map_families = surface_families(self.stage.doc());
+            let doc = self.stage.doc();
+            self.map_scales = map_scales_of(doc, map, self.options.map_range, &self.map_families);
         }
         self.gpu.set_map(self.options.analysis.map(|map| MapView {
             map,
@@ -656,7 +662,7 @@ impl Session {
         width: f32,
         height: f32,
     ) -> Vec<crate::gpu::OverlayVertex> {
-        let families = surface_families(self.stage.doc());
+        let families = &self.map_families;
         let selected = self.selected().map(|h| h.object());
         let family = families
             .iter()

@@ -750,3 +750,47 @@ fn sample_takes_the_samples_override() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("1 samples: expected 2..="), "{err}");
 }
+
+/// `--samples N` sets curves only and `NxM` surfaces only (`--help`: "N for every curve, NxM
+/// for every surface"): a count the scene has no object for changes nothing and says so in one
+/// note on stderr. The teapot OBJ (surfaces only) with `--samples 5` keeps its counts and gets
+/// the note; a scene with curves gets none (the negative control).
+#[test]
+fn a_samples_count_no_object_takes_is_noted() {
+    let run = |path: &std::path::Path, args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_prespline"))
+            .arg("sample")
+            .arg(path)
+            .args(args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8(out.stderr).unwrap();
+        assert!(out.status.success(), "{args:?}: {err}");
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        (v, err)
+    };
+    let teapot = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/teapot.obj");
+    let (plain, err) = run(&teapot, &[]);
+    assert!(!err.contains("note:"), "{err}");
+    let (with, err) = run(&teapot, &["--samples", "5"]);
+    assert_eq!(with, plain, "no object of the teapot takes N");
+    let notes: Vec<&str> = err.lines().filter(|l| l.contains("--samples")).collect();
+    assert_eq!(notes.len(), 1, "{err}");
+    assert!(
+        notes[0].starts_with("note: --samples 5 sets the sample count of curves")
+            && notes[0].contains("teapot.obj has none")
+            && notes[0].contains("--samples 5x5"),
+        "{err}"
+    );
+    let dir = Scratch::new("cli-samples-note");
+    let curves = dir.file("curves.json", &scene(&[CURVE]));
+    let (_, err) = run(&curves, &["--samples", "4x6"]);
+    assert!(
+        err.lines()
+            .any(|l| l.starts_with("note: --samples 4x6 sets the sample count of surfaces")),
+        "{err}"
+    );
+    let mixed = dir.file("mixed.json", &scene(&[CURVE, SURF]));
+    let (_, err) = run(&mixed, &["--samples", "5", "--samples", "4x6"]);
+    assert!(!err.contains("note:"), "every count applies: {err}");
+}

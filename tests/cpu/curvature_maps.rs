@@ -295,3 +295,98 @@ fn a_tilted_saddle_has_its_analytic_curvatures_in_the_full_and_the_delta_path() 
     let delta = saddle_error(&obj, 1.0);
     assert!(delta < 1e-12, "delta path: {delta:e}");
 }
+
+/// A scene file's objects with every point moved by `dx` in x and the names renamed by `name`.
+fn moved(
+    scene: &serde_json::Value,
+    dx: f64,
+    name: impl Fn(&str) -> String,
+) -> Vec<serde_json::Value> {
+    fn shift(v: &mut serde_json::Value, dx: f64) {
+        match v {
+            serde_json::Value::Array(a) if a.len() == 3 && a.iter().all(|c| c.is_number()) => {
+                a[0] = serde_json::json!(a[0].as_f64().unwrap() + dx);
+            }
+            serde_json::Value::Array(a) => a.iter_mut().for_each(|x| shift(x, dx)),
+            _ => {}
+        }
+    }
+    scene["objects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|o| {
+            let mut o = o.clone();
+            shift(&mut o["points"], dx);
+            o["name"] = serde_json::json!(name(o["name"].as_str().unwrap()));
+            o
+        })
+        .collect()
+}
+
+/// Curvature-map families (`--map-range per-object`): the teapot's 32 patches, which touch
+/// one another, are one family named `teapot`; a second teapot numbered on (`teapot_32` …
+/// `teapot_63`) but placed apart is a family of its own, both then named by their first and
+/// last patch; surfaces numbered alike but apart (Blender's `Surface.001`, OBJ's `surface`,
+/// `surface.2`) are one family each.
+#[test]
+fn surface_families_are_numbered_names_that_touch() {
+    use prespline::render::maps::surface_families;
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/teapot.json");
+    let teapot: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    let families = |objects: Vec<serde_json::Value>| {
+        let text = serde_json::json!({ "objects": objects }).to_string();
+        let scene = prespline::scene::parse_scene(&text).unwrap();
+        surface_families(&common::editor(&scene, None).into_document())
+    };
+    let one = families(moved(&teapot, 0.0, str::to_string));
+    assert_eq!(one, [("teapot".to_string(), (0..32).collect::<Vec<_>>())]);
+
+    let renumber = |n: &str| {
+        format!(
+            "teapot_{}",
+            n["teapot_".len()..].parse::<usize>().unwrap() + 32
+        )
+    };
+    let mut two = moved(&teapot, 0.0, str::to_string);
+    two.extend(moved(&teapot, 10.0, renumber));
+    assert_eq!(
+        families(two),
+        [
+            (
+                "teapot_00…teapot_31".to_string(),
+                (0..32).collect::<Vec<_>>()
+            ),
+            ("teapot_32…teapot_63".to_string(), (32..64).collect()),
+        ]
+    );
+    // Negative control: the second teapot moved onto the first joins it.
+    let mut overlapping = moved(&teapot, 0.0, str::to_string);
+    overlapping.extend(moved(&teapot, 0.5, renumber));
+    assert_eq!(families(overlapping).len(), 1);
+
+    let patch = &teapot["objects"][0];
+    let apart = |names: &[&str]| -> Vec<serde_json::Value> {
+        names
+            .iter()
+            .enumerate()
+            .flat_map(|(k, n)| {
+                let one = serde_json::json!({ "objects": [patch] });
+                moved(&one, 5.0 * k as f64, |_| (*n).to_string())
+            })
+            .collect()
+    };
+    for names in [
+        &["Surface.001", "Surface.002", "Surface.003"][..],
+        &["surface", "surface.2", "surface.3"],
+    ] {
+        let got = families(apart(names));
+        let want: Vec<(String, Vec<usize>)> = names
+            .iter()
+            .enumerate()
+            .map(|(k, n)| (n.to_string(), vec![k]))
+            .collect();
+        assert_eq!(got, want);
+    }
+}

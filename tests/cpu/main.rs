@@ -10,6 +10,7 @@ mod oracle;
 mod budget_accuracy;
 mod budget_counts;
 mod cli_errors;
+mod cli_help;
 mod cli_spline_errors;
 mod curvature_maps;
 mod delta_vs_full;

@@ -352,3 +352,154 @@ fn the_resident_comparison_fails_on_a_wrong_estimate() {
     assert!(!agrees(report_ratio(line).unwrap(), RESIDENT_TOLERANCE));
     assert_eq!(report_ratio("wrote x.png"), None);
 }
+
+/// What `render --analysis gaussian` wrote for `scene` with `args`: the image and the
+/// document and shot it shows (for projecting samples and placing legends).
+fn render_map(
+    scene: &Path,
+    out: &Path,
+    args: &[&str],
+) -> (
+    prespline::gpu::Pixels,
+    prespline::editor::Document,
+    prespline::render::offscreen::Shot,
+) {
+    use prespline::render::ViewOptions;
+    use prespline::render::maps::SurfaceMap;
+    let r = prespline()
+        .arg("render")
+        .arg(scene)
+        .arg("--out")
+        .arg(out)
+        .args(["--size", "960x540", "--msaa", "1", "--analysis", "gaussian"])
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let px = prespline::gpu::Pixels::read_png(out).unwrap();
+    let loaded = prespline::scene::Scene::load(scene).unwrap();
+    let doc = common::editor(&loaded, Some(SurfaceMap::Gaussian)).into_document();
+    let shot = prespline::render::offscreen::Shot {
+        width: 960,
+        height: 540,
+        camera: None,
+        options: ViewOptions {
+            analysis: Some(SurfaceMap::Gaussian),
+            ..ViewOptions::default()
+        },
+        msaa: 1,
+    };
+    (px, doc, shot)
+}
+
+/// The text of a legend drawn for `scale` at `slot` (named `name`): its title and its three
+/// values, as read from the image where [`legend_layout`] puts them.
+fn read_legend(
+    px: &prespline::gpu::Pixels,
+    scale: prespline::render::maps::MapScale,
+    name: Option<&str>,
+    slot: usize,
+) -> (Vec<String>, Vec<String>) {
+    use prespline::gpu::font::{Font, TextSize};
+    use prespline::render::analysis::PANEL;
+    use prespline::render::maps::{LEGEND_TEXT, LegendPlace, SurfaceMap, legend_layout};
+    let font = Font::new(1.0);
+    let place = LegendPlace {
+        name,
+        slot,
+        width: px.width as f32,
+        height: px.height as f32,
+    };
+    let layout = legend_layout(SurfaceMap::Gaussian, scale, &font, place);
+    let texts: Vec<(String, [f32; 2])> =
+        std::iter::once(layout.title).chain(layout.labels).collect();
+    let want = texts.iter().map(|(t, _)| t.clone()).collect();
+    let seen = texts
+        .iter()
+        .map(|(t, at)| {
+            let at = [at[0].round() as u32, at[1].round() as u32];
+            common::read_text(
+                px,
+                &font,
+                TextSize::Normal,
+                at,
+                t.chars().count(),
+                PANEL,
+                LEGEND_TEXT,
+            )
+        })
+        .collect();
+    (want, seen)
+}
+
+/// `render --map-range MIN,MAX` fixes the scale: the legend reads MIN, the middle and MAX, and
+/// a range far wider than the bumps' curvature leaves them white, where the default
+/// (per-object) range colours them and its legend shows the surface's own range.
+#[test]
+fn render_map_range_min_max_sets_the_legend_and_the_colours() {
+    use crate::render_analysis::coloured_fraction_beside;
+    use prespline::render::maps::{MapRange, MapScale, SurfaceMap, map_scales};
+    let scratch = common::Scratch::new("cli-map-range");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/bspline_surface.json");
+    let (px, doc, shot) = render_map(&scene, &scratch.join("default.png"), &[]);
+    let own = map_scales(&doc, SurfaceMap::Gaussian, MapRange::PerObject)[0];
+    let (want, seen) = read_legend(&px, own, None, 0);
+    assert_eq!(seen, want, "default: the surface's own range");
+    let coloured = coloured_fraction_beside(&doc, &shot, &px, 0, 1);
+    assert!(coloured > 0.3, "default: the bumps show colour: {coloured}");
+
+    let fixed = MapScale {
+        low: -50.0,
+        high: 50.0,
+    };
+    let (want, seen) = read_legend(&px, fixed, None, 0);
+    assert_ne!(
+        seen, want,
+        "negative control: the default legend is not the fixed one"
+    );
+    let (px, doc, shot) = render_map(&scene, &scratch.join("fixed.png"), &["--map-range=-50,50"]);
+    let (want, seen) = read_legend(&px, fixed, None, 0);
+    assert_eq!(want[1..], ["-50.00", "0", "50.00"]);
+    assert_eq!(
+        seen, want,
+        "--map-range=-50,50: the legend shows the fixed range"
+    );
+    let coloured = coloured_fraction_beside(&doc, &shot, &px, 0, 1);
+    assert!(
+        coloured < 0.05,
+        "a wide fixed range leaves the bumps white: {coloured}"
+    );
+}
+
+/// `render --map-range shared` against the default on the bumps beside the teapot: by default
+/// each family has its own legend (teapot above, bumps below) and the bumps show colour; shared,
+/// one unnamed legend with the teapot-sized range and the bumps go white.
+#[test]
+fn render_map_range_shared_against_the_default() {
+    use crate::render_analysis::{bumps_beside_the_teapot_json, coloured_fraction_beside};
+    use prespline::render::maps::{MapRange, SurfaceMap, map_scales};
+    let scratch = common::Scratch::new("cli-map-range");
+    let scene = scratch.file("mixed.json", &bumps_beside_the_teapot_json());
+    let (px, doc, shot) = render_map(&scene, &scratch.join("default.png"), &[]);
+    let bumps = doc.objects.len() - 1;
+    let own = map_scales(&doc, SurfaceMap::Gaussian, MapRange::PerObject);
+    let (want, seen) = read_legend(&px, own[0], Some("teapot"), 1);
+    assert_eq!(seen, want, "default: the teapot's legend on top");
+    let (want, seen) = read_legend(&px, own[bumps], Some("bumps"), 0);
+    assert_eq!(seen, want, "default: the bumps' legend below");
+    let coloured = coloured_fraction_beside(&doc, &shot, &px, bumps, 2);
+    assert!(coloured > 0.3, "default: the bumps show colour: {coloured}");
+
+    let shared = map_scales(&doc, SurfaceMap::Gaussian, MapRange::Shared)[0];
+    let (want, seen) = read_legend(&px, shared, None, 0);
+    assert_ne!(seen, want, "negative control: no shared legend by default");
+    let (px, doc, shot) = render_map(
+        &scene,
+        &scratch.join("shared.png"),
+        &["--map-range", "shared"],
+    );
+    let (want, seen) = read_legend(&px, shared, None, 0);
+    assert_eq!(seen, want, "shared: one legend with the shared range");
+    let coloured = coloured_fraction_beside(&doc, &shot, &px, bumps, 1);
+    assert!(coloured < 0.05, "shared: the bumps wash out: {coloured}");
+}

@@ -459,26 +459,30 @@ fn the_osculating_readout_is_not_overlapped_by_badges() {
 
 /// A B-spline curve whose interior knot has multiplicity degree + 1 is two pieces (C⁻¹, the
 /// "gap" badge): no line may bridge them. Degree 1 over (−3,0) (−1,0) | (1,2) (3,2), seen from
-/// straight above: the pieces are drawn, the diagonal between (−1,0) and (1,2) stays empty. The
-/// negative control is the same points with a simple interior knot, one polyline through all
-/// four, whose diagonal the same probes must see.
+/// straight above: the pieces are drawn, the diagonal between (−1,0) and (1,2) stays empty.
+/// Each piece reaches its end at the gap (the one-sided limits (−1,0) and (1,2)) even where no
+/// sample does: with 5 samples the last one left of the knot is at x = −2, and with 4 neither
+/// piece has a sample at the knot. The negative control is the same points with a simple
+/// interior knot, one polyline through all four, whose diagonal the same probes must see.
 #[test]
 fn curves_with_a_gap_are_drawn_apart() {
     use prespline::render::analysis::curve_pieces;
     use prespline::render::camera::OrbitCamera;
-    let scene = |knots: &str| {
+    let scene = |knots: &str, samples: usize| {
         prespline::scene::parse_scene(&format!(
             r#"{{"objects": [{{"name": "c", "type": "bspline_curve", "degree": 1, "knots": {knots},
-            "points": [[-3, 0, 0], [-1, 0, 0], [1, 2, 0], [3, 2, 0]], "samples": 41, "color": [1, 1, 1]}}]}}"#
+            "points": [[-3, 0, 0], [-1, 0, 0], [1, 2, 0], [3, 2, 0]], "samples": {samples}, "color": [1, 1, 1]}}]}}"#
         ))
         .unwrap()
     };
-    let (torn, whole) = (scene("[0, 0, 1, 1, 2, 2]"), scene("[0, 0, 1, 2, 3, 3]"));
     let camera = OrbitCamera::parse("0,1,20,0,1,0").unwrap();
     let ink = |scene: &Scene| {
         let doc = common::editor(scene, None).into_document();
         let sampled = &doc.objects[0].sampled;
-        let pieces = curve_pieces(sampled.model(), sampled.params()[0]);
+        let pieces: Vec<_> = curve_pieces(sampled.model(), sampled.params()[0])
+            .into_iter()
+            .map(|p| p.samples)
+            .collect();
         let (w, h) = (400u32, 400u32);
         let (mut renderer, sink) = common::renderer();
         let shot = Shot {
@@ -507,23 +511,36 @@ fn curves_with_a_gap_are_drawn_apart() {
             n
         };
         let pieces_lit = [DVec3::new(-2.0, 0.0, 0.0), DVec3::new(2.0, 2.0, 0.0)].map(lit);
+        let ends_lit = [DVec3::new(-1.2, 0.0, 0.0), DVec3::new(1.2, 2.0, 0.0)].map(lit);
         let bridge_lit = [0.3, 0.5, 0.7].map(|s| lit(DVec3::new(-1.0 + 2.0 * s, 2.0 * s, 0.0)));
-        (pieces, pieces_lit, bridge_lit)
+        (pieces, pieces_lit, ends_lit, bridge_lit)
     };
-    let (pieces, pieces_lit, bridge_lit) = ink(&torn);
-    assert_eq!(
-        pieces,
-        [0..20, 20..41],
-        "the sample at the gap starts the right piece"
-    );
-    assert!(
-        pieces_lit.iter().all(|&n| n > 0),
-        "both pieces drawn: {pieces_lit:?}"
-    );
-    assert_eq!(bridge_lit, [0, 0, 0], "nothing bridges the gap");
-    let (pieces, pieces_lit, bridge_lit) = ink(&whole);
+    for (samples, want) in [(41, [0..20, 20..41]), (5, [0..2, 2..5]), (4, [0..2, 2..4])] {
+        let (pieces, pieces_lit, ends_lit, bridge_lit) = ink(&scene("[0, 0, 1, 1, 2, 2]", samples));
+        assert_eq!(
+            pieces, want,
+            "{samples} samples: a sample at the gap starts the right piece"
+        );
+        assert!(
+            pieces_lit.iter().all(|&n| n > 0),
+            "{samples} samples: both pieces drawn: {pieces_lit:?}"
+        );
+        assert!(
+            ends_lit.iter().all(|&n| n > 0),
+            "{samples} samples: each piece reaches the gap: {ends_lit:?}"
+        );
+        assert_eq!(
+            bridge_lit,
+            [0, 0, 0],
+            "{samples} samples: nothing bridges the gap"
+        );
+    }
+    let (pieces, pieces_lit, ends_lit, bridge_lit) = ink(&scene("[0, 0, 1, 2, 3, 3]", 41));
     assert_eq!((pieces.len(), pieces.first()), (1, Some(&(0..41))));
-    assert!(pieces_lit.iter().all(|&n| n > 0), "{pieces_lit:?}");
+    assert!(
+        pieces_lit.iter().chain(&ends_lit).all(|&n| n > 0),
+        "{pieces_lit:?} {ends_lit:?}"
+    );
     assert!(
         bridge_lit.iter().all(|&n| n > 0),
         "negative control: the probes see a drawn diagonal: {bridge_lit:?}"
@@ -531,7 +548,12 @@ fn curves_with_a_gap_are_drawn_apart() {
 }
 
 /// The bumpy B-spline surface (moved to the left) next to the 32 teapot patches, Gaussian map.
-fn bumps_beside_the_teapot() -> Scene {
+pub(crate) fn bumps_beside_the_teapot() -> Scene {
+    prespline::scene::parse_scene(&bumps_beside_the_teapot_json()).unwrap()
+}
+
+/// [`bumps_beside_the_teapot`] as a scene file's text.
+pub(crate) fn bumps_beside_the_teapot_json() -> String {
     let read = |p: &str| -> serde_json::Value {
         let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(p));
         serde_json::from_str(&text.unwrap()).unwrap()
@@ -544,12 +566,23 @@ fn bumps_beside_the_teapot() -> Scene {
         }
     }
     scene["objects"].as_array_mut().unwrap().push(bumps);
-    prespline::scene::parse_scene(&scene.to_string()).unwrap()
+    scene.to_string()
 }
 
 /// The fraction of object `i`'s samples whose pixel is clearly coloured (not white or grey),
 /// leaving out those under the legends (bottom right, at most two stacked).
 fn coloured_fraction(doc: &Document, shot: &Shot, px: &Pixels, i: usize) -> f64 {
+    coloured_fraction_beside(doc, shot, px, i, 2)
+}
+
+/// [`coloured_fraction`] beside `slots` stacked legends.
+pub(crate) fn coloured_fraction_beside(
+    doc: &Document,
+    shot: &Shot,
+    px: &Pixels,
+    i: usize,
+    slots: usize,
+) -> f64 {
     let camera = shot_camera(doc, shot);
     let (w, h) = (shot.width as f64, shot.height as f64);
     let grid = doc.objects[i].sampled.grid();
@@ -559,7 +592,7 @@ fn coloured_fraction(doc: &Document, shot: &Shot, px: &Pixels, i: usize) -> f64 
         let Some((x, y, _)) = camera.project(grid.data[k * stride], w, h, &doc.bounds()) else {
             continue;
         };
-        let legends = x >= w - 340.0 && y >= h - 64.0 - 2.0 * 96.0;
+        let legends = x >= w - 340.0 && y >= h - 64.0 - slots as f64 * 96.0;
         if x < 0.0 || y < 0.0 || x >= w || y >= h || legends {
             continue;
         }
@@ -637,4 +670,179 @@ fn per_object_ranges_colour_every_surface_in_a_mixed_scene() {
         bumpy < 0.05,
         "negative control, shared scale: the bumps wash out: {bumpy}"
     );
+}
+
+/// Six copies of the bumpy B-spline surface named as Blender names separate objects
+/// (`Surface.001` … `Surface.006`), two rows of three a clear gap apart, their heights scaled
+/// by 1/8, 1/4, … 4 (so their curvatures differ by orders of magnitude).
+fn six_separate_surfaces() -> Scene {
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/bspline_surface.json"),
+    );
+    let bumps: serde_json::Value = serde_json::from_str(&text.unwrap()).unwrap();
+    let bumps = &bumps["objects"][0];
+    let objects: Vec<serde_json::Value> = (0..6)
+        .map(|k| {
+            let mut o = bumps.clone();
+            o["name"] = serde_json::json!(format!("Surface.{:03}", k + 1));
+            let (dx, dy) = (8.0 * (k % 3) as f64 - 8.0, 8.0 * (k / 3) as f64 - 4.0);
+            let height = 2f64.powi(k - 3);
+            for row in o["points"].as_array_mut().unwrap() {
+                for p in row.as_array_mut().unwrap() {
+                    let [x, y, z] = [0, 1, 2].map(|c| p[c].as_f64().unwrap());
+                    *p = serde_json::json!([x + dx, y + dy, z * height]);
+                }
+            }
+            o
+        })
+        .collect();
+    let scene = serde_json::json!({ "objects": objects });
+    prespline::scene::parse_scene(&scene.to_string()).unwrap()
+}
+
+/// Separate surfaces whose names differ only in a trailing number (Blender's `Surface.001` …)
+/// are not one model: each gets its own colour scale and shows colour, the flattest too. The
+/// negative control is the shared scale, under which the flattest goes white.
+#[test]
+fn separate_surfaces_with_numbered_names_get_their_own_ranges() {
+    use prespline::render::maps::{MapRange, map_scales, surface_families};
+    let doc = common::editor(&six_separate_surfaces(), Some(SurfaceMap::Gaussian)).into_document();
+    let families = surface_families(&doc);
+    let names: Vec<&str> = families.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "Surface.001",
+            "Surface.002",
+            "Surface.003",
+            "Surface.004",
+            "Surface.005",
+            "Surface.006"
+        ]
+    );
+    let own = map_scales(&doc, SurfaceMap::Gaussian, MapRange::PerObject);
+    assert!(
+        own.windows(2).all(|w| w[1].high > 1.5 * w[0].high),
+        "each its own range, growing with the height: {own:?}"
+    );
+    // From straight above, the scene left of the legends' column.
+    let camera = prespline::render::camera::OrbitCamera::parse("5,0,40,5,0,0").unwrap();
+    let render = |range: MapRange| {
+        let shot = Shot {
+            width: 1200,
+            height: 900,
+            camera: Some(camera),
+            options: ViewOptions {
+                analysis: Some(SurfaceMap::Gaussian),
+                map_range: range,
+                ..ViewOptions::default()
+            },
+            msaa: 1,
+        };
+        let (mut renderer, sink) = common::renderer();
+        let px = render_document(&mut renderer, &doc, &shot).unwrap();
+        common::teardown(renderer, sink);
+        if std::env::var_os("PRESPLINE_KEEP").is_some() {
+            px.write_png(&std::env::temp_dir().join(format!("six-{range:?}.png")))
+                .unwrap();
+        }
+        let slots = if range == MapRange::PerObject { 6 } else { 1 };
+        (0..6)
+            .map(|i| coloured_fraction_beside(&doc, &shot, &px, i, slots))
+            .collect::<Vec<_>>()
+    };
+    let coloured = render(MapRange::PerObject);
+    assert!(
+        coloured.iter().all(|&f| f > 0.15),
+        "every surface shows colour: {coloured:?}"
+    );
+    let shared = render(MapRange::Shared);
+    assert!(
+        shared[0] < 0.05,
+        "negative control, shared scale: the flattest washes out: {shared:?}"
+    );
+}
+
+/// Where the legends of a still image do not all fit, a note above them says how many
+/// families and surfaces have none: 6 separate surfaces at 800 × 400 show 3 legends and
+/// "+3 more: 3 surfaces without a legend". The negative control reads the same place with
+/// the shared scale (one legend, no note).
+#[test]
+fn legends_that_do_not_fit_are_counted_in_a_note() {
+    use prespline::gpu::font::Font;
+    use prespline::render::maps::{
+        LEGEND_TEXT, LegendPlace, MapRange, legend_layout, legend_note_height, legend_note_layout,
+        legend_note_text, map_scales,
+    };
+    use prespline::render::offscreen::legends_shown;
+    let doc = common::editor(&six_separate_surfaces(), Some(SurfaceMap::Gaussian)).into_document();
+    let font = Font::new(1.0);
+    let (w, h) = (800u32, 400u32);
+    let shown = legends_shown(6, h as f32, legend_note_height(&font));
+    assert_eq!(shown, 3);
+    let note = legend_note_text(3, 3);
+    assert_eq!(note, "+3 more: 3 surfaces without a legend");
+    let place = |name, slot| LegendPlace {
+        name,
+        slot,
+        width: w as f32,
+        height: h as f32,
+    };
+    let (_, at) = legend_note_layout(&note, &font, place(None, shown));
+    let read = |range: MapRange| {
+        let shot = Shot {
+            width: w,
+            height: h,
+            camera: None,
+            options: ViewOptions {
+                analysis: Some(SurfaceMap::Gaussian),
+                map_range: range,
+                ..ViewOptions::default()
+            },
+            msaa: 1,
+        };
+        let (mut renderer, sink) = common::renderer();
+        let px = render_document(&mut renderer, &doc, &shot).unwrap();
+        common::teardown(renderer, sink);
+        let text = |(s, at): (&str, [f32; 2])| {
+            let at = [at[0].round() as u32, at[1].round() as u32];
+            common::read_text(
+                &px,
+                &font,
+                TextSize::Normal,
+                at,
+                s.chars().count(),
+                PANEL,
+                LEGEND_TEXT,
+            )
+        };
+        // The legends shown are the first three families', the first on top.
+        let scales = map_scales(&doc, SurfaceMap::Gaussian, MapRange::PerObject);
+        let titles: Vec<[String; 2]> = (0..3)
+            .map(|k| {
+                let name = format!("Surface.{:03}", k + 1);
+                let slot = 2 - k;
+                let place = LegendPlace {
+                    name: Some(&name),
+                    slot,
+                    width: w as f32,
+                    height: h as f32,
+                };
+                let layout = legend_layout(SurfaceMap::Gaussian, scales[k], &font, place);
+                let (title, at) = layout.title;
+                [text((&title, at)), title]
+            })
+            .collect();
+        (text((&note, at)), titles)
+    };
+    let (seen, titles) = read(MapRange::PerObject);
+    assert_eq!(seen, note, "the note names what has no legend");
+    for [seen, want] in titles {
+        assert_eq!(
+            seen, want,
+            "the first three families' legends, top to bottom"
+        );
+    }
+    let (seen, _) = read(MapRange::Shared);
+    assert_ne!(seen, note, "negative control: one shared legend, no note");
 }

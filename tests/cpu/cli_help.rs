@@ -1,0 +1,60 @@
+//! What `prespline help` promises: the viewer's help points to its documentation and describes
+//! the demo scene as it is; `render --help` names the image formats `--out` takes.
+
+use std::process::Command;
+
+/// The help text of `prespline help COMMAND`, with clap's line wrapping undone.
+fn help(command: &str) -> String {
+    let out = Command::new(env!("CARGO_BIN_EXE_prespline"))
+        .args(["help", command])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout)
+        .unwrap()
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// `help view` names docs/viewer.md (which exists) and every kind of object of the demo it
+/// describes, the closed ERBS torus included, and the demo has that torus.
+#[test]
+fn help_view_names_the_viewer_docs_and_the_erbs_torus() {
+    let text = help("view");
+    assert!(text.contains("docs/viewer.md"), "{text}");
+    assert!(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("docs/viewer.md")
+            .is_file()
+    );
+    for part in [
+        "B-spline surface",
+        "ERBS surface and curve",
+        "NURBS circle",
+        "closed ERBS torus",
+        "Utah teapot",
+    ] {
+        assert!(text.contains(part), "help view lacks {part:?}: {text}");
+    }
+    let demo = prespline::scene::demo::demo_scene();
+    assert!(demo.objects.iter().any(|o| o.name == "erbs_torus"));
+}
+
+/// `render --help` says `--out` writes PNG or JPEG by the extension, not PNG only.
+#[test]
+fn help_render_names_png_and_jpeg() {
+    let text = help("render");
+    assert!(
+        text.contains("into a PNG or JPEG image (by the extension)"),
+        "{text}"
+    );
+    assert!(
+        text.contains("PNG for .png, JPEG for .jpg or .jpeg"),
+        "{text}"
+    );
+}
