@@ -87,11 +87,12 @@ impl<'a> CurveEval<'a> {
             }
             CurveEval::BSpline { curve, .. } => {
                 let (a, b) = curve.domain();
+                // Runs of equal knots in one pass (millions of knots are possible).
                 curve
                     .knots()
-                    .breakpoints(a, b)
-                    .into_iter()
-                    .filter(|&t| t > a && t < b && curve.knots().multiplicity(t) > 1)
+                    .chunk_by(|x, y| x == y)
+                    .filter(|run| run.len() > 1 && run[0] > a && run[0] < b)
+                    .map(|run| run[0])
                     .collect()
             }
             CurveEval::Erbs(_) => Vec::new(),
