@@ -412,11 +412,13 @@ pub struct Kept {
 
 impl std::fmt::Display for Kept {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        // Both carry the scene's file name, which may hold control characters: escaped, so
+        // the line stays one line and nothing reaches the terminal as a command.
         write!(
             f,
             "unsaved edits kept in {} (`{}` opens them)",
-            self.path.display(),
-            self.command
+            crate::scene::escape_controls(&self.path.display().to_string()),
+            crate::scene::escape_controls(&self.command)
         )
     }
 }
@@ -760,6 +762,20 @@ fn create_private_dir(dir: &Path) -> std::io::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_exit_line_escapes_control_characters() {
+        let kept = Kept {
+            path: PathBuf::from("/tmp/we\u{1b}[31mird\nname.autosave.json"),
+            command: "prespline view 'we\u{1b}[31mird\nname.json' --recover".into(),
+        };
+        let line = kept.to_string();
+        assert!(!line.chars().any(char::is_control), "{line:?}");
+        assert_eq!(line.matches("\\u{1b}").count(), 2, "{line}");
+        assert_eq!(line.matches("\\n").count(), 2, "{line}");
+        // Negative control: the raw fields do hold control characters.
+        assert!(kept.command.chars().any(char::is_control));
+    }
     use crate::scene::parse_scene;
 
     fn scene(x: f64) -> Scene {

@@ -102,7 +102,8 @@ fn parse_event(v: &Value, doc: &Document) -> Result<ScriptEvent, String> {
                 .ok_or("'t' must be a non-negative number")?;
             if t > MAX_SCRIPT_SECONDS {
                 return Err(format!(
-                    "'t' {t} s is beyond the longest a script may run ({MAX_SCRIPT_SECONDS} s, one day)"
+                    "'t' {} s is beyond the longest a script may run ({MAX_SCRIPT_SECONDS} s, one day)",
+                    crate::render::numbers::short(t)
                 ));
             }
             When::Seconds(t)
@@ -390,6 +391,8 @@ mod tests {
                 "{text}: {e}"
             );
             assert!(!e.contains('\n'), "{text}: one line, got {e:?}");
+            // A huge number is written short, not digit by digit (1e300 has 301).
+            assert!(e.len() < 200, "{text}: {} characters: {e}", e.len());
         }
     }
 

@@ -794,3 +794,50 @@ fn a_samples_count_no_object_takes_is_noted() {
     let (_, err) = run(&mixed, &["--samples", "5", "--samples", "4x6"]);
     assert!(!err.contains("note:"), "every count applies: {err}");
 }
+
+/// Command-line mistakes get one line like every other error, naming what is wrong and
+/// pointing to `--help` (clap writes a usage block and a hint over several lines).
+#[test]
+fn command_line_errors_are_one_line() {
+    let run = |args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_prespline"))
+            .args(args)
+            .output()
+            .unwrap();
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stdout).into_owned(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    for (args, part) in [
+        (&["bench", "--scenario", "nosuch"][..], "nosuch"),
+        (&["render"][..], "--out"),
+        (
+            &["sample", "x.json", "--samples", "10000001"][..],
+            "10000001",
+        ),
+        (&["sample", "x.json", "--bogus"][..], "--bogus"),
+        (&["nosuchcommand"][..], "nosuchcommand"),
+    ] {
+        let (code, stdout, stderr) = run(args);
+        assert_eq!(code, Some(2), "{args:?}: {stderr}");
+        assert!(stdout.is_empty(), "{args:?}: {stdout}");
+        assert_eq!(
+            stderr.lines().count(),
+            1,
+            "{args:?}: not one line:\n{stderr}"
+        );
+        assert!(
+            stderr.starts_with("error: ") && stderr.contains(part) && stderr.contains("--help"),
+            "{args:?}: {stderr}"
+        );
+    }
+    // Both missing arguments are named on the one line.
+    let (_, _, stderr) = run(&["render"]);
+    assert!(stderr.contains("<SCENE>"), "{stderr}");
+    // Negative control: help is not an error and keeps its lines.
+    let (code, stdout, _) = run(&["render", "--help"]);
+    assert_eq!(code, Some(0));
+    assert!(stdout.lines().count() > 5, "{stdout}");
+}
