@@ -76,4 +76,45 @@ mod tests {
         let knots = ErbsKnots::open(vec![0., 0., 1., 2., 3., 3.], 4).unwrap();
         assert_eq!(erbs_knot_probes(&knots), vec![0., 1., 2., 3.]);
     }
+
+    /// The surface's guards: a refinement (u and v) and a construction keep the shape, and a
+    /// local patch moved by 1e-5 where the comparison looks is caught.
+    #[test]
+    fn erbs_surface_refinement_and_construction_are_compared() {
+        use crate::geom::TensorSurface;
+        use crate::geom::erbs::ErbsSurface;
+        let points = (0..16)
+            .map(|k| DVec3::new((k / 4) as f64, (k % 4) as f64, ((k * 7) % 5) as f64 * 0.3))
+            .collect();
+        let source = TensorSurface::bezier([4, 4], points, None).unwrap();
+        let s = ErbsSurface::from_surface(
+            &source,
+            [3, 3],
+            [3, 3],
+            BFunctionKind::default(),
+            [false, false],
+        )
+        .unwrap();
+        for dir in 0..2 {
+            let t = s.knots()[dir].domain().0
+                + 0.37 * (s.knots()[dir].domain().1 - s.knots()[dir].domain().0);
+            let (refined, new) = s.insert_knot(dir, t, None).unwrap();
+            assert!(
+                s.refinement_change(&refined, (dir, t)).is_kept(),
+                "dir {dir}"
+            );
+            let mut at = [1, 1];
+            at[dir] = new;
+            let mut moved = refined.clone();
+            moved.transform_local(&[at], &DMat4::from_translation(DVec3::Z * 1e-5));
+            let change = s.refinement_change(&moved, (dir, t));
+            assert!(!change.is_kept(), "dir {dir}: {change:?}");
+        }
+        let local = s.local_patch(1, 1).clone();
+        let built = ErbsSurface::build(&local, [2, 2], [2, 2], BFunctionKind::default()).unwrap();
+        assert!(ErbsSurface::build_change(&local, &built).is_kept());
+        let mut moved = built;
+        moved.transform_local(&[[0, 1]], &DMat4::from_translation(DVec3::X * 1e-5));
+        assert!(!ErbsSurface::build_change(&local, &moved).is_kept());
+    }
 }

@@ -232,3 +232,43 @@ pub(super) fn check_elevation(
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod guard_tests {
+    use super::*;
+    use glam::DVec3;
+
+    /// The guard every B-spline curve refinement passes through (`prepare` takes its result
+    /// from `kept_curve`) refuses a refined net that moves the shape, in one error naming the
+    /// edit's field; the same net unmoved passes.
+    #[test]
+    fn a_refinement_that_moves_the_shape_is_refused() {
+        let c = BSplineCurve::new(
+            3,
+            vec![0.0, 0.0, 0.0, 0.0, 0.5, 1.0, 1.0, 1.0, 1.0],
+            vec![
+                DVec3::ZERO,
+                DVec3::new(1.0, 2.0, 0.0),
+                DVec3::new(2.0, -1.0, 1.0),
+                DVec3::new(3.0, 1.0, 0.0),
+                DVec3::new(4.0, 0.0, 0.0),
+            ],
+            None,
+        )
+        .unwrap();
+        let elevated = c.elevate_degree(1).unwrap();
+        assert!(kept_curve("elevate_degree", &c, Ok(elevated.clone()), c.domain()).is_ok());
+        let mut moved = elevated;
+        let p = moved.points()[3];
+        moved.set_point(3, p + DVec3::new(0.0, 1e-6, 0.0));
+        let e = kept_curve("elevate_degree", &c, Ok(moved), c.domain()).unwrap_err();
+        assert_eq!(e.field, "elevate_degree", "{e:?}");
+        let inserted = c.insert_knot(0.25, 1).unwrap();
+        let window = insertion_window(c.knots(), c.degree(), 0.25, c.domain());
+        assert!(kept_curve("insert_knot", &c, Ok(inserted.clone()), window).is_ok());
+        let mut moved = inserted;
+        let p = moved.points()[1];
+        moved.set_point(1, p * (1.0 + 1e-7));
+        assert!(kept_curve("insert_knot", &c, Ok(moved), window).is_err());
+    }
+}

@@ -224,3 +224,29 @@ fn in_direction(mut e: EditError, dir: usize) -> EditError {
     e.message = format!("{} direction: {}", ["u", "v"][dir], e.message);
     e
 }
+
+#[cfg(test)]
+mod guard_tests {
+    use super::*;
+
+    /// The guard every surface refinement passes through refuses a refined net that moves
+    /// the shape, naming the edit's field; the same net unmoved passes.
+    #[test]
+    fn a_refinement_that_moves_the_shape_is_refused() {
+        let points = (0..9)
+            .map(|k| DVec3::new((k / 3) as f64, (k % 3) as f64, ((k * 7) % 5) as f64 * 0.3))
+            .collect();
+        let s = TensorSurface::bezier([3, 3], points, None).unwrap();
+        let windows = [Some(s.domain()[0]), None];
+        let elevated = s.elevate_degree(0, 1);
+        assert_eq!(
+            check_surface_kept("elevate_degree", &s, &elevated, windows),
+            Ok(())
+        );
+        let mut moved = elevated;
+        let p = moved.points()[4];
+        moved.set_point(1, 1, p + DVec3::new(0.0, 0.0, 1e-6));
+        let e = check_surface_kept("elevate_degree", &s, &moved, windows).unwrap_err();
+        assert_eq!(e.field, "elevate_degree", "{e:?}");
+    }
+}
