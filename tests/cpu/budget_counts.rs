@@ -228,3 +228,37 @@ fn control_points_from_a_file_count_in_the_budget() {
     assert_eq!(code, Some(0), "{stderr}");
     assert!(stdout.starts_with("{\"objects\""));
 }
+
+/// `to_erbs` on an ERBS curve's local, at the top and inside a nested local: the count passes
+/// the budget before anything is built, in `sample` and `render`, as for surfaces.
+#[test]
+fn curve_to_erbs_edits_with_huge_local_counts_are_refused_before_building() {
+    let dir = Scratch::new("budget-counts");
+    dir.file("scene.json", &ERBS_CURVE_FROM.replace("1000000000000", "4"));
+    let top =
+        r#"[{"object":"e","local":0,"to_erbs":{"local_curves":1000000000000,"local_degree":2}}]"#;
+    let nested = r#"[{"object":"e","local":0,"to_erbs":{"local_curves":3,"local_degree":2}},{"object":"e","local":[0,1],"to_erbs":{"local_curves":1000000000000,"local_degree":2}}]"#;
+    for (name, edits) in [("top.json", top), ("nested.json", nested)] {
+        dir.file(name, edits);
+        let parts = ["object 'e'", "field 'to_erbs'", "memory budget"];
+        expect_one_line(&dir, &["sample", "scene.json", "--edits", name], &parts);
+        expect_one_line(
+            &dir,
+            &[
+                "render",
+                "scene.json",
+                "--edits",
+                name,
+                "--size",
+                "8x8",
+                "--out",
+                "x.png",
+            ],
+            &parts,
+        );
+    }
+    // Negative control: a modest count is built.
+    dir.file("small.json", &top.replace("1000000000000", "5"));
+    let (code, _, stderr) = run_limited(&dir, &["sample", "scene.json", "--edits", "small.json"]);
+    assert_eq!(code, Some(0), "{stderr}");
+}
