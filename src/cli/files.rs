@@ -100,6 +100,15 @@ impl SampleOverride {
 }
 
 impl SampleOverride {
+    /// The counts as defaults for scene-file objects that give none.
+    #[must_use]
+    pub fn defaults(&self) -> crate::scene::SampleDefaults {
+        crate::scene::SampleDefaults {
+            curve: self.curve,
+            surface: self.surface,
+        }
+    }
+
     /// A note for each given count that no object of `scene` (loaded from `file`) takes:
     /// `--samples N` sets curves only and `NxM` surfaces only, so `--samples 5` on a scene of
     /// surfaces would otherwise change nothing without a word.
@@ -139,7 +148,7 @@ pub fn load_scene(path: &Path, samples: &SampleOverride) -> Result<Scene, CliErr
             }
             import.scene
         }
-        _ => Scene::load(path).map_err(|e| CliError::in_file(path, e))?,
+        _ => Scene::load_with(path, samples.defaults()).map_err(|e| CliError::in_file(path, e))?,
     };
     samples.apply(&mut scene)?;
     let shown = path.display().to_string();

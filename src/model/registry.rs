@@ -149,6 +149,18 @@ macro_rules! kinds {
                 curves
             }
 
+            /// Whether scene-file type `ty` is a surface kind (`None`: no kind reads it).
+            #[must_use]
+            pub fn type_is_surface(ty: &str) -> Option<bool> {
+                use $crate::model::Kind;
+                $(
+                    if <$m>::TYPES.contains(&ty) {
+                        return Some(<$m>::SURFACE);
+                    }
+                )+
+                None
+            }
+
             /// The model's kind.
             #[must_use]
             pub fn kind(&self) -> &dyn DynKind {

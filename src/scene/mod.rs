@@ -10,7 +10,7 @@ mod write;
 pub use crate::format::json::{self, At, SceneError};
 pub use crate::model::{Index2, MAX_CURVE_SAMPLES, MAX_DEGREE, MAX_SURFACE_SAMPLES, Model};
 pub use edit::{EditList, parse_edits};
-pub use parse::parse_scene;
+pub use parse::{SampleDefaults, parse_scene, parse_scene_with};
 pub use write::scene_to_json;
 
 use std::borrow::Cow;
@@ -58,9 +58,14 @@ pub struct SceneObject {
 impl Scene {
     /// Reads and validates a scene file.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        Self::load_with(path, SampleDefaults::default())
+    }
+
+    /// [`Scene::load`] with sample counts for objects that give none.
+    pub fn load_with(path: &Path, defaults: SampleDefaults) -> Result<Scene, SceneError> {
         let text = std::fs::read_to_string(path)
             .map_err(|e| SceneError(format!("cannot read {}: {e}", path.display())))?;
-        parse_scene(&text)
+        parse_scene_with(&text, defaults)
     }
 
     /// Writes the scene file atomically and durably (see [`write_durably`]), so neither a

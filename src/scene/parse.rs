@@ -6,7 +6,7 @@ use crate::model::Model;
 use crate::model::file::opt;
 use crate::profile::{LOAD_PROGRESS_AFTER, Progress};
 use serde::Deserialize;
-use serde_json::Value;
+use serde_json::{Map, Value};
 use std::collections::HashMap;
 
 /// Parses and validates scene JSON text.
@@ -16,15 +16,34 @@ use std::collections::HashMap;
 /// (which took more time to build and free than the parsing itself, and four times the memory
 /// of the models).
 pub fn parse_scene(text: &str) -> Result<Scene, SceneError> {
+    parse_scene_with(text, SampleDefaults::default())
+}
+
+/// Sample counts for the objects of a scene file that give none (`--samples` on the command
+/// line): curves take `curve`, surfaces `surface`. An object without `samples` and without a
+/// default is an error, as the format asks.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct SampleDefaults {
+    pub curve: Option<usize>,
+    pub surface: Option<[usize; 2]>,
+}
+
+/// [`parse_scene`] with `defaults` for objects that give no sample count.
+pub fn parse_scene_with(text: &str, defaults: SampleDefaults) -> Result<Scene, SceneError> {
     if !text.trim_start().starts_with('{') {
         // Not an object (or not JSON): the whole-value path words the message.
         return parse_scene_value(text);
     }
     let failed = std::cell::RefCell::new(None);
     let mut de = serde_json::Deserializer::from_str(text);
-    let parsed =
-        serde::de::Deserializer::deserialize_map(&mut de, SceneVisitor { failed: &failed })
-            .and_then(|objects| de.end().map(|()| objects));
+    let parsed = serde::de::Deserializer::deserialize_map(
+        &mut de,
+        SceneVisitor {
+            failed: &failed,
+            defaults,
+        },
+    )
+    .and_then(|objects| de.end().map(|()| objects));
     match (parsed, failed.into_inner()) {
         (_, Some(e)) => Err(e),
         (Ok(objects), None) => {
@@ -58,6 +77,7 @@ fn fail<E: serde::de::Error>(failed: Failed<'_>, e: SceneError) -> E {
 /// The top-level `{"objects": [...]}`.
 struct SceneVisitor<'a> {
     failed: Failed<'a>,
+    defaults: SampleDefaults,
 }
 
 impl<'de> serde::de::Visitor<'de> for SceneVisitor<'_> {
@@ -78,6 +98,7 @@ impl<'de> serde::de::Visitor<'de> for SceneVisitor<'_> {
                 "objects" => {
                     objects = Some(map.next_value_seed(ObjectsSeed {
                         failed: self.failed,
+                        defaults: self.defaults,
                     })?);
                 }
                 _ => {
@@ -97,6 +118,7 @@ impl<'de> serde::de::Visitor<'de> for SceneVisitor<'_> {
 /// The `objects` array, parsed one object at a time.
 struct ObjectsSeed<'a> {
     failed: Failed<'a>,
+    defaults: SampleDefaults,
 }
 
 impl<'de> serde::de::DeserializeSeed<'de> for ObjectsSeed<'_> {
@@ -125,7 +147,7 @@ impl<'de> serde::de::Visitor<'de> for ObjectsSeed<'_> {
         while let Some(item) = seq.next_element::<Value>()? {
             progress.inc(1);
             let i = objects.len();
-            let obj = parse_object(i, &item).map_err(|e| fail(self.failed, e))?;
+            let obj = parse_object(i, &item, self.defaults).map_err(|e| fail(self.failed, e))?;
             if let Some(j) = names.insert(obj.name.clone(), i) {
                 return Err(fail(
                     self.failed,
@@ -218,7 +240,7 @@ fn check_connections(objects: &[SceneObject]) -> Result<(), SceneError> {
 /// Fields every object has besides its geometry.
 const OBJECT_FIELDS: [&str; 5] = ["name", "type", "samples", "color", "obj"];
 
-fn parse_object(i: usize, v: &Value) -> Result<SceneObject, SceneError> {
+fn parse_object(i: usize, v: &Value, defaults: SampleDefaults) -> Result<SceneObject, SceneError> {
     let at = At(format!("objects[{i}]"));
     let obj = v.as_object().ok_or_else(|| {
         SceneError(format!(
@@ -232,6 +254,16 @@ fn parse_object(i: usize, v: &Value) -> Result<SceneObject, SceneError> {
     }
     let at = At(format!("object '{name}' (objects[{i}])"));
     let ty = as_str(&at, "type", require(&at, obj, "type")?)?;
+    let with_default;
+    let obj = match default_samples(ty, obj, defaults) {
+        Some(samples) => {
+            let mut o = obj.clone();
+            o.insert("samples".into(), samples);
+            with_default = o;
+            &with_default
+        }
+        None => obj,
+    };
     let model = Model::read(ty, &at, obj, &OBJECT_FIELDS).unwrap_or_else(|| {
         Err(at.err(
             "type",
@@ -252,6 +284,17 @@ fn parse_object(i: usize, v: &Value) -> Result<SceneObject, SceneError> {
         color,
         obj: kept,
     })
+}
+
+/// The sample count `defaults` give an object of type `ty` that has none of its own.
+fn default_samples(ty: &str, obj: &Map<String, Value>, defaults: SampleDefaults) -> Option<Value> {
+    if obj.contains_key("samples") {
+        return None;
+    }
+    match Model::type_is_surface(ty)? {
+        true => defaults.surface.map(|[u, v]| Value::from(vec![u, v])),
+        false => defaults.curve.map(Value::from),
+    }
 }
 
 fn parse_color(at: &At, v: &Value) -> Result<[f64; 3], SceneError> {

@@ -749,6 +749,31 @@ fn sample_takes_the_samples_override() {
     assert!(out.stdout.is_empty());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("1 samples: expected 2..="), "{err}");
+    // Objects that give no count of their own take the flag's.
+    let bare = dir.file(
+        "bare.json",
+        &scene(&[
+            &CURVE.replace(r#", "samples": 10"#, ""),
+            &SURF.replace(r#", "samples": [3, 3]"#, ""),
+        ]),
+    );
+    assert_eq!(
+        counts(&["--samples", "7", "--samples", "4x6"], &bare),
+        [vec![7], vec![4, 6]]
+    );
+    // Negative control: without the flag (or without the surfaces' count) they are refused
+    // as the format asks.
+    for args in [&[][..], &["--samples", "7"][..]] {
+        let out = Command::new(env!("CARGO_BIN_EXE_prespline"))
+            .arg("sample")
+            .arg(&bare)
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(!out.status.success(), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("field 'samples': missing"), "{args:?}: {err}");
+    }
 }
 
 /// `--samples N` sets curves only and `NxM` surfaces only (`--help`: "N for every curve, NxM
