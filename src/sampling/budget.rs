@@ -482,6 +482,19 @@ fn add_erbs(e: &mut Estimate, extent: &Extent, locals: &[usize], at: &Layout) {
                 locals.iter().map(|&l| l as u128).product::<u128>()
             ),
         );
+        // Each polynomial local's own structure, whatever its samples: its table's header,
+        // knots and per-point ranges, and its samples' list.
+        use super::tables::axis::HermiteTable;
+        let d1 = extent.degree[0] as u128 + 1;
+        let per_local = std::mem::size_of::<HermiteTable>() as u128
+            + 2 * std::mem::size_of::<Vec<f64>>() as u128
+            + 2 * d1 * F64
+            + d1 * 2 * USIZE;
+        e.add(
+            "ERBS local curve structure",
+            locals[0] as u128 * per_local,
+            format!("{} locals × {per_local} B", locals[0]),
+        );
     }
 }
 

@@ -7,7 +7,6 @@ mod common;
 #[path = "../oracle/mod.rs"]
 mod oracle;
 
-mod budget_accuracy;
 mod budget_counts;
 mod cli_errors;
 mod cli_help;

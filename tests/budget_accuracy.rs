@@ -1,57 +1,36 @@
 //! The memory budget's estimate against the bytes pre-evaluation actually allocates (issue
 //! 25.8 for ERBS curves and surfaces, nested ones included; issue 23 on the teapot scene).
 //!
-//! A counting allocator keeps, per thread, the bytes currently allocated; a document is built
-//! on the test's own thread, so other tests running at the same time do not count.
+//! A counting allocator (`stats_alloc`) gives the bytes allocated and not freed while a
+//! document is built on one thread; the tests of this binary run one at a time, so nothing
+//! else counts.
 
 use prespline::editor::{Editor, EditorOptions};
 use prespline::sampling::SampleMode;
 use prespline::sampling::budget::{MemoryBudget, Uses};
 use prespline::scene::{Scene, parse_scene};
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
+use stats_alloc::{INSTRUMENTED_SYSTEM, Region, StatsAlloc};
+use std::alloc::System;
 use std::path::Path;
+use std::sync::{Mutex, MutexGuard, PoisonError};
 
-struct Counting;
-
-thread_local! {
-    static LIVE: Cell<i64> = const { Cell::new(0) };
-}
-
-fn add(n: i64) {
-    // `try_with`: the thread-local may be gone while a thread exits.
-    let _ = LIVE.try_with(|l| l.set(l.get() + n));
-}
-
-// SAFETY: every call is forwarded to the system allocator unchanged; only a counter is kept.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        add(layout.size() as i64);
-        // SAFETY: the caller's contract is the system allocator's.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        add(-(layout.size() as i64));
-        // SAFETY: as above.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        add(layout.size() as i64);
-        // SAFETY: as above.
-        unsafe { System.alloc_zeroed(layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        add(new_size as i64 - layout.size() as i64);
-        // SAFETY: as above.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
+// `stats_alloc` keeps the counts (its `unsafe` is the crate's, not ours: ours stays in
+// src/gpu). The counts are process-wide, so this file is a test binary of its own and every
+// test in it holds `ALONE` while it runs: nothing else allocates while one measures.
 #[global_allocator]
-static ALLOCATOR: Counting = Counting;
+static GLOBAL: &StatsAlloc<System> = &INSTRUMENTED_SYSTEM;
 
-fn live() -> i64 {
-    LIVE.with(Cell::get)
+static ALONE: Mutex<()> = Mutex::new(());
+
+fn alone() -> MutexGuard<'static, ()> {
+    ALONE.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// Bytes allocated and not freed since `region` began (`stats_alloc` books a reallocation's
+/// growth as allocated and its shrinking as freed; `bytes_reallocated` repeats that net).
+fn live(region: &Region<'_, System>) -> i64 {
+    let s = region.change();
+    s.bytes_allocated as i64 - s.bytes_deallocated as i64
 }
 
 /// (estimated bytes, bytes the document holds after pre-evaluating `scene` in `mode`).
@@ -59,14 +38,14 @@ fn estimate_and_held(scene: &Scene, mode: SampleMode) -> (u64, i64) {
     let uses = Uses::default();
     let budget = MemoryBudget::from_flag(Some(u64::MAX / 2));
     let estimate = scene.check_budget(mode, uses, &budget).unwrap();
-    let before = live();
-    // Pre-evaluation on this thread alone: the counter is per thread.
+    let region = Region::new(GLOBAL);
+    // Pre-evaluation on one thread, so the figure is the document's and not the workers'.
     let doc = prespline::parallel::on_one_thread(|| {
         Editor::new(scene, EditorOptions { mode, uses, budget })
             .unwrap()
             .into_document()
     });
-    let held = live() - before;
+    let held = live(&region);
     drop(doc);
     (estimate, held)
 }
@@ -134,6 +113,7 @@ const ERBS_TOLERANCE: f64 = 0.15;
 
 #[test]
 fn erbs_curve_estimate_matches_allocated_bytes() {
+    let _alone = alone();
     for nested in [false, true] {
         let scene = erbs_curve_scene(nested);
         for (name, mode) in MODES {
@@ -150,6 +130,7 @@ fn erbs_curve_estimate_matches_allocated_bytes() {
 
 #[test]
 fn erbs_surface_estimate_matches_allocated_bytes() {
+    let _alone = alone();
     for nested in [false, true] {
         let scene = erbs_surface_scene(nested);
         for (name, mode) in MODES {
@@ -169,6 +150,7 @@ fn erbs_surface_estimate_matches_allocated_bytes() {
 /// samples, so the estimate must count it.
 #[test]
 fn many_small_locals_estimate_matches_allocated_bytes() {
+    let _alone = alone();
     let curve = parse_scene(
         r#"{"objects":[{"name":"e","type":"erbs_curve","samples":10,"from":{"type":"bezier_curve","points":[[0,0,0],[1,1,0],[2,0,1]]},"local_curves":5000,"local_degree":3}]}"#,
     )
@@ -192,6 +174,7 @@ fn many_small_locals_estimate_matches_allocated_bytes() {
 /// table ranges are the object.
 #[test]
 fn a_long_control_polygon_estimate_matches_allocated_bytes() {
+    let _alone = alone();
     let n = 200_000;
     let points: Vec<String> = (0..n)
         .map(|i| format!("[{},{},0]", i as f64 * 1e-3, (i % 7) as f64 * 1e-2))
@@ -213,6 +196,7 @@ fn a_long_control_polygon_estimate_matches_allocated_bytes() {
 
 #[test]
 fn teapot_scene_estimate_matches_allocated_bytes() {
+    let _alone = alone();
     let teapot =
         Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/teapot.json")).unwrap();
     let (e, held) = estimate_and_held(&teapot, SampleMode::Render);
@@ -221,6 +205,7 @@ fn teapot_scene_estimate_matches_allocated_bytes() {
 
 #[test]
 fn the_comparison_fails_on_a_halved_estimate() {
+    let _alone = alone();
     // Negative control: an estimate that halves what is held is caught.
     let r = std::panic::catch_unwind(|| assert_close("halved", 500, 1000, 0.15));
     assert!(r.is_err());
@@ -232,6 +217,7 @@ fn the_comparison_fails_on_a_halved_estimate() {
 /// computed by the same code; only the order of work differs).
 #[test]
 fn pre_evaluation_on_n_threads_equals_one_thread_bit_for_bit() {
+    let _alone = alone();
     let teapot =
         Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/teapot.json")).unwrap();
     let mut scene = erbs_surface_scene(true);
