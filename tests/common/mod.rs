@@ -290,6 +290,39 @@ impl Drop for Scratch {
     }
 }
 
+/// At most this many children of one test binary run at once. A binary's tests run on a
+/// thread each, and a dozen viewers starting together on a loaded 2-core machine left Xvfb
+/// behind: one failed with "Failed to open connection to X server". The limit is a wait, not a
+/// skip: every child still runs.
+const MAX_CHILDREN: usize = 3;
+
+struct ChildSlot;
+
+static RUNNING: std::sync::Mutex<usize> = std::sync::Mutex::new(0);
+static FREED: std::sync::Condvar = std::sync::Condvar::new();
+
+impl ChildSlot {
+    fn take() -> ChildSlot {
+        let poisoned = std::sync::PoisonError::into_inner;
+        let mut running = RUNNING.lock().unwrap_or_else(poisoned);
+        while *running >= MAX_CHILDREN {
+            running = FREED.wait(running).unwrap_or_else(poisoned);
+        }
+        *running += 1;
+        ChildSlot
+    }
+}
+
+impl Drop for ChildSlot {
+    fn drop(&mut self) {
+        let mut running = RUNNING
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        *running -= 1;
+        FREED.notify_one();
+    }
+}
+
 /// Runs `command` to completion with its output captured, killing it and failing the test
 /// when it runs longer than `limit` (a hung viewer must not hang the suite).
 pub fn output_with_timeout(
@@ -298,6 +331,7 @@ pub fn output_with_timeout(
 ) -> std::process::Output {
     use std::io::Read;
     use std::process::Stdio;
+    let _slot = ChildSlot::take();
     let mut child = command
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
