@@ -38,6 +38,11 @@ struct Pair {
 
 impl Pair {
     fn new(scene: &Scene, map: Option<SurfaceMap>) -> Self {
+        Self::with_samples(scene, map, 1)
+    }
+
+    /// Both sessions drawing into `samples`-times multisampled targets.
+    fn with_samples(scene: &Scene, map: Option<SurfaceMap>, samples: u32) -> Self {
         let (mut renderer, sink) = common::renderer();
         let mut runs = Vec::new();
         for redraw in [Redraw::Retained, Redraw::Full] {
@@ -45,7 +50,7 @@ impl Pair {
                 .create_offscreen(&OffscreenDesc {
                     width: SIZE[0],
                     height: SIZE[1],
-                    samples: 1,
+                    samples,
                 })
                 .unwrap();
             let mut session = Session::open(
@@ -324,6 +329,22 @@ fn retained_frames_equal_full_redraws_over_random_scenes_and_gestures() {
         );
         pair.finish();
     }
+}
+
+/// At MSAA 4 a target has no static layer (a multisampled depth buffer cannot be restored
+/// bit for bit), so `--redraw retained` draws every frame in full: the same pixels as
+/// `--redraw full`, within any golden tolerance because within none.
+#[test]
+fn at_msaa_4_retained_draws_in_full_and_equals_full() {
+    let mut rng = Rng::new(0x5eed);
+    let scene = random_scene(&mut rng);
+    let mut pair = Pair::with_samples(&scene, None, 4);
+    check(&mut pair, &[vec![]], "MSAA 4: first frame");
+    let h = handle_of(&pair, &mut rng, 0);
+    let script = drag(&mut rng, h, false, 5);
+    check(&mut pair, &script, &format!("MSAA 4: drag of {h:?}"));
+    assert_eq!(pair.retained_frames, 0, "no layer at MSAA 4");
+    pair.finish();
 }
 
 #[test]
