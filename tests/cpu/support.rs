@@ -238,3 +238,21 @@ fn supports_are_local_and_a_shrunk_support_misses_changes() {
     let edit = doc.move_handle(handle, DVec3::new(0.0, 0.0, 0.25)).unwrap();
     assert!(missed(&mut sampled, &edit.edit, &shrunk) > 0);
 }
+
+/// Bounds and framing read control positions through `ControlDisplay::grip_points`, which
+/// must name the very points picking offers (`grips`), in order, for every layout: polygons,
+/// nets, ERBS local curves and patches. Negative control: one point dropped is seen.
+#[test]
+fn grip_points_are_the_grips_positions_for_every_layout() {
+    let doc = Document::new(&scene());
+    let mut layouts = std::collections::HashSet::new();
+    for o in &doc.objects {
+        let from_grips: Vec<DVec3> = o.controls.grips().into_iter().map(|(_, p)| p).collect();
+        let points: Vec<DVec3> = o.controls.grip_points().collect();
+        assert!(!points.is_empty(), "{}: no control points", o.name);
+        assert_eq!(points, from_grips, "{}", o.name);
+        assert_ne!(points[1..], from_grips[..], "negative control");
+        layouts.insert(std::mem::discriminant(&o.controls.layout));
+    }
+    assert_eq!(layouts.len(), 4, "every layout kind is covered");
+}
