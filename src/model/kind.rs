@@ -28,8 +28,11 @@ pub trait Kind: Clone + Debug + PartialEq + Sized + 'static {
     /// The scene-file `type` names this kind reads (docs/scene-format.md).
     const TYPES: &'static [&'static str];
 
-    /// The scene-file `type` of this model.
-    fn type_name(&self) -> &'static str;
+    /// The scene-file `type` of this model: the kind's one type, unless the model says which
+    /// of several it is.
+    fn type_name(&self) -> &'static str {
+        Self::TYPES[0]
+    }
 
     /// Reads an object of type `ty` (one of [`Kind::TYPES`]) from its fields; `common` names
     /// the fields every object has, which the scene reads.

@@ -43,10 +43,6 @@ impl Kind for ErbsCurveModel {
         file::read_curve_edit(at, obj)
     }
 
-    fn type_name(&self) -> &'static str {
-        "erbs_curve"
-    }
-
     fn sample_dims(&self) -> [usize; 2] {
         [self.samples(), 1]
     }
@@ -125,10 +121,6 @@ impl Kind for ErbsSurfaceModel {
 
     fn read_edit(&self, at: &At, obj: &Map<String, Value>) -> Result<ErbsSurfaceEdit, SceneError> {
         file::read_surface_edit(at, obj)
-    }
-
-    fn type_name(&self) -> &'static str {
-        "erbs_surface"
     }
 
     fn sample_dims(&self) -> [usize; 2] {
