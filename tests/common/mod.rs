@@ -291,9 +291,10 @@ impl Drop for Scratch {
 }
 
 /// At most this many children of one test binary run at once. A binary's tests run on a
-/// thread each, and a dozen viewers starting together on a loaded 2-core machine left Xvfb
-/// behind: one failed with "Failed to open connection to X server". The limit is a wait, not a
-/// skip: every child still runs.
+/// thread each, and a dozen viewers starting together would share two cores with the Xvfb
+/// server and each other (the "Failed to open connection to X server" that once came with it
+/// was the server resetting between clients; `make test` runs Xvfb with -noreset). The limit
+/// is a wait, not a skip: every child still runs.
 const MAX_CHILDREN: usize = 3;
 
 struct ChildSlot;
