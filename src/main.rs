@@ -446,6 +446,7 @@ fn main() -> ExitCode {
                 &samples.counts(),
                 &memory.budget(),
                 display.analysis,
+                display.net,
             )
             .and_then(|(doc, estimate)| {
                 let mut options = display.options();

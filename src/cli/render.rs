@@ -34,7 +34,7 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     Ok((w, h))
 }
 
-pub use crate::render::{DRAW_USES, RENDER_USES, validation_mode};
+pub use crate::render::{DRAW_USES, render_uses, validation_mode};
 
 /// Refuses a scene whose pre-evaluation and GPU mirrors would not fit `budget` (one line naming
 /// the object and the estimate).
@@ -47,18 +47,20 @@ pub fn check_drawable(scene: &Scene, path: &Path, budget: &MemoryBudget) -> Resu
 
 /// Loads a scene (JSON or OBJ) into an editor held to the memory budget and applies an edits
 /// file through it (the delta path; edits that grow an object are budgeted as they come), with
-/// `map` shown on the surfaces (a curvature map is budgeted first).
+/// `map` shown on the surfaces (a curvature map is budgeted first) and, with `nets`, every
+/// object's control display drawn.
 pub fn load_document(
     scene_path: &Path,
     edits: Option<&Path>,
     samples: &SampleOverride,
     budget: &MemoryBudget,
     map: Option<SurfaceMap>,
+    nets: bool,
 ) -> Result<(Document, u64), CliError> {
     let scene = load_scene(scene_path, samples)?;
     let options = EditorOptions {
         mode: SampleMode::Render,
-        uses: RENDER_USES,
+        uses: render_uses(nets),
         budget: *budget,
     };
     let mut editor = Editor::new(&scene, options).map_err(|e| CliError::in_file(scene_path, e))?;

@@ -52,6 +52,7 @@ pub fn run(args: &SampleArgs) -> Result<String, CliError> {
         mode: SampleMode::Derivatives(args.derivatives),
         uses: Uses {
             gpu_slots: 0,
+            control_displays: false,
             json_text: true,
         },
         budget: args.memory,

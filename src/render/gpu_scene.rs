@@ -35,8 +35,10 @@ struct ObjectGpu {
     samples: Place,
     /// Sample rows (surfaces) or samples (curves) each slot has not seen yet.
     dirty: [DirtySet; FRAMES_IN_FLIGHT],
-    controls: Mirror,
-    /// Control display vertices each slot has not seen yet.
+    /// The control display's mirror, made when a frame first draws the display: a scene of
+    /// many patches drawn without their nets (`render`) never pays a Vulkan buffer per patch.
+    controls: Option<Mirror>,
+    /// Control display vertices each slot has not seen yet (while `controls` exists).
     controls_dirty: [DirtySet; FRAMES_IN_FLIGHT],
     /// The control display changed layout: the next upload replaces the control mirror.
     controls_resized: bool,
@@ -159,8 +161,8 @@ struct Layer {
 const ZEBRA_STRIPES: f32 = 16.0;
 
 impl GpuScene {
-    /// Creates every mirror; the sample arenas are written by the first upload into each
-    /// frame slot, the control mirrors now.
+    /// Creates the sample arenas, which the first upload into each frame slot writes; control
+    /// mirrors are made by the first frame that draws them.
     pub fn new(renderer: &mut Renderer, doc: &Document) -> GpuResult<Self> {
         let (places, sizes) = arena_layout(doc);
         let mut scene = Self {
@@ -207,22 +209,17 @@ impl GpuScene {
             self.unfilled.push([true; FRAMES_IN_FLIGHT]);
         }
         for (i, o) in doc.objects.iter().enumerate() {
-            let data = vertex_floats(&o.controls.vertices);
-            let mut controls =
-                renderer.create_mirror(&format!("{} controls", o.name), data.len().max(3))?;
-            let filled = renderer.fill_mirror(&mut controls, 0, &data);
             self.objects.push(ObjectGpu {
                 name: o.name.clone(),
                 samples: places[i],
                 dirty: Default::default(),
-                controls,
+                controls: None,
                 controls_dirty: Default::default(),
                 controls_resized: false,
                 lod: None,
                 metrics: None,
                 bounds: None,
             });
-            filled?;
         }
         Ok(())
     }
@@ -373,15 +370,21 @@ impl GpuScene {
                 }
             }
             let vertices = &doc.objects[i].controls.vertices;
-            if std::mem::take(&mut o.controls_resized) {
+            let resized = std::mem::take(&mut o.controls_resized);
+            let ranges = o.controls_dirty[slot].take();
+            // Without a mirror there is nothing to keep current: the first frame that draws
+            // the display makes it from the vertices of that time.
+            let Some(controls) = &mut o.controls else {
+                continue;
+            };
+            if resized {
                 let name = format!("{} controls", o.name);
                 let data = vertex_floats(vertices);
-                frame.replace_mirror(&mut o.controls, &name, &data)?;
+                frame.replace_mirror(controls, &name, &data)?;
                 stats.bytes += data.len() * 4 * FRAMES_IN_FLIGHT;
             }
-            let ranges = o.controls_dirty[slot].take();
             if !ranges.is_empty() {
-                let mut w = frame.write_mirror(&mut o.controls);
+                let mut w = frame.write_mirror(controls);
                 for r in ranges {
                     let data = vertex_floats(&vertices[r.clone()]);
                     w.write(r.start * 3, &data)?;
@@ -509,6 +512,7 @@ impl GpuScene {
         lod: &Lod,
     ) -> GpuResult<DrawReport> {
         let mut report = DrawReport::default();
+        self.make_controls(frame, doc, opts, hl)?;
         if self.lod_view != Some(*lod) {
             self.lod_view = Some(*lod);
             self.objects.iter_mut().for_each(|o| o.lod = None);
@@ -532,6 +536,28 @@ impl GpuScene {
             self.draw_lines(frame, doc, opts, hl, &|_| true, None)?;
         }
         Ok(report)
+    }
+
+    /// Makes the control mirrors this frame draws and does not have yet, from the vertices of
+    /// now (in every slot, so nothing of them is dirty).
+    fn make_controls(
+        &mut self,
+        frame: &mut Frame<'_>,
+        doc: &Document,
+        opts: &ViewOptions,
+        hl: &Highlight,
+    ) -> GpuResult<()> {
+        for (i, o) in self.objects.iter_mut().enumerate() {
+            let controls = &doc.objects[i].controls;
+            if o.controls.is_some() || !control_drawn(opts, hl, i, &controls.layout) {
+                continue;
+            }
+            let data = vertex_floats(&controls.vertices);
+            o.controls = Some(frame.create_mirror(&format!("{} controls", o.name), &data)?);
+            o.controls_dirty = Default::default();
+            o.controls_resized = false;
+        }
+        Ok(())
     }
 
     /// The curves' samples and every object's control display (of the objects `only`
@@ -567,14 +593,26 @@ impl GpuScene {
                 }
             }
             let controls = &doc.objects[i].controls;
+            // No mirror: nothing of the display is drawn (`make_controls` made every other).
+            let Some(mirror) = &o.controls else {
+                continue;
+            };
             if let (Some(c), ControlLayout::Net { rows, cols }) = (clip, &controls.layout)
                 && c.object == i
                 && net_shown(opts, hl, i)
             {
-                clipped_net(frame, o, &controls.vertices, [*rows, *cols], opts, hl, c)?;
+                clipped_net(
+                    frame,
+                    mirror,
+                    &controls.vertices,
+                    [*rows, *cols],
+                    opts,
+                    hl,
+                    c,
+                )?;
                 continue;
             }
-            ControlPass::new(i, &o.controls, opts, hl, &palette).draw(frame, &controls.layout)?;
+            ControlPass::new(i, mirror, opts, hl, &palette).draw(frame, &controls.layout)?;
         }
         Ok(())
     }
@@ -1023,8 +1061,8 @@ impl GpuScene {
         for a in self.arenas {
             renderer.destroy_mirror(a);
         }
-        for o in self.objects {
-            renderer.destroy_mirror(o.controls);
+        for m in self.objects.into_iter().filter_map(|o| o.controls) {
+            renderer.destroy_mirror(m);
         }
     }
 }
@@ -1257,6 +1295,15 @@ fn net_shown(opts: &ViewOptions, hl: &Highlight, i: usize) -> bool {
     }
 }
 
+/// Whether [`ControlPass::draw`] draws anything of object `i`'s control display: a polygon or
+/// net where the nets are shown, an ERBS object's locals always.
+fn control_drawn(opts: &ViewOptions, hl: &Highlight, i: usize, layout: &ControlLayout) -> bool {
+    match layout {
+        ControlLayout::Polygon { .. } | ControlLayout::Net { .. } => net_shown(opts, hl, i),
+        ControlLayout::LocalCurves(_) | ControlLayout::LocalPatches(_) => true,
+    }
+}
+
 /// A pixel rectangle that draws are clipped to, so the gesture's control net need only draw
 /// its rows and columns that reach it.
 struct NetClip {
@@ -1272,7 +1319,7 @@ struct NetClip {
 /// lines as in the full draw and keep their order, and what is left out has no pixel there.
 fn clipped_net(
     frame: &mut Frame<'_>,
-    o: &ObjectGpu,
+    controls: &Mirror,
     vertices: &[DVec3],
     [rows, cols]: [usize; 2],
     opts: &ViewOptions,
@@ -1309,10 +1356,10 @@ fn clipped_net(
         count,
     };
     for r in (0..rows).filter(|&r| row_hit[r]) {
-        polyline(frame, &o.controls, run(r * cols, 1, cols), &net)?;
+        polyline(frame, controls, run(r * cols, 1, cols), &net)?;
     }
     for c in (0..cols).filter(|&c| col_hit[c]) {
-        polyline(frame, &o.controls, run(c, cols, rows), &net)?;
+        polyline(frame, controls, run(c, cols, rows), &net)?;
     }
     let index_of = |h: Option<Handle>, r: usize| match h {
         Some(Handle::Point {
@@ -1329,7 +1376,7 @@ fn clipped_net(
             selected: index_of(hl.selected, r),
             ..PointStyle::default()
         };
-        frame.draw_points(&o.controls, run(r * cols, 1, cols), &style)?;
+        frame.draw_points(controls, run(r * cols, 1, cols), &style)?;
     }
     Ok(())
 }

@@ -26,18 +26,24 @@ use crate::gpu::ValidationMode;
 use crate::sampling::budget::Uses;
 
 /// What interactive drawing (`view`, `bench`) keeps per object besides the samples: GPU
-/// mirrors in every frame slot, index buffers.
+/// mirrors in every frame slot, index buffers, a mirror of every control display (the nets
+/// can be shown at any time).
 pub const DRAW_USES: Uses = Uses {
     gpu_slots: crate::gpu::FRAMES_IN_FLIGHT as u8,
+    control_displays: true,
     json_text: false,
 };
 
 /// What `render` keeps per object besides the samples: it draws one frame, so one slot of
-/// the GPU mirrors is ever written.
-pub const RENDER_USES: Uses = Uses {
-    gpu_slots: 1,
-    ..DRAW_USES
-};
+/// the GPU mirrors is ever written, and control displays only with `--net`.
+#[must_use]
+pub const fn render_uses(nets: bool) -> Uses {
+    Uses {
+        gpu_slots: 1,
+        control_displays: nets,
+        ..DRAW_USES
+    }
+}
 
 /// Validation layer policy for interactive commands: on in debug builds or with
 /// `PRESPLINE_VALIDATION=1`, when the layer is installed; `PRESPLINE_VALIDATION=required`

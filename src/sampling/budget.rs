@@ -223,6 +223,10 @@ pub struct Uses {
     /// (one frame), every slot for `view` and `bench`. A slot's mirror is written by the
     /// first frame that uses it, so only those slots' pages become resident.
     pub gpu_slots: u8,
+    /// Every object's control display is drawn (`view` and `bench`, where the nets can be
+    /// shown at any time; `render --net`). Otherwise only the displays drawn whatever the nets
+    /// (ERBS objects' locals) get a GPU mirror, made when first drawn.
+    pub control_displays: bool,
     /// The whole `prespline sample` JSON text, built in memory so a failure prints nothing.
     pub json_text: bool,
 }
@@ -575,7 +579,11 @@ fn add_gpu(e: &mut Estimate, extent: &Extent, mode: SampleMode, uses: Uses, at: 
         );
     }
     // The control structure's mirror is written in every slot: at least a small buffer's
-    // cost, and three f32 per vertex where a display has many.
+    // cost, and three f32 per vertex where a display has many. It is made when the display is
+    // first drawn, and an ERBS object's locals are drawn without the nets.
+    if !uses.control_displays && extent.erbs_locals.is_none() {
+        return;
+    }
     let mirror = CONTROL_MIRROR.max(extent.control_vertices as u128 * 3 * F32);
     e.add(
         "GPU control mirrors",
@@ -937,6 +945,7 @@ mod tests {
             SampleMode::Render,
             Uses {
                 gpu_slots: 3,
+                control_displays: true,
                 json_text: false,
             },
         );
@@ -946,6 +955,45 @@ mod tests {
         assert_eq!(part("homogeneous samples"), n * 3 * 32);
         assert_eq!(part("normals"), n * 24);
         assert_eq!(part("GPU mirrors"), 3 * n * 24);
+    }
+
+    /// A control display's mirror is counted where it is drawn: every one when the nets can
+    /// show, otherwise only an ERBS object's (its locals are drawn without the nets).
+    #[test]
+    fn control_mirrors_are_counted_where_control_displays_are_drawn() {
+        let spline = Extent {
+            samples: vec![17, 17],
+            degree: vec![3, 3],
+            rational: false,
+            erbs_locals: None,
+            nested: Vec::new(),
+            control_vertices: 16,
+            control_bytes: 0,
+            shared_tables: None,
+        };
+        let erbs = Extent {
+            erbs_locals: Some(vec![3, 3]),
+            control_vertices: 3 * 3 * (81 + 16),
+            ..spline.clone()
+        };
+        let mirrors = |x: &Extent, control_displays: bool| {
+            let uses = Uses {
+                gpu_slots: 1,
+                control_displays,
+                json_text: false,
+            };
+            estimate(x, SampleMode::Render, uses)
+                .parts
+                .iter()
+                .find(|p| p.what == "GPU control mirrors")
+                .map(|p| p.bytes)
+        };
+        let small = (GPU_SLOTS_ALWAYS * CONTROL_MIRROR) as u64;
+        assert_eq!(mirrors(&spline, true), Some(small));
+        assert_eq!(mirrors(&spline, false), None);
+        let big = (GPU_SLOTS_ALWAYS * 3 * 3 * (81 + 16) * 3 * F32) as u64;
+        assert_eq!(mirrors(&erbs, true), Some(big));
+        assert_eq!(mirrors(&erbs, false), Some(big));
     }
 
     #[test]
@@ -962,6 +1010,7 @@ mod tests {
         };
         let uses = Uses {
             gpu_slots: 3,
+            control_displays: true,
             json_text: false,
         };
         let n = 512 * 512;

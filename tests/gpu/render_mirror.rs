@@ -224,6 +224,65 @@ fn incremental_mirrors_end_identical_to_a_fresh_upload() {
     );
 }
 
+/// Control mirrors are made by the first frame that draws them: edits (structural ones
+/// included) before the nets are first shown, while they are hidden again and after, end with
+/// the pixels of a fresh upload; once a mirror exists, a moved point copies its three floats
+/// into each slot beside the sample rows.
+#[test]
+fn control_mirrors_made_late_end_identical_to_a_fresh_upload() {
+    let (mut renderer, sink) = common::renderer();
+    let mut ed = common::editor(&scene(), None);
+    let shown = fixed_shot(ed.doc(), 480, 320);
+    let hidden = Shot {
+        options: ViewOptions {
+            control_nets: NetMode::Off,
+            ..shown.options
+        },
+        ..shown.clone()
+    };
+    let mut target = offscreen(&mut renderer, &shown);
+    let mut gs = GpuScene::new(&mut renderer, ed.doc()).unwrap();
+    let mut rng = Lcg(11);
+    for f in 0..60 {
+        for _ in 0..1 + rng.below(4) {
+            let e = random_edit(ed.doc(), &mut rng);
+            ed.submit(e).unwrap();
+        }
+        gs.consume(&ed.apply_pending());
+        let shot = if (20..35).contains(&f) || f >= 45 {
+            &shown
+        } else {
+            &hidden
+        };
+        draw_frame(&mut renderer, &mut target, &mut gs, ed.doc(), shot);
+    }
+    // Both slots up to date, then one interior point of the B-spline surface moved.
+    draw_frame(&mut renderer, &mut target, &mut gs, ed.doc(), &shown);
+    draw_frame(&mut renderer, &mut target, &mut gs, ed.doc(), &shown);
+    let e = Edit {
+        object: 0,
+        edit: SurfaceEdit::Point(PointEdit::Move {
+            point: [3, 4],
+            delta: DVec3::new(0.0, 0.0, 0.3),
+        })
+        .into_object(),
+    };
+    let region = common::edit(&mut ed, &mut gs, e).changes[0].samples[0].clone();
+    let row_bytes = region.rows.len() * ed.doc().objects[0].sampled.grid().dims[1] * 24;
+    for slot in 0..2 {
+        let copied = draw_frame(&mut renderer, &mut target, &mut gs, ed.doc(), &shown);
+        assert_eq!(copied, row_bytes + 12, "slot {slot}");
+    }
+    let doc = ed.into_document();
+    let incremental: Pixels = renderer.read_pixels(&target).unwrap();
+    gs.destroy(&mut renderer);
+    let fresh = fresh_render(&mut renderer, &mut target, &doc, &shown);
+    renderer.destroy_offscreen(target).unwrap();
+    common::teardown(renderer, sink);
+    let diff = common::compare_images(&incremental, &fresh, 0).unwrap();
+    assert_eq!(diff.differing, 0, "{} pixels differ", diff.differing);
+}
+
 #[test]
 fn a_missed_update_is_detected() {
     // Negative control: if one slot skipped its dirty rows the comparison must fail.
