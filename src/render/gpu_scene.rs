@@ -1,6 +1,6 @@
-//! The document on the GPU: one mirror per object for its samples and one for its control
-//! structures, with per-frame-slot dirty tracking so each slot receives exactly the rows changed
-//! since it was last written.
+//! The document on the GPU: the objects' samples in arena mirrors and a mirror per drawn
+//! control structure, with per-frame-slot dirty tracking so each slot receives exactly the rows
+//! changed since it was last written.
 
 use super::analysis::{CurvePiece, curve_pieces};
 use super::lod::{GridMetrics, Lod};
@@ -95,7 +95,8 @@ pub struct DrawReport {
 
 /// The document's GPU side. Samples of all objects live in a few large *arena* mirrors
 /// (surfaces first, in document order, then curves), so a group of same-shaped surfaces is
-/// drawn with one multi-draw per level of detail; control structures have a mirror per object.
+/// drawn with one multi-draw per level of detail; a control structure has a mirror of its own
+/// from the first frame that draws it.
 pub struct GpuScene {
     arenas: Vec<Mirror>,
     objects: Vec<ObjectGpu>,
