@@ -40,6 +40,11 @@ const OBJECT_STRUCTURE: u128 = 3072;
 /// What lavapipe keeps per shaded vertex of a draw until the frame is rasterised (measured
 /// with heaptrack on `render` of 50,000 curves: 411.6 MB for 9.6 M polyline vertices).
 const DRIVER_VERTEX_BYTES: u128 = 43;
+/// What the driver allocates, once per process, when it first draws a scene: lavapipe's
+/// compiled pipelines and draw state (measured after `render` of one-object scenes and of one
+/// teapot: 27–30 MiB over the resident size once the device was made; 17–24 MiB on 8 × 8 to
+/// 64 × 64 teapots, where the rest of the estimate runs slightly high).
+const DRIVER_DRAW_STATE: u128 = 26 << 20;
 /// Vertices one entry of a surface batch's multi-draw covers at most (`gpu::RUN_VERTICES`).
 pub const RUN_VERTICES: u64 = 1 << 16;
 /// Budget when physical memory cannot be read.
@@ -620,6 +625,11 @@ pub fn shared_estimate(objects: &[(&str, Extent)], uses: Uses) -> Estimate {
         bytes,
         format!("{} grid shapes × 2 × copies × samples × 40 B", shapes.len()),
     );
+    e.add(
+        "GPU driver draw state",
+        DRIVER_DRAW_STATE,
+        "compiled pipelines and draw state, once (lavapipe)".to_string(),
+    );
     e
 }
 
@@ -792,7 +802,8 @@ pub fn check_extents(
     uses: Uses,
     budget: &MemoryBudget,
 ) -> Result<u64, String> {
-    let mut total = shared_estimate(objects, uses).bytes();
+    let shared_parts = shared_estimate(objects, uses);
+    let mut total = shared_parts.bytes();
     let mut largest: Option<(usize, u64)> = None;
     let mut tables_seen = std::collections::HashSet::new();
     for (i, (name, extent)) in objects.iter().enumerate() {
@@ -818,11 +829,15 @@ pub fn check_extents(
     }
     match largest {
         Some((i, bytes)) if total > budget.bytes => Err(format!(
-            "{} objects need about {} together to pre-evaluate (the largest, object '{}' (objects[{i}]), about {}), over the memory budget of {}",
+            "{} objects need about {} together to pre-evaluate (the largest, object '{}' (objects[{i}]), about {}{}), over the memory budget of {}",
             objects.len(),
             format_bytes(total),
             objects[i].0,
             format_bytes(bytes),
+            match shared_parts.bytes() {
+                0 => String::new(),
+                b => format!("; what they share on the GPU, about {}", format_bytes(b)),
+            },
             budget.describe()
         )),
         _ => Ok(total),
@@ -1049,6 +1064,49 @@ mod tests {
         let unlimited =
             "Max address space         unlimited            unlimited            bytes     \n";
         assert_eq!(address_space_limit(unlimited), None);
+    }
+
+    /// A scene drawn on the GPU counts the driver's draw state once, whatever its objects, and
+    /// a refusal of the whole names what the objects share; without a GPU neither appears.
+    #[test]
+    fn the_driver_draw_state_is_counted_once_per_drawn_scene() {
+        let patch = Extent {
+            samples: vec![17, 17],
+            degree: vec![3, 3],
+            rational: false,
+            erbs_locals: None,
+            nested: Vec::new(),
+            control_vertices: 16,
+            control_bytes: 0,
+            shared_tables: None,
+        };
+        let objects = [("a", patch.clone()), ("b", patch.clone())];
+        let uses = |gpu_slots| Uses {
+            gpu_slots,
+            control_displays: false,
+            json_text: false,
+        };
+        let each = estimate(&patch, SampleMode::Render, uses(1)).bytes();
+        let shared = shared_estimate(&objects, uses(1));
+        assert_eq!(
+            shared.part_bytes("GPU driver draw state"),
+            DRIVER_DRAW_STATE as u64
+        );
+        let roomy = MemoryBudget::from_flag(Some(1 << 40));
+        let total = check_extents(&objects, SampleMode::Render, uses(1), &roomy).unwrap();
+        assert_eq!(total, 2 * each + shared.bytes());
+        let tight = MemoryBudget::from_flag(Some(total - 1));
+        let e = check_extents(&objects, SampleMode::Render, uses(1), &tight).unwrap_err();
+        assert!(e.starts_with("2 objects need about"), "{e}");
+        assert!(e.contains("; what they share on the GPU, about 26."), "{e}");
+        let on_cpu = check_extents(&objects, SampleMode::Render, uses(0), &roomy).unwrap();
+        assert_eq!(
+            on_cpu,
+            2 * estimate(&patch, SampleMode::Render, uses(0)).bytes()
+        );
+        let tight = MemoryBudget::from_flag(Some(on_cpu - 1));
+        let e = check_extents(&objects, SampleMode::Render, uses(0), &tight).unwrap_err();
+        assert!(!e.contains("share on the GPU"), "{e}");
     }
 
     #[test]
