@@ -539,15 +539,18 @@ impl GpuScene {
         Ok(report)
     }
 
-    /// Makes the control mirrors this frame draws and does not have yet, from the vertices of
-    /// now (in every slot, so nothing of them is dirty).
-    fn make_controls(
+    /// Makes the control mirrors a frame drawn with `opts` and `hl` needs and does not have
+    /// yet, from the vertices of now (in every slot, so nothing of them is dirty). Returns the
+    /// bytes written. [`GpuScene::draw`] calls it; a caller that reports upload figures calls
+    /// it after [`GpuScene::upload`] so they include these bytes.
+    pub fn make_controls(
         &mut self,
         frame: &mut Frame<'_>,
         doc: &Document,
         opts: &ViewOptions,
         hl: &Highlight,
-    ) -> GpuResult<()> {
+    ) -> GpuResult<usize> {
+        let mut bytes = 0;
         for (i, o) in self.objects.iter_mut().enumerate() {
             let controls = &doc.objects[i].controls;
             if o.controls.is_some() || !control_drawn(opts, hl, i, &controls.layout) {
@@ -557,8 +560,9 @@ impl GpuScene {
             o.controls = Some(frame.create_mirror(&format!("{} controls", o.name), &data)?);
             o.controls_dirty = Default::default();
             o.controls_resized = false;
+            bytes += data.len() * 4 * FRAMES_IN_FLIGHT;
         }
-        Ok(())
+        Ok(bytes)
     }
 
     /// The curves' samples and every object's control display (of the objects `only`
@@ -1296,12 +1300,17 @@ fn net_shown(opts: &ViewOptions, hl: &Highlight, i: usize) -> bool {
     }
 }
 
-/// Whether [`ControlPass::draw`] draws anything of object `i`'s control display: a polygon or
-/// net where the nets are shown, an ERBS object's locals always.
+/// Whether [`ControlPass::draw`] may draw something of object `i`'s control display: a
+/// polygon or net where the nets are shown; an ERBS object's locals where local curves and
+/// patches are shown, or its nets, or one of its locals is chosen.
 fn control_drawn(opts: &ViewOptions, hl: &Highlight, i: usize, layout: &ControlLayout) -> bool {
     match layout {
         ControlLayout::Polygon { .. } | ControlLayout::Net { .. } => net_shown(opts, hl, i),
-        ControlLayout::LocalCurves(_) | ControlLayout::LocalPatches(_) => true,
+        ControlLayout::LocalCurves(_) | ControlLayout::LocalPatches(_) => {
+            opts.local_curves
+                || net_shown(opts, hl, i)
+                || hl.selected_local.is_some_and(|(o, _)| o == i)
+        }
     }
 }
 

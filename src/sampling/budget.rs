@@ -829,14 +829,21 @@ pub fn check_extents(
     }
     match largest {
         Some((i, bytes)) if total > budget.bytes => Err(format!(
-            "{} objects need about {} together to pre-evaluate (the largest, object '{}' (objects[{i}]), about {}{}), over the memory budget of {}",
-            objects.len(),
+            "{} need{} about {} in all to pre-evaluate and draw (the largest, object '{}' (objects[{i}]), about {}{}), over the memory budget of {}",
+            match objects.len() {
+                1 => "1 object".to_string(),
+                n => format!("{n} objects"),
+            },
+            if objects.len() == 1 { "s" } else { "" },
             format_bytes(total),
             objects[i].0,
             format_bytes(bytes),
             match shared_parts.bytes() {
                 0 => String::new(),
-                b => format!("; what they share on the GPU, about {}", format_bytes(b)),
+                b => format!(
+                    "; what the GPU shares between objects, about {}",
+                    format_bytes(b)
+                ),
             },
             budget.describe()
         )),
@@ -1098,7 +1105,16 @@ mod tests {
         let tight = MemoryBudget::from_flag(Some(total - 1));
         let e = check_extents(&objects, SampleMode::Render, uses(1), &tight).unwrap_err();
         assert!(e.starts_with("2 objects need about"), "{e}");
-        assert!(e.contains("; what they share on the GPU, about 26."), "{e}");
+        assert!(
+            e.contains("; what the GPU shares between objects, about 26."),
+            "{e}"
+        );
+        let alone = check_extents(&objects[..1], SampleMode::Render, uses(1), &roomy).unwrap();
+        let tight_alone = MemoryBudget::from_flag(Some(alone - 1));
+        let one =
+            check_extents(&objects[..1], SampleMode::Render, uses(1), &tight_alone).unwrap_err();
+        assert!(e.contains(" in all to pre-evaluate and draw "), "{e}");
+        assert!(one.starts_with("1 object needs about"), "{one}");
         let on_cpu = check_extents(&objects, SampleMode::Render, uses(0), &roomy).unwrap();
         assert_eq!(
             on_cpu,
@@ -1106,7 +1122,7 @@ mod tests {
         );
         let tight = MemoryBudget::from_flag(Some(on_cpu - 1));
         let e = check_extents(&objects, SampleMode::Render, uses(0), &tight).unwrap_err();
-        assert!(!e.contains("share on the GPU"), "{e}");
+        assert!(!e.contains("the GPU shares"), "{e}");
     }
 
     #[test]

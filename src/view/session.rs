@@ -331,11 +331,27 @@ impl Session {
         self.hud.samples_touched = applied.samples;
     }
 
-    /// Copies this slot's dirty rows into the mirrors.
+    /// Copies this slot's dirty rows into the mirrors, and makes the control mirrors this
+    /// frame will draw for the first time (counted with the bytes copied).
     pub fn upload(&mut self, frame: &mut Frame<'_>) -> GpuResult<UploadStats> {
-        let stats = self.gpu.upload(frame, self.stage.doc())?;
+        let mut stats = self.gpu.upload(frame, self.stage.doc())?;
+        let hl = self.highlight();
+        stats.bytes += self
+            .gpu
+            .make_controls(frame, self.stage.doc(), &self.options, &hl)?;
         self.hud.bytes = stats.bytes;
         Ok(stats)
+    }
+
+    /// The hovered and selected handles, local and object, as the draw marks them.
+    fn highlight(&self) -> Highlight {
+        let s = &self.stage.selection;
+        Highlight {
+            hovered: s.hovered.map(|p| p.handle),
+            selected: s.selected,
+            selected_local: s.selected_local,
+            hovered_object: s.hovered_object,
+        }
     }
 
     /// Why the last scripted action could not run (a `move_to` a point that does not exist),
@@ -401,12 +417,7 @@ impl Session {
         let aspect = s.size[0] / s.size[1];
         frame.set_clear_color(Palette::default().background);
         frame.set_camera(s.camera.gpu(aspect, &s.bounds));
-        let hl = Highlight {
-            hovered: s.selection.hovered.map(|p| p.handle),
-            selected: s.selection.selected,
-            selected_local: s.selection.selected_local,
-            hovered_object: s.selection.hovered_object,
-        };
+        let hl = self.highlight();
         let lod = Lod::new(
             s.camera.view_proj(aspect, &s.bounds),
             s.size,

@@ -283,6 +283,36 @@ fn control_mirrors_made_late_end_identical_to_a_fresh_upload() {
     assert_eq!(diff.differing, 0, "{} pixels differ", diff.differing);
 }
 
+/// Making the control mirrors reports the bytes it wrote (every slot of each display shown),
+/// once: the viewer adds them to the frame's upload figures.
+#[test]
+fn making_control_mirrors_reports_their_bytes_once() {
+    let (mut renderer, sink) = common::renderer();
+    let ed = common::editor(&scene(), None);
+    let doc = ed.doc();
+    let shot = fixed_shot(doc, 64, 64);
+    let mut target = offscreen(&mut renderer, &shot);
+    let mut gs = GpuScene::new(&mut renderer, doc).unwrap();
+    let hl = Highlight::default();
+    let hidden = ViewOptions {
+        control_nets: NetMode::Off,
+        local_curves: false,
+        ..options()
+    };
+    let vertices: usize = doc.objects.iter().map(|o| o.controls.vertices.len()).sum();
+    let mut frame = renderer.begin_offscreen(&mut target).unwrap();
+    let none = gs.make_controls(&mut frame, doc, &hidden, &hl).unwrap();
+    let all = gs.make_controls(&mut frame, doc, &options(), &hl).unwrap();
+    let again = gs.make_controls(&mut frame, doc, &options(), &hl).unwrap();
+    frame.finish().unwrap();
+    gs.destroy(&mut renderer);
+    renderer.destroy_offscreen(target).unwrap();
+    common::teardown(renderer, sink);
+    assert_eq!(none, 0, "nothing of the displays is drawn");
+    assert_eq!(all, vertices * 3 * 4 * prespline::gpu::FRAMES_IN_FLIGHT);
+    assert_eq!(again, 0, "made once");
+}
+
 #[test]
 fn a_missed_update_is_detected() {
     // Negative control: if one slot skipped its dirty rows the comparison must fail.
