@@ -21,7 +21,7 @@ use crate::gpu::{
 use crate::model::Index2;
 use crate::sampling::{DirtyRegion, DirtySet};
 use glam::DVec3;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 
 /// Where an object's samples sit: an arena mirror and a float offset in it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -131,6 +131,12 @@ pub struct GpuScene {
     /// Control vertices of the gesture's object its edits rewrote so far (the next layer
     /// redraws the lines through them every frame).
     moved_controls: DirtySet,
+    /// Objects whose control display is an ERBS local display (drawn wherever local curves
+    /// are shown), kept current when a display changes layout: the frames that make control
+    /// mirrors look at these and the focused objects, not at every object of the scene.
+    local_displays: BTreeSet<usize>,
+    /// Every object has its control mirror: nothing is left to make.
+    controls_complete: bool,
 }
 
 /// A static layer in the target and what it was built for.
@@ -184,6 +190,10 @@ impl GpuScene {
             drop_chunk: false,
             drop_lines: false,
             moved_controls: DirtySet::default(),
+            local_displays: (0..doc.objects.len())
+                .filter(|&i| is_local_display(&doc.objects[i].controls.layout))
+                .collect(),
+            controls_complete: doc.objects.is_empty(),
         };
         // On failure, give back what was created.
         match scene.fill(renderer, doc, &places, &sizes) {
@@ -372,6 +382,14 @@ impl GpuScene {
             }
             let vertices = &doc.objects[i].controls.vertices;
             let resized = std::mem::take(&mut o.controls_resized);
+            if resized {
+                // A conversion can turn a polygon into ERBS locals or back.
+                if is_local_display(&doc.objects[i].controls.layout) {
+                    self.local_displays.insert(i);
+                } else {
+                    self.local_displays.remove(&i);
+                }
+            }
             let ranges = o.controls_dirty[slot].take();
             // Without a mirror there is nothing to keep current: the first frame that draws
             // the display makes it from the vertices of that time.
@@ -550,8 +568,30 @@ impl GpuScene {
         opts: &ViewOptions,
         hl: &Highlight,
     ) -> GpuResult<usize> {
+        if self.controls_complete {
+            return Ok(0);
+        }
+        // Only these can be drawn: every object's display where the nets are all shown;
+        // otherwise the focused objects' and, where local curves are shown, ERBS objects'.
+        let all = opts.control_nets == NetMode::All;
+        let candidates: Vec<usize> = if all {
+            (0..self.objects.len()).collect()
+        } else {
+            let focused = [
+                hl.hovered.map(|h| h.object()),
+                hl.selected.map(|h| h.object()),
+                hl.selected_local.map(|(o, _)| o),
+                hl.hovered_object,
+            ];
+            let mut c: BTreeSet<usize> = focused.into_iter().flatten().collect();
+            if opts.local_curves {
+                c.extend(&self.local_displays);
+            }
+            c.into_iter().filter(|&i| i < self.objects.len()).collect()
+        };
         let mut bytes = 0;
-        for (i, o) in self.objects.iter_mut().enumerate() {
+        for i in candidates {
+            let o = &mut self.objects[i];
             let controls = &doc.objects[i].controls;
             if o.controls.is_some() || !control_drawn(opts, hl, i, &controls.layout) {
                 continue;
@@ -561,6 +601,9 @@ impl GpuScene {
             o.controls_dirty = Default::default();
             o.controls_resized = false;
             bytes += data.len() * 4 * FRAMES_IN_FLIGHT;
+        }
+        if all {
+            self.controls_complete = self.objects.iter().all(|o| o.controls.is_some());
         }
         Ok(bytes)
     }
@@ -1298,6 +1341,14 @@ fn net_shown(opts: &ViewOptions, hl: &Highlight, i: usize) -> bool {
         NetMode::Focused => hl.focuses(i),
         NetMode::Off => false,
     }
+}
+
+/// An ERBS object's display of its locals (drawn wherever local curves are shown).
+fn is_local_display(layout: &ControlLayout) -> bool {
+    matches!(
+        layout,
+        ControlLayout::LocalCurves(_) | ControlLayout::LocalPatches(_)
+    )
 }
 
 /// Whether [`ControlPass::draw`] may draw something of object `i`'s control display: a

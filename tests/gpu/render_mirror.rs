@@ -313,6 +313,107 @@ fn making_control_mirrors_reports_their_bytes_once() {
     assert_eq!(again, 0, "made once");
 }
 
+/// One frame of `doc` with `hl` through a fresh GPU scene; with `every_mirror` the control
+/// mirrors of every object are made first, as if each had been drawn before.
+fn focused_frame(
+    renderer: &mut Renderer,
+    target: &mut OffscreenTarget,
+    doc: &Document,
+    shot: &Shot,
+    hl: &Highlight,
+    every_mirror: bool,
+) -> Pixels {
+    let mut gs = GpuScene::new(renderer, doc).unwrap();
+    let camera = shot_camera(doc, shot);
+    let aspect = shot.width as f64 / shot.height as f64;
+    let mut frame = renderer.begin_offscreen(target).unwrap();
+    gs.upload(&mut frame, doc).unwrap();
+    if every_mirror {
+        gs.make_controls(&mut frame, doc, &options(), hl).unwrap();
+    }
+    frame.set_camera(camera.gpu(aspect, &doc.bounds()));
+    let viewport = [shot.width as f64, shot.height as f64];
+    let lod = Lod::new(
+        camera.view_proj(aspect, &doc.bounds()),
+        viewport,
+        frame.samples(),
+    );
+    gs.draw(&mut frame, doc, &shot.options, hl, &lod).unwrap();
+    frame.capture();
+    frame.finish().unwrap();
+    let pixels = renderer.read_pixels(target).unwrap();
+    gs.destroy(renderer);
+    pixels
+}
+
+/// With the nets shown for the focused objects only, hovering an object, hovering or
+/// selecting one of its points, or choosing an ERBS local makes that object's control mirror:
+/// the frame equals one where every mirror already existed, and differs from one with nothing
+/// focused.
+#[test]
+fn focused_objects_get_their_control_mirrors() {
+    let (mut renderer, sink) = common::renderer();
+    let ed = common::editor(&scene(), None);
+    let doc = ed.doc();
+    let shot = Shot {
+        options: ViewOptions {
+            control_nets: NetMode::Focused,
+            local_curves: false,
+            ..options()
+        },
+        ..fixed_shot(doc, 320, 240)
+    };
+    let mut target = offscreen(&mut renderer, &shot);
+    let point = doc.handles(0)[5].0;
+    let local = doc
+        .handles(1)
+        .into_iter()
+        .find_map(|(h, _)| match h {
+            Handle::LocalPoint { object, local, .. } => Some((object, local)),
+            _ => None,
+        })
+        .expect("the ERBS surface has local points");
+    let focused = [
+        Highlight {
+            hovered_object: Some(3),
+            ..Highlight::default()
+        },
+        Highlight {
+            hovered: Some(point),
+            ..Highlight::default()
+        },
+        Highlight {
+            selected: Some(point),
+            ..Highlight::default()
+        },
+        Highlight {
+            selected_local: Some(local),
+            ..Highlight::default()
+        },
+    ];
+    let nothing = focused_frame(
+        &mut renderer,
+        &mut target,
+        doc,
+        &shot,
+        &Highlight::default(),
+        false,
+    );
+    for hl in &focused {
+        let made_now = focused_frame(&mut renderer, &mut target, doc, &shot, hl, false);
+        let made_before = focused_frame(&mut renderer, &mut target, doc, &shot, hl, true);
+        let diff = common::compare_images(&made_before, &made_now, 0).unwrap();
+        assert_eq!(
+            diff.differing, 0,
+            "{hl:?}: {} pixels differ",
+            diff.differing
+        );
+        assert_ne!(made_now.rgba, nothing.rgba, "{hl:?}: nothing drawn");
+    }
+    renderer.destroy_offscreen(target).unwrap();
+    common::teardown(renderer, sink);
+}
+
 #[test]
 fn a_missed_update_is_detected() {
     // Negative control: if one slot skipped its dirty rows the comparison must fail.
