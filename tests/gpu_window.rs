@@ -5,7 +5,7 @@
 //! winit allows one event loop per process, so this binary holds exactly one windowed test
 //! (the other only runs it again in child processes).
 //!
-//! `Xvfb :99 -screen 0 1280x1024x24 & DISPLAY=:99 cargo test --test gpu_window`
+//! `Xvfb :99 -screen 0 1280x1024x24 -noreset & DISPLAY=:99 cargo test --test gpu_window`
 
 mod common;
 
