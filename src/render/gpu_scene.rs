@@ -573,25 +573,30 @@ impl GpuScene {
         }
         // Only these can be drawn: every object's display where the nets are all shown;
         // otherwise the focused objects' and, where local curves are shown, ERBS objects'.
+        // An object met twice already has its mirror the second time.
         let all = opts.control_nets == NetMode::All;
-        let candidates: Vec<usize> = if all {
-            (0..self.objects.len()).collect()
+        let focused = [
+            hl.hovered.map(|h| h.object()),
+            hl.selected.map(|h| h.object()),
+            hl.selected_local.map(|(o, _)| o),
+            hl.hovered_object,
+        ];
+        let locals = opts.local_curves.then_some(&self.local_displays);
+        let candidates: Box<dyn Iterator<Item = usize>> = if all {
+            Box::new(0..self.objects.len())
         } else {
-            let focused = [
-                hl.hovered.map(|h| h.object()),
-                hl.selected.map(|h| h.object()),
-                hl.selected_local.map(|(o, _)| o),
-                hl.hovered_object,
-            ];
-            let mut c: BTreeSet<usize> = focused.into_iter().flatten().collect();
-            if opts.local_curves {
-                c.extend(&self.local_displays);
-            }
-            c.into_iter().filter(|&i| i < self.objects.len()).collect()
+            Box::new(
+                focused
+                    .into_iter()
+                    .flatten()
+                    .chain(locals.into_iter().flatten().copied()),
+            )
         };
         let mut bytes = 0;
         for i in candidates {
-            let o = &mut self.objects[i];
+            let Some(o) = self.objects.get_mut(i) else {
+                continue;
+            };
             let controls = &doc.objects[i].controls;
             if o.controls.is_some() || !control_drawn(opts, hl, i, &controls.layout) {
                 continue;

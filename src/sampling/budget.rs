@@ -983,16 +983,7 @@ mod tests {
     /// show, otherwise only an ERBS object's (its locals are drawn without the nets).
     #[test]
     fn control_mirrors_are_counted_where_control_displays_are_drawn() {
-        let spline = Extent {
-            samples: vec![17, 17],
-            degree: vec![3, 3],
-            rational: false,
-            erbs_locals: None,
-            nested: Vec::new(),
-            control_vertices: 16,
-            control_bytes: 0,
-            shared_tables: None,
-        };
+        let spline = Extent::polynomial(&[17, 17], &[3, 3], false).with_controls(16, 0);
         let erbs = Extent {
             erbs_locals: Some(vec![3, 3]),
             control_vertices: 3 * 3 * (81 + 16),
@@ -1077,16 +1068,7 @@ mod tests {
     /// a refusal of the whole names what the objects share; without a GPU neither appears.
     #[test]
     fn the_driver_draw_state_is_counted_once_per_drawn_scene() {
-        let patch = Extent {
-            samples: vec![17, 17],
-            degree: vec![3, 3],
-            rational: false,
-            erbs_locals: None,
-            nested: Vec::new(),
-            control_vertices: 16,
-            control_bytes: 0,
-            shared_tables: None,
-        };
+        let patch = Extent::polynomial(&[17, 17], &[3, 3], false).with_controls(16, 0);
         let objects = [("a", patch.clone()), ("b", patch.clone())];
         let uses = |gpu_slots| Uses {
             gpu_slots,

@@ -121,10 +121,35 @@ fn draw_frame(
     doc: &Document,
     shot: &Shot,
 ) -> usize {
+    draw_frame_lit(
+        renderer,
+        target,
+        gs,
+        doc,
+        shot,
+        &Highlight::default(),
+        false,
+    )
+}
+
+/// [`draw_frame`] with `hl` marked; with `every_mirror` the control mirrors of every object
+/// are made after the upload, as if each had been drawn before.
+fn draw_frame_lit(
+    renderer: &mut Renderer,
+    target: &mut OffscreenTarget,
+    gs: &mut GpuScene,
+    doc: &Document,
+    shot: &Shot,
+    hl: &Highlight,
+    every_mirror: bool,
+) -> usize {
     let camera = shot_camera(doc, shot);
     let aspect = shot.width as f64 / shot.height as f64;
     let mut frame = renderer.begin_offscreen(target).unwrap();
     let stats = gs.upload(&mut frame, doc).unwrap();
+    if every_mirror {
+        gs.make_controls(&mut frame, doc, &options(), hl).unwrap();
+    }
     frame.set_camera(camera.gpu(aspect, &doc.bounds()));
     let viewport = [shot.width as f64, shot.height as f64];
     let lod = Lod::new(
@@ -132,8 +157,7 @@ fn draw_frame(
         viewport,
         frame.samples(),
     );
-    gs.draw(&mut frame, doc, &shot.options, &Highlight::default(), &lod)
-        .unwrap();
+    gs.draw(&mut frame, doc, &shot.options, hl, &lod).unwrap();
     frame.capture();
     frame.finish().unwrap();
     stats.bytes
@@ -313,8 +337,7 @@ fn making_control_mirrors_reports_their_bytes_once() {
     assert_eq!(again, 0, "made once");
 }
 
-/// One frame of `doc` with `hl` through a fresh GPU scene; with `every_mirror` the control
-/// mirrors of every object are made first, as if each had been drawn before.
+/// One frame of `doc` with `hl` through a fresh GPU scene ([`draw_frame_lit`]).
 fn focused_frame(
     renderer: &mut Renderer,
     target: &mut OffscreenTarget,
@@ -324,23 +347,7 @@ fn focused_frame(
     every_mirror: bool,
 ) -> Pixels {
     let mut gs = GpuScene::new(renderer, doc).unwrap();
-    let camera = shot_camera(doc, shot);
-    let aspect = shot.width as f64 / shot.height as f64;
-    let mut frame = renderer.begin_offscreen(target).unwrap();
-    gs.upload(&mut frame, doc).unwrap();
-    if every_mirror {
-        gs.make_controls(&mut frame, doc, &options(), hl).unwrap();
-    }
-    frame.set_camera(camera.gpu(aspect, &doc.bounds()));
-    let viewport = [shot.width as f64, shot.height as f64];
-    let lod = Lod::new(
-        camera.view_proj(aspect, &doc.bounds()),
-        viewport,
-        frame.samples(),
-    );
-    gs.draw(&mut frame, doc, &shot.options, hl, &lod).unwrap();
-    frame.capture();
-    frame.finish().unwrap();
+    draw_frame_lit(renderer, target, &mut gs, doc, shot, hl, every_mirror);
     let pixels = renderer.read_pixels(target).unwrap();
     gs.destroy(renderer);
     pixels
