@@ -32,9 +32,9 @@ fn main() -> ExitCode {
         PathBuf::from,
     );
     let teapot = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/teapot.json");
-    let result = Scene::load(&teapot)
+    let result = prespline::formats::read_json(&teapot)
         .map_err(|e| e.to_string())
-        .and_then(|one| grid(&one, n).save(&out).map_err(|e| e.to_string()));
+        .and_then(|one| prespline::formats::save_json(&grid(&one, n), &out));
     match result {
         Ok(()) => {
             eprintln!("wrote {} ({} teapots)", out.display(), n * n);

@@ -7,13 +7,15 @@
 #![warn(clippy::undocumented_unsafe_blocks)]
 pub mod cli;
 pub mod editor;
-pub mod format;
+pub mod fields;
+pub mod formats;
 pub mod geom;
 #[allow(unsafe_code)]
 pub mod gpu;
 pub mod model;
 pub mod parallel;
 pub mod profile;
+pub mod progress;
 pub mod render;
 pub mod sampling;
 pub mod scene;

@@ -6,9 +6,10 @@
 //! else counts.
 
 use prespline::editor::{Editor, EditorOptions};
+use prespline::formats::parse_scene;
 use prespline::sampling::SampleMode;
 use prespline::sampling::budget::{MemoryBudget, Uses};
-use prespline::scene::{Scene, parse_scene};
+use prespline::scene::Scene;
 use stats_alloc::{INSTRUMENTED_SYSTEM, Region, StatsAlloc};
 use std::alloc::System;
 use std::path::Path;
@@ -197,8 +198,10 @@ fn a_long_control_polygon_estimate_matches_allocated_bytes() {
 #[test]
 fn teapot_scene_estimate_matches_allocated_bytes() {
     let _alone = alone();
-    let teapot =
-        Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/teapot.json")).unwrap();
+    let teapot = prespline::formats::read_json(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/teapot.json"),
+    )
+    .unwrap();
     let (e, held) = estimate_and_held(&teapot, SampleMode::Render);
     assert_close("teapot, render", e, held, 0.15);
 }
@@ -218,8 +221,10 @@ fn the_comparison_fails_on_a_halved_estimate() {
 #[test]
 fn pre_evaluation_on_n_threads_equals_one_thread_bit_for_bit() {
     let _alone = alone();
-    let teapot =
-        Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/teapot.json")).unwrap();
+    let teapot = prespline::formats::read_json(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/teapot.json"),
+    )
+    .unwrap();
     let mut scene = erbs_surface_scene(true);
     scene.objects.extend(erbs_curve_scene(true).objects);
     for k in 0..8 {

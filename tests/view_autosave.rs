@@ -71,7 +71,9 @@ fn bump_z(scene: &Scene) -> f64 {
 }
 
 fn load_z(path: &Path) -> f64 {
-    bump_z(&Scene::load(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())))
+    bump_z(
+        &prespline::formats::read_json(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())),
+    )
 }
 
 /// Selects bumps' point (3, 3), moves it by exactly `dz` along z (G Z, typed), then `end`

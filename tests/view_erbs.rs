@@ -89,7 +89,7 @@ fn run(dir: &Path, undos: usize) -> Scene {
         "viewer failed: {}",
         String::from_utf8_lossy(&out.stderr)
     );
-    Scene::load(&saved).unwrap()
+    prespline::formats::read_json(&saved).unwrap()
 }
 
 fn domes(s: &Scene) -> ErbsSurface {
@@ -113,7 +113,7 @@ fn erbs_refine_nest_transform_and_undo_exactly() {
         return;
     }
     let dir = common::Scratch::new("view-erbs");
-    let original = prespline::scene::parse_scene(SCENE).unwrap();
+    let original = prespline::formats::parse_scene(SCENE).unwrap();
     let before = domes(&original);
     assert_eq!(before.count(), [3, 3]);
 
@@ -161,8 +161,8 @@ fn erbs_refine_nest_transform_and_undo_exactly() {
     let undone = run(dir.path(), 4);
     assert!(undone == original, "undo must restore the scene exactly");
     assert_eq!(
-        prespline::scene::scene_to_json(&undone),
-        prespline::scene::scene_to_json(&original)
+        prespline::formats::json::scene_to_json(&undone),
+        prespline::formats::json::scene_to_json(&original)
     );
     let shot = prespline::gpu::Pixels::read_png(&dir.join("shot-0.png")).unwrap();
     assert!(shot.width == 960 && shot.height == 600);
@@ -191,7 +191,7 @@ struct Headless {
 
 impl Headless {
     fn new(text: &str) -> Self {
-        Self::with_scene(&prespline::scene::parse_scene(text).unwrap())
+        Self::with_scene(&prespline::formats::parse_scene(text).unwrap())
     }
 
     fn with_scene(scene: &Scene) -> Self {
@@ -365,7 +365,7 @@ fn refining_on_a_knot_is_refused_and_refinement_and_x_undo_exactly() {
 
 #[test]
 fn closed_torus_refines_across_its_seam_and_inside_a_detail_there() {
-    let scene = prespline::scene::demo::demo_scene();
+    let scene = prespline::formats::demo::demo_scene();
     let object = scene.find("erbs_torus").unwrap();
     let mut v = Headless::with_scene(&scene);
     let torus = |v: &mut Headless| {
@@ -435,7 +435,7 @@ fn closed_torus_refines_across_its_seam_and_inside_a_detail_there() {
 #[test]
 fn detail_example_raises_a_bump_only_inside_the_refined_patch() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples");
-    let scene = Scene::load(&dir.join("erbs_detail.json")).unwrap();
+    let scene = prespline::formats::read_json(&dir.join("erbs_detail.json")).unwrap();
     let text = std::fs::read_to_string(dir.join("erbs_detail_edits.json")).unwrap();
     let edits = prespline::scene::parse_edits(&text, &scene).unwrap();
     assert_eq!(edits.len(), 6);

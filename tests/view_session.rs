@@ -8,9 +8,10 @@ mod common;
 
 use glam::{DMat4, DVec3};
 use prespline::editor::Handle;
+use prespline::formats::parse_scene;
 use prespline::model::{Index2, LocalPath, Model};
 use prespline::sampling::budget::MemoryBudget;
-use prespline::scene::{Scene, parse_scene};
+use prespline::scene::Scene;
 use prespline::view::Session;
 use prespline::view::autosave::{AUTOSAVE_DELAY, Autosave, Places, RETRY_FIRST};
 use prespline::view::input::{InputEvent, Key, Modifiers, MouseButton};
@@ -304,7 +305,7 @@ fn autosave_is_written_within_a_second_of_an_edit_and_removed_by_a_clean_save() 
     assert_eq!(v.session.tick(due), None, "written, nothing more due");
     let model = v.scene();
     assert_eq!(
-        Scene::load(&path).unwrap(),
+        prespline::formats::read_json(&path).unwrap(),
         model,
         "the autosave holds the exact model"
     );
@@ -312,7 +313,10 @@ fn autosave_is_written_within_a_second_of_an_edit_and_removed_by_a_clean_save() 
     // Ctrl+S: the scene file gets the model, the autosave goes.
     v.key('s', true, false);
     assert!(!path.exists(), "a clean save removes the autosave");
-    assert_eq!(Scene::load(&scratch.join("scene.json")).unwrap(), model);
+    assert_eq!(
+        prespline::formats::read_json(&scratch.join("scene.json")).unwrap(),
+        model
+    );
     assert_eq!(v.session.on_exit(), Ok(None), "saved: nothing to keep");
     assert!(!path.exists());
     v.finish();
@@ -348,7 +352,7 @@ fn every_way_out_writes_the_autosave() {
             "the command names the real scene"
         );
         let model = v.scene();
-        assert_eq!(Scene::load(&path).unwrap(), model);
+        assert_eq!(prespline::formats::read_json(&path).unwrap(), model);
         let p = local_points(&model, 2)[1];
         let p0 = local_points(&parse_scene(SCENE).unwrap(), 2)[1];
         assert_eq!(p.y, p0.y + 0.125);
@@ -389,7 +393,7 @@ fn an_earlier_sessions_autosave_is_kept_aside() {
         "{name}"
     );
     assert_eq!(std::fs::read_to_string(aside).unwrap(), SCENE);
-    assert_eq!(Scene::load(&path).unwrap(), v.scene());
+    assert_eq!(prespline::formats::read_json(&path).unwrap(), v.scene());
     assert!(
         v.session.status().contains("kept the earlier autosave")
             && v.session.status().contains(&*name),
@@ -417,7 +421,7 @@ fn an_unwritable_directory_falls_back_then_backs_off() {
     v.session.apply_pending();
     let due = v.session.tick(Instant::now()).unwrap();
     assert_eq!(v.session.tick(due), None, "written");
-    assert_eq!(Scene::load(&fallback).unwrap(), v.scene());
+    assert_eq!(prespline::formats::read_json(&fallback).unwrap(), v.scene());
     assert!(
         v.session
             .status()
@@ -471,9 +475,7 @@ fn an_unwritable_directory_falls_back_then_backs_off() {
 fn scene_writes_are_fsynced_before_the_rename() {
     const CHILD: &str = "PRESPLINE_FSYNC_CHILD";
     if let Some(target) = std::env::var_os(CHILD) {
-        parse_scene(SCENE)
-            .unwrap()
-            .save(&PathBuf::from(target))
+        prespline::formats::save_json(&parse_scene(SCENE).unwrap(), &PathBuf::from(target))
             .unwrap();
         return;
     }
@@ -512,7 +514,10 @@ fn scene_writes_are_fsynced_before_the_rename() {
         "strace or the child failed: {}\n{log}",
         String::from_utf8_lossy(&out.stderr)
     );
-    assert_eq!(Scene::load(&target).unwrap(), parse_scene(SCENE).unwrap());
+    assert_eq!(
+        prespline::formats::read_json(&target).unwrap(),
+        parse_scene(SCENE).unwrap()
+    );
     let lines: Vec<&str> = log.lines().collect();
     let name = target.file_name().unwrap().to_string_lossy().into_owned();
     let dir = scratch.path().to_string_lossy().into_owned();
@@ -639,7 +644,7 @@ fn elevating_beside_a_short_span_saves_the_curve_shown() {
         });
         v.key('e', false, false);
         v.key('s', true, false);
-        let saved = curve(&Scene::load(&path).unwrap());
+        let saved = curve(&prespline::formats::read_json(&path).unwrap());
         let degree = if presses == 1 { 11 } else { 12 };
         assert_eq!(saved.degree(), degree, "status: {}", v.session.status());
         let moved = (0..=4000)

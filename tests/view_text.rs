@@ -5,11 +5,11 @@
 
 mod common;
 
+use prespline::formats::parse_scene;
 use prespline::gpu::font::{Font, TextSize};
 use prespline::gpu::{OffscreenDesc, OverlayVertex, Pixels, Renderer, ValidationSink};
 use prespline::render::analysis::PANEL;
 use prespline::render::maps::{LegendPlace, MapScale, SurfaceMap, legend};
-use prespline::scene::parse_scene;
 use prespline::view::Session;
 use prespline::view::hud::{
     HELP_PANEL, STATUS_MARGIN, TEXT, help_overlay, status_lines, status_top,

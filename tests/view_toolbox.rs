@@ -92,7 +92,7 @@ fn run(dir: &Path, undos: usize) -> Scene {
         "viewer failed: {}",
         String::from_utf8_lossy(&out.stderr)
     );
-    Scene::load(&saved).unwrap()
+    prespline::formats::read_json(&saved).unwrap()
 }
 
 #[test]
@@ -102,7 +102,7 @@ fn toolbox_edits_keep_their_constructions_and_undo_exactly() {
     }
     let scratch = common::Scratch::new("view-toolbox");
     let dir = scratch.path();
-    let original = prespline::scene::parse_scene(SCENE).unwrap();
+    let original = prespline::formats::parse_scene(SCENE).unwrap();
 
     let edited = run(dir, 0);
     let by = |s: &Scene, n: &str| s.objects[s.find(n).unwrap()].model.clone();
@@ -140,8 +140,8 @@ fn toolbox_edits_keep_their_constructions_and_undo_exactly() {
     // Six steps (drag, drag, weight drag, typed weight, conversion, …) undone: bit for bit.
     let undone = run(dir, 5);
     assert!(undone == original, "undo must restore the scene exactly");
-    let text = prespline::scene::scene_to_json(&undone);
-    assert_eq!(text, prespline::scene::scene_to_json(&original));
+    let text = prespline::formats::json::scene_to_json(&undone);
+    assert_eq!(text, prespline::formats::json::scene_to_json(&original));
     let shot = prespline::gpu::Pixels::read_png(&dir.join("shot-0.png")).unwrap();
     assert!(shot.width == 960 && shot.height == 600);
 }

@@ -11,10 +11,9 @@ mod common;
 
 use common::Scratch;
 use glam::DVec3;
+use prespline::formats::demo::demo_scene;
 use prespline::gpu::Pixels;
 use prespline::model::Model;
-use prespline::scene::Scene;
-use prespline::scene::demo::demo_scene;
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
 
@@ -73,7 +72,7 @@ fn scripted_session_saves_exact_edits_and_matches_the_golden() {
 
     // Exact control data: only the two confirmed moves remain; the rotation was undone.
     let before = demo_scene();
-    let after = Scene::load(&saved).unwrap();
+    let after = prespline::formats::read_json(&saved).unwrap();
     assert_eq!(before.objects.len(), after.objects.len());
     for (a, b) in before.objects.iter().zip(&after.objects) {
         assert_eq!(a.name, b.name);
@@ -231,7 +230,7 @@ fn unsaved_edits_survive_in_the_autosave_and_come_back_with_recover() {
     let scene = dir.join("surface.json");
     std::fs::copy(&example, &scene).unwrap();
     let autosave = dir.join("surface.autosave.json");
-    let original = Scene::load(&scene).unwrap();
+    let original = prespline::formats::read_json(&scene).unwrap();
 
     // A drag, then nothing for seconds before the script quits.
     let mut child = spawn_view(
@@ -274,10 +273,10 @@ fn unsaved_edits_survive_in_the_autosave_and_come_back_with_recover() {
         )),
         "the autosave's path and the real command are not printed on close: {err}"
     );
-    let kept = Scene::load(&autosave).unwrap();
+    let kept = prespline::formats::read_json(&autosave).unwrap();
     assert_ne!(kept, original, "the drag is in the autosave");
     assert_eq!(
-        Scene::load(&scene).unwrap(),
+        prespline::formats::read_json(&scene).unwrap(),
         original,
         "the scene file is untouched"
     );
@@ -294,7 +293,7 @@ fn unsaved_edits_survive_in_the_autosave_and_come_back_with_recover() {
     assert_eq!(notice.len(), 1, "{err}");
     assert!(notice[0].contains(&autosave.display().to_string()), "{err}");
     assert_eq!(
-        Scene::load(&autosave).unwrap(),
+        prespline::formats::read_json(&autosave).unwrap(),
         kept,
         "the notice alone changes nothing"
     );
@@ -312,7 +311,7 @@ fn unsaved_edits_survive_in_the_autosave_and_come_back_with_recover() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{err}");
     assert_eq!(
-        Scene::load(&scene).unwrap(),
+        prespline::formats::read_json(&scene).unwrap(),
         kept,
         "the recovered edits were saved"
     );
@@ -358,7 +357,7 @@ fn the_demo_autosaves_in_the_working_directory() {
         ),
         "{err}"
     );
-    let kept = Scene::load(&autosave).unwrap();
+    let kept = prespline::formats::read_json(&autosave).unwrap();
     assert_ne!(kept, demo_scene());
 }
 
@@ -459,7 +458,7 @@ fn an_error_exit_keeps_the_unsaved_edits() {
             "{err}"
         );
         assert_ne!(
-            Scene::load(&dir.join("demo.autosave.json")).unwrap(),
+            prespline::formats::read_json(&dir.join("demo.autosave.json")).unwrap(),
             demo_scene()
         );
     }
@@ -506,10 +505,10 @@ fn knot_insertion_drag_and_two_undos_restore_the_scene_exactly() {
         assert!(out.status.success(), "viewer failed: {err}");
         std::fs::read_to_string(&saved).unwrap()
     };
-    let original = prespline::scene::scene_to_json(&demo_scene());
+    let original = prespline::formats::json::scene_to_json(&demo_scene());
 
     let refined = session("refined", "");
-    let after = prespline::scene::parse_scene(&refined).unwrap();
+    let after = prespline::formats::parse_scene(&refined).unwrap();
     let (Model::Surface(s0), Model::Surface(s1)) =
         (&demo_scene().objects[0].model, &after.objects[0].model)
     else {

@@ -9,7 +9,10 @@
 //! one-line banner naming scenario, scene, frames, size, mode and target.
 
 use super::CliError;
+use super::args::{MapRangeArgs, MemoryArgs, SamplesArgs, parse_size};
+use super::load::load_scene;
 use super::render::validation_mode;
+use crate::formats::demo::demo_scene;
 use crate::gpu::{FRAMES_IN_FLIGHT, OffscreenDesc, Renderer, RendererDesc};
 use crate::profile::{
     FrameRecord, Phase, Progress, Recorder, RunInfo, Summary, compare, write_all,
@@ -17,133 +20,179 @@ use crate::profile::{
 use crate::render::Redraw;
 use crate::render::maps::SurfaceMap;
 use crate::sampling::budget::MemoryBudget;
-use crate::scene::Scene;
-use crate::scene::demo::demo_scene;
+use crate::scene::{Scene, escape_controls};
 use crate::view::app::{self, ViewArgs};
 use crate::view::scenario::{Scenario, ScenarioDriver};
 use crate::view::session::Session;
+use clap::Args;
 use std::path::{Path, PathBuf};
 
-/// Options of one `bench` run.
-#[derive(Debug, Clone)]
+/// Run a scripted, reproducible editing session and report where every millisecond goes.
+#[derive(Args, Debug, Clone)]
 pub struct BenchArgs {
+    /// Scene file (JSON or OBJ); the demo scene without it.
     pub scene: Option<PathBuf>,
+    /// What the scripted user does.
+    #[arg(long, default_value = "drag", value_parser = Scenario::parse, value_name = "drag|erbs-rotate|orbit|idle")]
     pub scenario: Scenario,
+    /// Measured frames.
+    #[arg(long, default_value_t = 300)]
     pub frames: usize,
+    /// Warm-up frames before measuring (shader compilation, first uploads), reported separately.
+    #[arg(long, default_value_t = 30)]
     pub warmup: usize,
+    /// Image or window size.
+    #[arg(long, default_value = "1280x720", value_parser = parse_size, value_name = "WxH")]
     pub size: (u32, u32),
+    /// Run in a window (no vsync) instead of headless.
+    #[arg(long)]
     pub window: bool,
+    /// Also run the same session the way tools without pre-evaluation work (full re-sampling
+    /// and full upload of edited objects every frame) and compare: reports in DIR/incremental
+    /// and DIR/naive, the comparison printed and saved as DIR/comparison.txt.
+    #[arg(long)]
     pub naive: bool,
+    /// Output directory for the reports.
+    #[arg(long, default_value = "bench-out", value_name = "DIR")]
     pub out: PathBuf,
+    /// MSAA samples (1, 2, 4, 8); 0 picks the device's default: 1 on CPU rasterisers such
+    /// as lavapipe, 4 on GPUs (see docs/performance.md, "Frames").
+    #[arg(long, default_value_t = 0)]
     pub msaa: u32,
-    /// What pre-evaluation and the GPU mirrors may take.
-    pub memory: MemoryBudget,
-    /// Display level of detail (off: every sample of every surface is drawn).
-    pub lod: bool,
-    /// A surface analysis map shown throughout (`--analysis`).
+    #[command(flatten)]
+    pub samples: SamplesArgs,
+    #[command(flatten)]
+    pub memory: MemoryArgs,
+    /// Draw every sample of every surface (no display level of detail), for comparison.
+    #[arg(long)]
+    pub no_lod: bool,
+    /// Show a surface analysis map throughout: gaussian, mean, kmax, kmin or zebra.
+    #[arg(long, value_name = "MAP", value_parser = SurfaceMap::parse)]
     pub analysis: Option<SurfaceMap>,
-    /// `--samples` overrides for the scene (the demo's too).
-    pub samples: super::files::SampleOverride,
-    /// How the map's colour scale is chosen (`--map-range`).
-    pub map_range: crate::render::maps::MapRange,
-    /// How gestures redraw (`--redraw`).
+    #[command(flatten)]
+    pub map_range: MapRangeArgs,
+    /// How a gesture redraws: retained (what it cannot change is drawn once into a static
+    /// layer; each frame restores it and draws only what moves) or full (every object,
+    /// every frame). Both give the same pixels.
+    #[arg(long, default_value = "retained", value_parser = Redraw::parse, value_name = "retained|full")]
     pub redraw: Redraw,
 }
 
-/// Runs the benchmark, writes the reports and returns the closing line.
-pub fn run(args: &BenchArgs) -> Result<String, CliError> {
-    if args.frames == 0 {
-        return Err(CliError("--frames must be at least 1".into()));
-    }
-    let (scene, scene_name) = match &args.scene {
-        Some(p) => (
-            super::files::load_scene(p, &args.samples)?,
-            p.display().to_string(),
-        ),
-        None => {
-            let mut demo = demo_scene();
-            args.samples.apply(&mut demo)?;
-            (demo, "demo".to_string())
-        }
+/// The settings of one bench run, resolved from [`BenchArgs`].
+struct Bench {
+    args: BenchArgs,
+    budget: MemoryBudget,
+}
+
+/// Runs the benchmark, writes the reports and prints the closing line.
+pub fn run(args: BenchArgs) -> Result<(), CliError> {
+    let bench = Bench {
+        budget: args.memory.budget(),
+        args,
     };
-    super::render::check_drawable(&scene, Path::new(&scene_name), &args.memory)?;
-    super::render::check_analysis(&scene, args.analysis, &args.memory)?;
-    // Every frame keeps a record (and a frame-time entry in the progress line) until the
-    // reports are written: the counts pass the budget before the recorder reserves them.
-    let frames = args.frames as u128 + args.warmup as u128;
-    crate::sampling::budget::check_build(
-        format_args!("--frames {} with --warmup {}", args.frames, args.warmup),
-        frames * (std::mem::size_of::<crate::profile::FrameRecord>() as u128 + 8),
-    )
-    .map_err(CliError)?;
-    let modes: &[bool] = if args.naive { &[false, true] } else { &[false] };
-    let mut summaries = Vec::new();
-    let mut written = Vec::new();
-    for &naive in modes {
-        let mode = session_mode(naive);
-        let dir = if args.naive {
-            args.out.join(mode)
-        } else {
-            args.out.clone()
-        };
-        let (frames, device) = if args.window {
-            run_window(args, &scene, naive)?
-        } else {
-            run_headless(args, &scene, naive, &dir)?
-        };
-        // The banner heads the results rather than announcing the run: printed first, it
-        // would stand above the error of a run that fails to start, making it two lines.
-        eprintln!("{}", banner(args, &scene_name, mode));
-        let summary = Summary::from_frames(&frames);
-        eprint!("{}", summary.table());
-        let mut info = RunInfo {
-            scenario: args.scenario.name().into(),
-            scene: scene_name.clone(),
-            size: format!("{}x{}", args.size.0, args.size.1),
-            frames: args.frames,
-            warmup_frames: args.warmup,
-            device,
-            mode: mode.into(),
-            ..RunInfo::default()
-        };
-        info = info.with("target", if args.window { "window" } else { "offscreen" });
-        // The problem size, which `--samples` sets: every object's sample count, summed.
-        let samples: usize = scene
-            .objects
-            .iter()
-            .map(|o| o.model.sample_dims().iter().product::<usize>())
-            .sum();
-        info = info.with("scene_samples", samples);
-        info = info.with("redraw", args.redraw.name());
-        // How many measured frames a static layer served (a gesture draws in full where a
-        // layer would not pay, docs/performance.md).
-        let retained = frames.iter().filter(|f| !f.warmup && f.retained).count();
-        info = info.with("retained_frames", retained);
-        eprintln!(
-            "redraw {}: {retained} of {} measured frames drawn from the static layer",
-            args.redraw.name(),
-            args.frames
-        );
-        let paths = write_all(&dir, &info, &frames).map_err(|e| CliError(e.to_string()))?;
-        written.extend(paths);
-        if !args.window {
-            written.push(dir.join("final.png"));
+    let line = bench.run()?;
+    eprintln!("{}", escape_controls(&line));
+    Ok(())
+}
+
+impl Bench {
+    /// Runs the benchmark, writes the reports and returns the closing line.
+    fn run(&self) -> Result<String, CliError> {
+        let args = &self.args;
+        if args.frames == 0 {
+            return Err(CliError("--frames must be at least 1".into()));
         }
-        summaries.push((mode, summary));
+        let (scene, scene_name) = match &args.scene {
+            Some(p) => (
+                load_scene(p, &args.samples.counts(), &self.budget)?,
+                p.display().to_string(),
+            ),
+            None => {
+                let mut demo = demo_scene();
+                args.samples.counts().apply(&mut demo)?;
+                (demo, "demo".to_string())
+            }
+        };
+        super::render::check_drawable(&scene, Path::new(&scene_name), &self.budget)?;
+        super::render::check_analysis(&scene, args.analysis, &self.budget)?;
+        // Every frame keeps a record (and a frame-time entry in the progress line) until the
+        // reports are written: the counts pass the budget before the recorder reserves them.
+        let frames = args.frames as u128 + args.warmup as u128;
+        self.budget
+            .check_build(
+                format_args!("--frames {} with --warmup {}", args.frames, args.warmup),
+                frames * (std::mem::size_of::<crate::profile::FrameRecord>() as u128 + 8),
+            )
+            .map_err(CliError)?;
+        let modes: &[bool] = if args.naive { &[false, true] } else { &[false] };
+        let mut summaries = Vec::new();
+        let mut written = Vec::new();
+        for &naive in modes {
+            let mode = session_mode(naive);
+            let dir = if args.naive {
+                args.out.join(mode)
+            } else {
+                args.out.clone()
+            };
+            let (frames, device) = if args.window {
+                self.run_window(&scene, naive)?
+            } else {
+                self.run_headless(&scene, naive, &dir)?
+            };
+            // The banner heads the results rather than announcing the run: printed first, it
+            // would stand above the error of a run that fails to start, making it two lines.
+            eprintln!("{}", banner(args, &scene_name, mode));
+            let summary = Summary::from_frames(&frames);
+            eprint!("{}", summary.table());
+            let mut info = RunInfo {
+                scenario: args.scenario.name().into(),
+                scene: scene_name.clone(),
+                size: format!("{}x{}", args.size.0, args.size.1),
+                frames: args.frames,
+                warmup_frames: args.warmup,
+                device,
+                mode: mode.into(),
+                ..RunInfo::default()
+            };
+            info = info.with("target", if args.window { "window" } else { "offscreen" });
+            // The problem size, which `--samples` sets: every object's sample count, summed.
+            let samples: usize = scene
+                .objects
+                .iter()
+                .map(|o| o.model.sample_dims().iter().product::<usize>())
+                .sum();
+            info = info.with("scene_samples", samples);
+            info = info.with("redraw", args.redraw.name());
+            // How many measured frames a static layer served (a gesture draws in full where a
+            // layer would not pay, docs/performance.md).
+            let retained = frames.iter().filter(|f| !f.warmup && f.retained).count();
+            info = info.with("retained_frames", retained);
+            eprintln!(
+                "redraw {}: {retained} of {} measured frames drawn from the static layer",
+                args.redraw.name(),
+                args.frames
+            );
+            let paths = write_all(&dir, &info, &frames).map_err(|e| CliError(e.to_string()))?;
+            written.extend(paths);
+            if !args.window {
+                written.push(dir.join("final.png"));
+            }
+            summaries.push((mode, summary));
+        }
+        if let [(a, inc), (b, naive)] = summaries.as_slice() {
+            let text = comparison(a, inc, b, naive);
+            eprint!("{text}");
+            let path = args.out.join(COMPARISON_TXT);
+            std::fs::write(&path, &text)
+                .map_err(|e| CliError(format!("cannot write {}: {e}", path.display())))?;
+            written.push(path);
+        }
+        Ok(format!(
+            "bench results in {} ({} files)",
+            args.out.display(),
+            written.len()
+        ))
     }
-    if let [(a, inc), (b, naive)] = summaries.as_slice() {
-        let text = comparison(a, inc, b, naive);
-        eprint!("{text}");
-        let path = args.out.join(COMPARISON_TXT);
-        std::fs::write(&path, &text)
-            .map_err(|e| CliError(format!("cannot write {}: {e}", path.display())))?;
-        written.push(path);
-    }
-    Ok(format!(
-        "bench results in {} ({} files)",
-        args.out.display(),
-        written.len()
-    ))
 }
 
 /// With `--naive`: the side-by-side table of both runs, in the output folder.
@@ -181,138 +230,142 @@ fn comparison(a: &str, inc: &Summary, b: &str, naive: &Summary) -> String {
     text
 }
 
-/// The session in an offscreen target: exactly the viewer's per-frame work without a window.
-fn run_headless(
-    args: &BenchArgs,
-    scene: &Scene,
-    naive: bool,
-    dir: &Path,
-) -> Result<(Vec<FrameRecord>, String), CliError> {
-    let gpu = |e: crate::gpu::GpuError| CliError(e.to_string());
-    let mut renderer = Renderer::new(&RendererDesc {
-        app_name: "prespline bench".into(),
-        validation: validation_mode(),
-        ..RendererDesc::default()
-    })
-    .map_err(gpu)?;
-    let device = renderer.caps().name.clone();
-    let (w, h) = args.size;
-    let mut target = renderer
-        .create_offscreen(&OffscreenDesc {
-            width: w,
-            height: h,
-            samples: args.msaa,
+impl Bench {
+    /// The session in an offscreen target: exactly the viewer's per-frame work without a window.
+    fn run_headless(
+        &self,
+        scene: &Scene,
+        naive: bool,
+        dir: &Path,
+    ) -> Result<(Vec<FrameRecord>, String), CliError> {
+        let args = &self.args;
+        let gpu = |e: crate::gpu::GpuError| CliError(e.to_string());
+        let mut renderer = Renderer::new(&RendererDesc {
+            app_name: "prespline bench".into(),
+            validation: validation_mode(),
+            ..RendererDesc::default()
         })
         .map_err(gpu)?;
-    let mut session = Session::open(
-        &mut renderer,
-        scene,
-        dir.join("scene.json"),
-        [w, h],
-        args.memory,
-    )
-    .map_err(CliError)?;
-    session.set_naive(naive);
-    session.set_redraw(args.redraw);
-    session.options.lod = args.lod;
-    session.options.map_range = args.map_range;
-    session.set_map(args.analysis);
-    let total = args.warmup + args.frames;
-    let result = (|| -> Result<Recorder, CliError> {
-        let mut driver = ScenarioDriver::new(args.scenario, &session, args.warmup, args.frames)
-            .map_err(CliError)?;
-        let mut rec = Recorder::with_capacity(args.warmup, total);
-        let label = format!("bench {} ({})", args.scenario.name(), session_mode(naive));
-        let progress = Progress::new(&label, Some(total as u64)).unit("frames");
-        for k in 0..total {
-            let index = rec.begin_frame();
-            rec.phase_start(Phase::Input);
-            for action in driver.actions(k, &session) {
-                session.perform(action);
-            }
-            rec.phase_start(Phase::Delta);
-            let applied = session.apply_pending();
-            rec.add_samples(applied.samples as u64);
-            // Waiting for the frame slot's fence is what presenting costs offscreen.
-            rec.phase_start(Phase::Present);
-            let mut frame = renderer.begin_offscreen(&mut target).map_err(gpu)?;
-            if let Some(ms) = frame.gpu_time_ms() {
-                rec.set_gpu_ms(index.saturating_sub(FRAMES_IN_FLIGHT), ms);
-            }
-            rec.phase_start(Phase::Upload);
-            let stats = session.upload(&mut frame).map_err(gpu)?;
-            rec.add_bytes(stats.bytes as u64);
-            rec.phase_start(Phase::Record);
-            session.record(&mut frame, true).map_err(gpu)?;
-            rec.set_retained(session.hud.retained.is_some());
-            if k + 1 == total {
-                // Only the last image is written (final.png); no other frame is read back.
-                frame.capture();
-            }
-            rec.phase_start(Phase::Submit);
-            frame.finish().map_err(gpu)?;
-            rec.end_frame();
-            session
-                .hud
-                .push_frame(rec.frames().last().map_or(0.0, |f| f.frame_ms));
-            session.hud.gpu_ms = renderer.last_gpu_time_ms();
-            progress.inc(1);
-        }
-        progress.finish();
-        // The last frames' GPU times arrive when their slots are waited on.
-        renderer.wait_idle().map_err(gpu)?;
-        std::fs::create_dir_all(dir)
-            .map_err(|e| CliError(format!("cannot create {}: {e}", dir.display())))?;
-        let png = dir.join("final.png");
-        renderer
-            .read_pixels(&target)
-            .map_err(gpu)?
-            .write_png(&png)
+        let device = renderer.caps().name.clone();
+        let (w, h) = args.size;
+        let mut target = renderer
+            .create_offscreen(&OffscreenDesc {
+                width: w,
+                height: h,
+                samples: args.msaa,
+            })
             .map_err(gpu)?;
-        Ok(rec)
-    })();
-    session.destroy(&mut renderer);
-    renderer.destroy_offscreen(target).map_err(gpu)?;
-    let sink = renderer.validation_sink();
-    drop(renderer);
-    if let Some(errors) = sink.map(|s| s.errors()).filter(|e| !e.is_empty()) {
-        return Err(CliError(format!(
-            "Vulkan validation reported {} error(s), first: {}",
-            errors.len(),
-            errors[0]
-        )));
+        let mut session = Session::open(
+            &mut renderer,
+            scene,
+            dir.join("scene.json"),
+            [w, h],
+            self.budget,
+        )
+        .map_err(CliError)?;
+        session.set_naive(naive);
+        session.set_redraw(args.redraw);
+        session.options.lod = !args.no_lod;
+        session.options.map_range = args.map_range.map_range;
+        session.set_map(args.analysis);
+        let total = args.warmup + args.frames;
+        let result = (|| -> Result<Recorder, CliError> {
+            let mut driver = ScenarioDriver::new(args.scenario, &session, args.warmup, args.frames)
+                .map_err(CliError)?;
+            let mut rec = Recorder::with_capacity(args.warmup, total);
+            let label = format!("bench {} ({})", args.scenario.name(), session_mode(naive));
+            let progress = Progress::new(&label, Some(total as u64)).unit("frames");
+            for k in 0..total {
+                let index = rec.begin_frame();
+                rec.phase_start(Phase::Input);
+                for action in driver.actions(k, &session) {
+                    session.perform(action);
+                }
+                rec.phase_start(Phase::Delta);
+                let applied = session.apply_pending();
+                rec.add_samples(applied.samples as u64);
+                // Waiting for the frame slot's fence is what presenting costs offscreen.
+                rec.phase_start(Phase::Present);
+                let mut frame = renderer.begin_offscreen(&mut target).map_err(gpu)?;
+                if let Some(ms) = frame.gpu_time_ms() {
+                    rec.set_gpu_ms(index.saturating_sub(FRAMES_IN_FLIGHT), ms);
+                }
+                rec.phase_start(Phase::Upload);
+                let stats = session.upload(&mut frame).map_err(gpu)?;
+                rec.add_bytes(stats.bytes as u64);
+                rec.phase_start(Phase::Record);
+                session.record(&mut frame, true).map_err(gpu)?;
+                rec.set_retained(session.hud.retained.is_some());
+                if k + 1 == total {
+                    // Only the last image is written (final.png); no other frame is read back.
+                    frame.capture();
+                }
+                rec.phase_start(Phase::Submit);
+                frame.finish().map_err(gpu)?;
+                rec.end_frame();
+                session
+                    .hud
+                    .push_frame(rec.frames().last().map_or(0.0, |f| f.frame_ms));
+                session.hud.gpu_ms = renderer.last_gpu_time_ms();
+                progress.inc(1);
+            }
+            progress.finish();
+            // The last frames' GPU times arrive when their slots are waited on.
+            renderer.wait_idle().map_err(gpu)?;
+            std::fs::create_dir_all(dir)
+                .map_err(|e| CliError(format!("cannot create {}: {e}", dir.display())))?;
+            let png = dir.join("final.png");
+            renderer
+                .read_pixels(&target)
+                .map_err(gpu)?
+                .write_png(&png)
+                .map_err(gpu)?;
+            Ok(rec)
+        })();
+        session.destroy(&mut renderer);
+        renderer.destroy_offscreen(target).map_err(gpu)?;
+        let sink = renderer.validation_sink();
+        drop(renderer);
+        if let Some(errors) = sink.map(|s| s.errors()).filter(|e| !e.is_empty()) {
+            return Err(CliError(format!(
+                "Vulkan validation reported {} error(s), first: {}",
+                errors.len(),
+                errors[0]
+            )));
+        }
+        Ok((result?.into_frames(), device))
     }
-    Ok((result?.into_frames(), device))
+
+    fn run_window(
+        &self,
+        scene: &Scene,
+        naive: bool,
+    ) -> Result<(Vec<FrameRecord>, String), CliError> {
+        let args = &self.args;
+        let run = app::run(ViewArgs {
+            scene: scene.clone(),
+            title: format!("bench {}", args.scenario.name()),
+            save_path: args.out.join("scene.json"),
+            size: args.size,
+            vsync: false,
+            script: None,
+            scenario: Some(args.scenario),
+            warmup: args.warmup,
+            max_frames: Some(args.warmup + args.frames),
+            naive,
+            autosave: None,
+            msaa: args.msaa,
+            lod: !args.no_lod,
+            analysis: args.analysis,
+            map_range: args.map_range.map_range,
+            memory: self.budget,
+            redraw: args.redraw,
+        })
+        .map_err(CliError)?;
+        Ok((run.frames, run.device))
+    }
 }
 
 fn session_mode(naive: bool) -> &'static str {
     if naive { "naive" } else { "incremental" }
-}
-
-fn run_window(
-    args: &BenchArgs,
-    scene: &Scene,
-    naive: bool,
-) -> Result<(Vec<FrameRecord>, String), CliError> {
-    let run = app::run(ViewArgs {
-        scene: scene.clone(),
-        title: format!("bench {}", args.scenario.name()),
-        save_path: args.out.join("scene.json"),
-        size: args.size,
-        vsync: false,
-        script: None,
-        scenario: Some(args.scenario),
-        warmup: args.warmup,
-        max_frames: Some(args.warmup + args.frames),
-        naive,
-        autosave: None,
-        msaa: args.msaa,
-        lod: args.lod,
-        analysis: args.analysis,
-        map_range: args.map_range,
-        memory: args.memory,
-        redraw: args.redraw,
-    })
-    .map_err(CliError)?;
-    Ok((run.frames, run.device))
 }

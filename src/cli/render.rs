@@ -1,37 +1,112 @@
 //! `prespline render`: draws a scene headless into a PNG or JPEG file (by the extension).
 
 use super::CliError;
-use super::files::{SampleOverride, load_scene};
+use super::args::{DisplayArgs, MemoryArgs, SamplesArgs, parse_size};
+use super::load::load_scene;
 use super::resident::{MemoryReport, Resident};
+use super::samples::SampleOverride;
 use crate::editor::{Document, Editor, EditorOptions, ListRefused};
 use crate::gpu::{Renderer, RendererDesc};
+use crate::render::OrbitCamera;
 use crate::render::image_file::{ImageFormat, write_image};
 use crate::render::maps::SurfaceMap;
 use crate::render::offscreen::{Shot, render_document};
-use crate::render::{OrbitCamera, ViewOptions};
 use crate::sampling::SampleMode;
 use crate::sampling::budget::MemoryBudget;
-use crate::scene::{EditList, Scene};
-use std::path::Path;
+use crate::scene::{EditList, Scene, escape_controls};
+use clap::Args;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// Parses `WIDTHxHEIGHT`.
-pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("'{s}' is not WIDTHxHEIGHT"))?;
-    let w: u32 = w
-        .trim()
-        .parse()
-        .map_err(|_| format!("'{w}' is not a width"))?;
-    let h: u32 = h
-        .trim()
-        .parse()
-        .map_err(|_| format!("'{h}' is not a height"))?;
-    if !(1..=16384).contains(&w) || !(1..=16384).contains(&h) {
-        return Err(format!("{w}x{h}: width and height must be within 1..16384"));
+/// Render a scene headless (no display needed) into a PNG or JPEG image (by the extension).
+#[derive(Args, Debug, Clone)]
+pub struct RenderArgs {
+    /// Scene file (JSON, or Wavefront OBJ by its .obj extension).
+    pub scene: PathBuf,
+    /// Output image: PNG for .png, JPEG for .jpg or .jpeg; other extensions are refused.
+    #[arg(long, short = 'o', value_name = "IMAGE.png|IMAGE.jpg")]
+    pub out: PathBuf,
+    /// Image size.
+    #[arg(long, default_value = "1280x720", value_parser = parse_size, value_name = "WxH")]
+    pub size: (u32, u32),
+    /// Camera as eye and target, optionally the vertical field of view in degrees:
+    /// EX,EY,EZ,TX,TY,TZ[,FOV]. Default: frames the whole scene.
+    #[arg(long, value_parser = OrbitCamera::parse, value_name = "EYE,TARGET[,FOV]", allow_hyphen_values = true)]
+    pub camera: Option<OrbitCamera>,
+    /// Edits (JSON list) applied before rendering.
+    #[arg(long, value_name = "EDITS.json")]
+    pub edits: Option<PathBuf>,
+    /// MSAA samples (1, 2, 4, 8); a still image is worth 4; 0 picks the device's interactive
+    /// default (1 on CPU rasterisers, 4 on GPUs).
+    #[arg(long, default_value_t = 4)]
+    pub msaa: u32,
+    /// Draw the osculating circle of curve NAME at parameter T, labelled with its
+    /// curvature, radius and torsion.
+    #[arg(long, value_name = "NAME@T", value_parser = parse_osculating)]
+    pub osculating: Option<(String, f64)>,
+    #[command(flatten)]
+    pub display: DisplayArgs,
+    #[command(flatten)]
+    pub samples: SamplesArgs,
+    #[command(flatten)]
+    pub memory: MemoryArgs,
+    /// After writing the image, print the memory budget's estimate of the scene next to
+    /// what it made resident (peak resident size less the program and the Vulkan driver).
+    #[arg(long)]
+    pub memory_report: bool,
+}
+
+/// Loads, edits and renders; prints the closing line (and the memory report).
+pub fn run(args: RenderArgs) -> Result<(), CliError> {
+    let before = Resident::read();
+    let (doc, estimate) = load_document(
+        &args.scene,
+        args.edits.as_deref(),
+        &args.samples.counts(),
+        &args.memory.budget(),
+        args.display.analysis,
+        args.display.net,
+    )?;
+    let mut options = args.display.options();
+    if let Some((name, t)) = &args.osculating {
+        options.osculating_at = Some(osculating_at(&doc, name, *t)?);
     }
-    Ok((w, h))
+    let probe = before
+        .filter(|_| args.memory_report)
+        .map(|before| MemoryProbe { estimate, before });
+    let (w, h) = args.size;
+    let shot = Shot {
+        width: w,
+        height: h,
+        camera: args.camera,
+        options,
+        msaa: args.msaa,
+    };
+    let lines = render_image(&doc, &args.out, shot, probe);
+    // The process ends with this command: freeing a large scene's allocations one by one
+    // (two per object and more) would only delay the exit.
+    std::mem::forget(doc);
+    let (line, report) = lines?;
+    eprintln!("{}", escape_controls(&line));
+    if let Some(r) = report {
+        eprintln!("{r}");
+    } else if args.memory_report {
+        eprintln!("memory: the resident size is not readable here (/proc/self/status)");
+    }
+    Ok(())
+}
+
+/// `NAME@T` of `--osculating`.
+pub fn parse_osculating(s: &str) -> Result<(String, f64), String> {
+    let (name, t) = s
+        .rsplit_once('@')
+        .ok_or_else(|| format!("'{s}' is not NAME@T"))?;
+    let t: f64 = t
+        .parse()
+        .ok()
+        .filter(|t: &f64| t.is_finite())
+        .ok_or_else(|| format!("'{t}' is not a parameter value"))?;
+    Ok((name.to_string(), t))
 }
 
 pub use crate::render::{DRAW_USES, render_uses, validation_mode};
@@ -57,7 +132,7 @@ pub fn load_document(
     map: Option<SurfaceMap>,
     nets: bool,
 ) -> Result<(Document, u64), CliError> {
-    let scene = load_scene(scene_path, samples)?;
+    let scene = load_scene(scene_path, samples, budget)?;
     let options = EditorOptions {
         mode: SampleMode::Render,
         uses: render_uses(nets),
@@ -129,19 +204,15 @@ pub struct MemoryProbe {
     pub before: Resident,
 }
 
-/// Renders `doc` headless and writes `out` (PNG or JPEG, by its extension); returns a one-line summary, and with
-/// `probe` the `--memory-report` line.
-#[allow(clippy::too_many_arguments)]
-pub fn run(
+/// Renders `doc` headless and writes `out` (PNG or JPEG, by its extension); returns a
+/// one-line summary, and with `probe` the `--memory-report` line.
+pub fn render_image(
     doc: &Document,
     out: &Path,
-    width: u32,
-    height: u32,
-    camera: Option<OrbitCamera>,
-    options: ViewOptions,
-    msaa: u32,
+    shot: Shot,
     probe: Option<MemoryProbe>,
 ) -> Result<(String, Option<String>), CliError> {
+    let (width, height) = (shot.width, shot.height);
     let start = Instant::now();
     // An image name that names no format the renderer writes is refused before anything runs.
     ImageFormat::of(out).map_err(CliError)?;
@@ -153,13 +224,6 @@ pub fn run(
     })
     .map_err(|e| CliError(e.to_string()))?;
     let after_driver = Resident::read();
-    let shot = Shot {
-        width,
-        height,
-        camera,
-        options,
-        msaa,
-    };
     let pixels = render_document(&mut renderer, doc, &shot).map_err(|e| CliError(e.to_string()))?;
     let sink = renderer.validation_sink();
     let device = renderer.caps().name.clone();

@@ -2,42 +2,58 @@
 //! JSON contract of docs/scene-format.md on stdout.
 
 use super::CliError;
+use super::args::{MemoryArgs, SamplesArgs};
+use super::load::load_scene;
 use crate::editor::{Editor, EditorOptions, ListRefused};
 use crate::model::SampledObject;
 use crate::sampling::SampleMode;
-use crate::sampling::budget::{MemoryBudget, Uses};
+use crate::sampling::budget::Uses;
 use crate::scene::EditList;
+use clap::Args;
 use std::fmt::Write;
-use std::path::Path;
+use std::path::PathBuf;
 
 /// Highest derivative order `--derivatives` accepts.
 pub const MAX_DERIVATIVES: usize = 20;
 
-/// Options of one `sample` run.
-#[derive(Debug, Clone)]
-pub struct SampleArgs<'a> {
-    pub scene: &'a Path,
+/// Sample every object of a scene and print positions and derivatives as JSON on stdout.
+#[derive(Args, Debug, Clone)]
+pub struct SampleArgs {
+    /// Scene file (JSON, see docs/scene-format.md; or Wavefront OBJ, see docs/obj.md).
+    pub scene: PathBuf,
+    /// Highest derivative order N: curves get c..c^(N), surfaces every ∂^{a+b}S with a, b ≤ N.
+    #[arg(long, short = 'd', default_value_t = 1, value_name = "N")]
     pub derivatives: usize,
-    pub edits: Option<&'a Path>,
-    /// Apply edits to the model and re-sample from scratch instead of the delta path.
+    /// Edits (JSON list) applied in order through the incremental (delta) path.
+    #[arg(long, value_name = "EDITS.json")]
+    pub edits: Option<PathBuf>,
+    /// Apply the edits to the model and re-sample from scratch instead of the delta path.
+    #[arg(long)]
     pub full: bool,
-    /// What pre-evaluation and the output text may take.
-    pub memory: MemoryBudget,
-    /// `--samples` overrides for the loaded scene.
-    pub samples: super::files::SampleOverride,
+    #[command(flatten)]
+    pub samples: SamplesArgs,
+    #[command(flatten)]
+    pub memory: MemoryArgs,
 }
 
-/// Runs the command and returns the complete output text (nothing is printed on error, so a
-/// failure never leaves partial output).
-pub fn run(args: &SampleArgs) -> Result<String, CliError> {
+/// Runs the command and prints the output; nothing is printed on error, so a failure never
+/// leaves partial output.
+pub fn run(args: SampleArgs) -> Result<(), CliError> {
+    let text = sample_text(&args)?;
+    super::print_stdout(&text)
+}
+
+/// The complete output text.
+fn sample_text(args: &SampleArgs) -> Result<String, CliError> {
     if args.derivatives > MAX_DERIVATIVES {
         return Err(CliError(format!(
             "--derivatives {} exceeds the supported maximum {MAX_DERIVATIVES}",
             args.derivatives
         )));
     }
-    let scene = super::files::load_scene(args.scene, &args.samples)?;
-    let edits = match args.edits {
+    let budget = args.memory.budget();
+    let scene = load_scene(&args.scene, &args.samples.counts(), &budget)?;
+    let edits = match &args.edits {
         Some(path) => {
             let text = std::fs::read_to_string(path)
                 .map_err(|e| CliError(format!("cannot read {}: {e}", path.display())))?;
@@ -55,14 +71,14 @@ pub fn run(args: &SampleArgs) -> Result<String, CliError> {
             control_displays: false,
             json_text: true,
         },
-        budget: args.memory,
+        budget,
     };
-    let mut editor = Editor::new(&scene, options).map_err(|e| CliError::in_file(args.scene, e))?;
+    let mut editor = Editor::new(&scene, options).map_err(|e| CliError::in_file(&args.scene, e))?;
     if let Some((path, list)) = &edits {
         // Through the delta path; edits that grow an object are budgeted as they come.
         editor.submit_list(list).map_err(|r| match r {
             ListRefused::Edit(e) => CliError::in_file(path, e),
-            ListRefused::OverBudget(e) => CliError::in_file(args.scene, e),
+            ListRefused::OverBudget(e) => CliError::in_file(&args.scene, e),
         })?;
     }
     if args.full {

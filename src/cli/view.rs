@@ -1,53 +1,92 @@
 //! `prespline view`: the interactive viewer.
 
 use super::CliError;
-use super::files::{SampleOverride, load_scene};
-use crate::profile::{RunInfo, Summary, write_all};
-use crate::sampling::budget::MemoryBudget;
-use crate::scene::Scene;
-use crate::scene::demo::demo_scene;
-use crate::view::app::{self, ViewArgs};
+use super::args::{MapRangeArgs, MemoryArgs, SamplesArgs, parse_size};
+use super::load::load_scene;
+use crate::formats::demo::demo_scene;
+use crate::formats::{self, LoadOptions};
+use crate::profile::{RunInfo, Summary, TerminalProgress, write_all};
+use crate::render::Redraw;
+use crate::render::maps::SurfaceMap;
+use crate::view::app;
 use crate::view::autosave::{Autosave, Places, state_dir};
 use crate::view::script::parse_script;
+use clap::Args;
 use std::path::{Path, PathBuf};
 
 /// Where Ctrl+S writes the demo scene.
 const DEMO_SAVE: &str = "prespline-demo.json";
 
-/// Command-line options of `prespline view`.
-#[derive(Debug, Clone, Copy)]
-pub struct ViewOptions<'a> {
-    pub scene: Option<&'a Path>,
+/// Open the interactive viewer on a scene (the built-in demo scene without SCENE).
+///
+/// docs/viewer.md describes the mouse, the keys, the editing modes and the --script
+/// format; H or F1 in the viewer lists the keys.
+#[derive(Args, Debug, Clone)]
+pub struct ViewArgs {
+    /// Scene file (JSON, or Wavefront OBJ by its .obj extension); without it, the demo:
+    /// B-spline surface, ERBS surface and curve, NURBS circle, closed ERBS torus, Utah
+    /// teapot.
+    pub scene: Option<PathBuf>,
+    /// Window size.
+    #[arg(long, default_value = "1280x720", value_parser = parse_size, value_name = "WxH")]
     pub size: (u32, u32),
-    pub vsync: bool,
-    pub script: Option<&'a Path>,
-    pub save_as: Option<&'a Path>,
-    pub profile: Option<&'a Path>,
-    /// `--samples` overrides for the loaded scene.
-    pub samples: SampleOverride,
-    /// What pre-evaluation and the GPU mirrors may take.
-    pub memory: MemoryBudget,
-    /// Open an autosave (unsaved edits of an earlier session) instead of the scene: `Some(None)`
-    /// the newest, `Some(Some(FILE))` the one named.
-    pub recover: Option<Option<&'a Path>>,
-    /// A surface analysis map shown from the start (`--analysis`; M cycles it later).
-    pub analysis: Option<crate::render::maps::SurfaceMap>,
-    /// How the map's colour scale is chosen (`--map-range`).
-    pub map_range: crate::render::maps::MapRange,
-    /// How gestures redraw (`--redraw`).
-    pub redraw: crate::render::Redraw,
+    /// Present without vsync (MAILBOX or IMMEDIATE) to measure frame times.
+    #[arg(long)]
+    pub no_vsync: bool,
+    /// Replay timed input events from a JSON script (format: docs/viewer.md, "Scripts").
+    #[arg(long, value_name = "SCRIPT.json")]
+    pub script: Option<PathBuf>,
+    /// Where Ctrl+S writes (default: the scene file, or prespline-demo.json for the demo);
+    /// a path ending in .obj is written as Wavefront OBJ.
+    #[arg(long, value_name = "PATH")]
+    pub save_as: Option<PathBuf>,
+    #[command(flatten)]
+    pub samples: SamplesArgs,
+    /// Record per-frame phase timings while interacting and write the reports (CSV, JSON
+    /// summary, Chrome trace, SVG plots) into DIR when the window closes.
+    #[arg(long, value_name = "DIR")]
+    pub profile: Option<PathBuf>,
+    /// Open an earlier session's unsaved edits instead of the scene: the newest autosave,
+    /// or =FILE (the start-up note lists those waiting). Autosaves: NAME.autosave.json
+    /// beside NAME.json (demo.autosave.json for the demo), earlier sessions' as
+    /// NAME.autosave.YYYYMMDD-HHMMSS.json, or in $XDG_STATE_HOME/prespline/ when the
+    /// scene's directory cannot take them. Ctrl+S removes the recovered autosave; see
+    /// docs/autosave.md.
+    #[arg(long, value_name = "FILE", num_args = 0..=1, require_equals = true)]
+    pub recover: Option<Option<PathBuf>>,
+    #[command(flatten)]
+    pub memory: MemoryArgs,
+    /// Open with a surface analysis map on: gaussian, mean, kmax, kmin or zebra (M cycles).
+    #[arg(long, value_name = "MAP", value_parser = SurfaceMap::parse)]
+    pub analysis: Option<SurfaceMap>,
+    #[command(flatten)]
+    pub map_range: MapRangeArgs,
+    /// How a gesture redraws: retained (what it cannot change is drawn once into a static
+    /// layer; each frame restores it and draws only what moves) or full (every object,
+    /// every frame). Both give the same pixels.
+    #[arg(long, default_value = "retained", value_parser = Redraw::parse, value_name = "retained|full")]
+    pub redraw: Redraw,
 }
 
-pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
-    let places = Places::new(opts.scene, state_dir().as_deref());
-    let recovered = match opts.recover {
-        Some(named) => Some(recover_file(&places, named)?),
+/// Opens the viewer; returns when its window closes.
+pub fn run(opts: ViewArgs) -> Result<(), CliError> {
+    let budget = opts.memory.budget();
+    let samples = opts.samples.counts();
+    let places = Places::new(opts.scene.as_deref(), state_dir().as_deref());
+    let recovered = match &opts.recover {
+        Some(named) => Some(recover_file(&places, named.as_deref())?),
         None => None,
     };
-    let (scene, title, default_save) = match (&recovered, opts.scene) {
+    let (scene, title, default_save) = match (&recovered, opts.scene.as_deref()) {
         (Some(file), scene) => {
-            let mut loaded = Scene::load(file).map_err(|e| CliError::in_file(file, e))?;
-            opts.samples.apply(&mut loaded)?;
+            let options = LoadOptions {
+                budget,
+                progress: &TerminalProgress,
+                samples: Default::default(),
+            };
+            // An autosave is a JSON scene whatever the scene's own format.
+            let mut loaded = formats::load_json(file, options).map_err(CliError)?;
+            samples.apply(&mut loaded)?;
             let (title, save) = match scene {
                 Some(p) => (p.display().to_string(), p.to_path_buf()),
                 None => ("demo".to_string(), Path::new(DEMO_SAVE).to_path_buf()),
@@ -55,13 +94,13 @@ pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
             (loaded, format!("{title} (recovered)"), save)
         }
         (None, Some(p)) => (
-            load_scene(p, &opts.samples)?,
+            load_scene(p, &samples, &budget)?,
             p.display().to_string(),
             p.to_path_buf(),
         ),
         (None, None) => {
             let mut demo = demo_scene();
-            opts.samples.apply(&mut demo)?;
+            samples.apply(&mut demo)?;
             (demo, "demo".to_string(), Path::new(DEMO_SAVE).to_path_buf())
         }
     };
@@ -74,14 +113,14 @@ pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
         // Shown by the session, on the status line and stderr.
         autosave.notify(note);
     }
-    super::render::check_drawable(&scene, Path::new(&title), &opts.memory)?;
-    super::render::check_analysis(&scene, opts.analysis, &opts.memory)?;
+    super::render::check_drawable(&scene, Path::new(&title), &budget)?;
+    super::render::check_analysis(&scene, opts.analysis, &budget)?;
     if !app::display_available() {
         return Err(CliError(
             "no display: DISPLAY is not set (prespline view needs X11 or XWayland; headless: `prespline render` or `prespline bench`, or `make run` which falls back to a headless demo)".into(),
         ));
     }
-    let script = match opts.script {
+    let script = match &opts.script {
         Some(p) => {
             let text = std::fs::read_to_string(p)
                 .map_err(|e| CliError(format!("cannot read {}: {e}", p.display())))?;
@@ -90,12 +129,12 @@ pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
         }
         None => None,
     };
-    let args = ViewArgs {
+    let args = app::ViewArgs {
         scene,
         title,
-        save_path: opts.save_as.map_or(default_save, Path::to_path_buf),
+        save_path: opts.save_as.clone().unwrap_or(default_save),
         size: opts.size,
-        vsync: opts.vsync,
+        vsync: !opts.no_vsync,
         script,
         scenario: None,
         warmup: 0,
@@ -105,13 +144,13 @@ pub fn run(opts: &ViewOptions) -> Result<(), CliError> {
         msaa: 0,
         lod: true,
         analysis: opts.analysis,
-        map_range: opts.map_range,
-        memory: opts.memory,
+        map_range: opts.map_range.map_range,
+        memory: budget,
         redraw: opts.redraw,
     };
     let title = args.title.clone();
     let run = app::run(args).map_err(CliError)?;
-    if let Some(dir) = opts.profile {
+    if let Some(dir) = &opts.profile {
         let summary = Summary::from_frames(&run.frames);
         eprint!("{}", summary.table());
         let info = RunInfo {

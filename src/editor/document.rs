@@ -8,7 +8,7 @@ use crate::model::{
     ControlDisplay, Edit, ErbsCurveEdit, ErbsSurfaceEdit, Grip, Index2, KindEdit, LocalEdit,
     LocalPath, Model, ModelRef, ObjectEdit, each_curve_leaf_of, each_patch_leaf_of,
 };
-use crate::profile::{LOAD_PROGRESS_AFTER, Progress};
+use crate::progress::{ProgressSink, Silent};
 use crate::sampling::SampleMode;
 use crate::scene::{Scene, SceneObject};
 use glam::DVec3;
@@ -18,8 +18,8 @@ use glam::DVec3;
 pub struct DocObject {
     pub name: String,
     pub color: Option<[f64; 3]>,
-    /// What its OBJ source held that prespline does not use, kept through edits for saving.
-    pub obj: crate::scene::obj::carried::Carried,
+    /// What its file held that prespline does not use, kept through edits for saving.
+    pub kept: crate::scene::Carried,
     pub sampled: SampledObject,
     /// What is drawn and picked besides the samples, kept up to date by every apply.
     pub controls: ControlDisplay,
@@ -34,7 +34,7 @@ impl DocObject {
         Self {
             name: o.name.clone(),
             color: o.color,
-            obj: o.obj.clone(),
+            kept: o.kept.clone(),
             sampled,
             controls,
         }
@@ -47,7 +47,7 @@ impl DocObject {
             name: self.name.clone(),
             model: self.sampled.model().to_model(),
             color: self.color,
-            obj: self.obj.clone(),
+            kept: self.kept.clone(),
         }
     }
 }
@@ -115,6 +115,12 @@ impl Document {
     /// objects spread over every core ([`crate::parallel`]; the same bits as on one thread).
     #[must_use]
     pub fn with_mode(scene: &Scene, mode: SampleMode) -> Self {
+        Self::with_progress(scene, mode, &Silent)
+    }
+
+    /// [`Document::with_mode`], counting the samples done into `progress`.
+    #[must_use]
+    pub fn with_progress(scene: &Scene, mode: SampleMode, progress: &dyn ProgressSink) -> Self {
         let samples: u64 = scene
             .objects
             .iter()
@@ -126,8 +132,7 @@ impl Document {
                     .product::<u64>()
             })
             .sum();
-        let progress =
-            Progress::delayed("pre-evaluating", Some(samples), LOAD_PROGRESS_AFTER).unit("samples");
+        let progress = progress.start("pre-evaluating", Some(samples), "samples");
         let objects = crate::parallel::map(&scene.objects, |o| {
             let d = DocObject::new(o, mode);
             progress.inc(d.sampled.grid().data.len() as u64 / d.sampled.grid().stride() as u64);

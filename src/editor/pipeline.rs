@@ -130,6 +130,12 @@ impl Editor {
             return Ok(());
         }
         self.flush();
+        if let Some(b) = edit.edit.builds() {
+            self.options
+                .budget
+                .check_build(&b.what, b.bytes)
+                .map_err(|e| Refused::Invalid(EditError::new(b.field, e)))?;
+        }
         let model = self.doc.objects[edit.object].sampled.model();
         let result = edit.edit.prepare(model)?;
         let grown = match &result {

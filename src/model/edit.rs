@@ -63,6 +63,15 @@ fn significant(x: f64) -> String {
     }
 }
 
+/// What an edit will build: `what` in words ("3 local curves of degree 2") and about how many
+/// bytes, for the field `field` of the edit.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Build {
+    pub field: &'static str,
+    pub what: String,
+    pub bytes: u128,
+}
+
 /// What an edit acts on. Edits on different targets commute; consecutive edits on one target
 /// may merge. A structural edit acts on the whole object and orders everything around it. It
 /// also says what the edit changes in the drawn control structures: one point, one local curve
@@ -127,6 +136,12 @@ pub trait KindEdit: Clone + Debug + PartialEq + Sized + IntoObject {
     /// This edit followed by `next` as one edit, when both act on one target and combine.
     #[must_use]
     fn merge(&self, next: &Self) -> Option<Self>;
+
+    /// What preparing the edit will allocate, known from the edit alone, so the editor holds
+    /// it to the memory budget before anything is built (an ERBS local built from a count).
+    fn builds(&self) -> Option<Build> {
+        None
+    }
 
     /// The edit as an edit of any kind.
     #[must_use]

@@ -2,7 +2,7 @@
 //! with one-line errors, and the pieces of the edit vocabulary common to all kinds.
 
 use super::{EditError, MAX_CURVE_SAMPLES, MAX_DEGREE, MAX_SURFACE_SAMPLES, PointEdit};
-use crate::format::json::*;
+use crate::fields::json::*;
 use crate::geom::{BFunctionKind, GeomError};
 use glam::DVec3;
 use serde_json::{Map, Value};

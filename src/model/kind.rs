@@ -3,11 +3,11 @@
 //! `match` in every layer.
 
 use super::controls::{ControlDisplay, Grip};
-use super::edit::{KindEdit, Target};
+use super::edit::{EditError, KindEdit, Target};
 use super::erbs::LocalPath;
 use super::index::Index2;
 use super::spline::curve::CurveModel;
-use crate::format::{At, SceneError};
+use crate::fields::{At, ReadCtx, SceneError};
 use crate::sampling::budget::Extent;
 use crate::sampling::{DirtyRegion, SampleMode, Sampler, Tracked};
 use glam::DVec3;
@@ -34,13 +34,13 @@ pub trait Kind: Clone + Debug + PartialEq + Sized + 'static {
         Self::TYPES[0]
     }
 
-    /// Reads an object of type `ty` (one of [`Kind::TYPES`]) from its fields; `common` names
-    /// the fields every object has, which the scene reads.
+    /// Reads an object of type `ty` (one of [`Kind::TYPES`]) from its fields; `ctx.common`
+    /// names the fields every object has, which the scene reads.
     fn read(
         ty: &str,
         at: &At,
         obj: &Map<String, Value>,
-        common: &[&'static str],
+        ctx: &ReadCtx<'_>,
     ) -> Result<Self, SceneError>;
 
     /// Writes the kind's own fields, each as `, "name": value` (the scene writes the name,
@@ -52,6 +52,10 @@ pub trait Kind: Clone + Debug + PartialEq + Sized + 'static {
 
     /// Sample grid dimensions: [m, 1] for curves, [mu, mv] for surfaces.
     fn sample_dims(&self) -> [usize; 2];
+
+    /// The same geometry with other sample counts (`--samples`): [m, _] for curves, [mu, mv]
+    /// for surfaces, checked against the limits.
+    fn with_samples(&self, samples: [usize; 2]) -> Result<Self, EditError>;
 
     /// Parameter domain per direction (one entry for curves).
     fn domain(&self) -> Vec<(f64, f64)>;

@@ -32,7 +32,7 @@ pub use chain::{
     BezierSplineEdit, BezierSplineModel, CatmullRomEdit, CatmullRomModel, ChainEdit, ChainModel,
 };
 pub use controls::{ControlDisplay, ControlLayout, ControlsChange, Grip};
-pub use edit::{EditError, IntoObject, KindEdit, Target};
+pub use edit::{Build, EditError, IntoObject, KindEdit, Target};
 pub use erbs::controls::{each_curve_leaf_of, each_patch_leaf_of};
 pub use erbs::curve_sampler::ErbsCurveSampler;
 pub use erbs::surface_sampler::ErbsSurfaceSampler;

@@ -109,6 +109,12 @@ impl ObjectEdit {
         self.as_dyn()?.merge(next)
     }
 
+    /// What preparing the edit will allocate ([`KindEdit::builds`](super::KindEdit::builds)).
+    #[must_use]
+    pub fn builds(&self) -> Option<super::edit::Build> {
+        self.as_dyn()?.builds()
+    }
+
     /// Checks the edit against a model (of its own kind).
     pub fn validate(&self, model: ModelRef<'_>) -> Result<(), EditError> {
         match self {

@@ -9,7 +9,7 @@ use super::edit::{EditError, IntoObject, KindEdit, Target};
 use super::erbs::LocalPath;
 use super::index::Index2;
 use super::kind::{Kind, Support};
-use crate::format::{At, SceneError};
+use crate::fields::{At, SceneError};
 use crate::sampling::budget::Extent;
 use crate::sampling::{DirtyRegion, SampleGrid, SampleMode, Sampler, Tracked};
 use glam::DVec3;
@@ -119,14 +119,14 @@ macro_rules! kinds {
             /// `None` for a type no kind declares.
             pub fn read(
                 ty: &str,
-                at: &$crate::format::At,
+                at: &$crate::fields::At,
                 obj: &serde_json::Map<String, serde_json::Value>,
-                common: &[&'static str],
-            ) -> Option<Result<Model, $crate::format::SceneError>> {
+                ctx: &$crate::fields::ReadCtx<'_>,
+            ) -> Option<Result<Model, $crate::fields::SceneError>> {
                 use $crate::model::Kind;
                 $(
                     if <$m>::TYPES.contains(&ty) {
-                        return Some(<$m>::read(ty, at, obj, common).map(Model::$v));
+                        return Some(<$m>::read(ty, at, obj, ctx).map(Model::$v));
                     }
                 )+
                 None
@@ -226,6 +226,8 @@ pub trait DynKind {
     fn type_name(&self) -> &'static str;
     fn is_surface(&self) -> bool;
     fn sample_dims(&self) -> [usize; 2];
+    /// The model with other sample counts ([`Kind::with_samples`]).
+    fn with_samples(&self, samples: [usize; 2]) -> Result<Model, EditError>;
     fn domain(&self) -> Vec<(f64, f64)>;
     fn to_model(&self) -> Model;
     fn sampled(&self, mode: SampleMode) -> SampledObject;
@@ -281,6 +283,10 @@ where
 
     fn sample_dims(&self) -> [usize; 2] {
         Kind::sample_dims(self)
+    }
+
+    fn with_samples(&self, samples: [usize; 2]) -> Result<Model, EditError> {
+        Kind::with_samples(self, samples).map(Model::from)
     }
 
     fn domain(&self) -> Vec<(f64, f64)> {
@@ -377,6 +383,8 @@ pub trait DynEdit {
     fn target(&self) -> Target;
     /// This edit followed by `next` as one, when both act on one target and combine.
     fn merge(&self, next: &ObjectEdit) -> Option<ObjectEdit>;
+    /// What preparing it will allocate ([`KindEdit::builds`]).
+    fn builds(&self) -> Option<super::edit::Build>;
 }
 
 impl<E> DynEdit for E
@@ -395,6 +403,10 @@ where
     fn merge(&self, next: &ObjectEdit) -> Option<ObjectEdit> {
         let next = E::from_object(next)?;
         KindEdit::merge(self, next).map(KindEdit::into_object)
+    }
+
+    fn builds(&self) -> Option<super::edit::Build> {
+        KindEdit::builds(self)
     }
 }
 

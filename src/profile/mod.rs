@@ -75,7 +75,7 @@ pub use csv::{CSV_HEADER, write_frames_csv, write_frames_csv_to};
 pub use histogram::{histogram_svg, write_histogram_svg};
 pub use phase::{GPU_MEANING, OTHER_MEANING, Phase, PhaseMap};
 pub use plot::{frame_times_svg, write_frame_times_svg};
-pub use progress::{LOAD_PROGRESS_AFTER, Progress};
+pub use progress::{LOAD_PROGRESS_AFTER, Progress, TerminalProgress};
 pub use recorder::{FrameRecord, Recorder};
 pub use stats::{LOW_1PCT_MEANING, PERCENTILE_MEANING, Stats, percentile, slowest_mean};
 pub use summary::{

@@ -150,6 +150,28 @@ impl Progress {
     }
 }
 
+/// The command line's progress sink: loads that take longer than [`LOAD_PROGRESS_AFTER`] show
+/// a line on a terminal, nothing otherwise.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct TerminalProgress;
+
+impl crate::progress::ProgressSink for TerminalProgress {
+    fn start(
+        &self,
+        label: &str,
+        total: Option<u64>,
+        unit: &str,
+    ) -> Box<dyn crate::progress::ProgressTask + '_> {
+        Box::new(Progress::delayed(label, total, LOAD_PROGRESS_AFTER).unit(unit))
+    }
+}
+
+impl crate::progress::ProgressTask for Progress {
+    fn inc(&self, n: u64) {
+        Progress::inc(self, n);
+    }
+}
+
 impl Drop for Progress {
     fn drop(&mut self) {
         if !self.finished {

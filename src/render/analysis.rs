@@ -454,7 +454,7 @@ mod tests {
         assert_eq!(short(-0.04120), "-0.04120");
         assert_eq!(short(1e-7), "1.000e-7");
     }
-    use crate::scene::parse_scene;
+    use crate::formats::parse_scene;
 
     fn model(text: &str) -> Model {
         parse_scene(text).unwrap().objects.remove(0).model

@@ -725,49 +725,20 @@ impl MemoryBudget {
     }
 }
 
-thread_local! {
-    /// The budget counts read from files, edits and flags are held to on this thread before
-    /// anything is built from them ([`check_build`]); `None` until set or first asked.
-    static BUILD_BUDGET: std::cell::Cell<Option<MemoryBudget>> = const { std::cell::Cell::new(None) };
-}
-
-/// The budget [`check_build`] holds counts to on this thread: the one set by
-/// [`set_build_budget`] (each command sets its `--memory-limit`), else the machine's default.
-///
-/// It is kept per thread rather than passed down because the counts that must pass it sit deep
-/// in parsers and edit constructors (an ERBS `from` in a nested local, a `to_erbs` edit) that
-/// take no budget; one checkpoint per construction, reached from every entry, is what makes
-/// "nothing is built before the budget" hold for all of them.
-#[must_use]
-pub fn build_budget() -> MemoryBudget {
-    BUILD_BUDGET.with(|b| match b.get() {
-        Some(budget) => budget,
-        None => {
-            let budget = MemoryBudget::machine_default();
-            b.set(Some(budget));
-            budget
+impl MemoryBudget {
+    /// Refuses, as one line, building `what` (e.g. "1000000000000 local curves of degree 3")
+    /// when its `bytes` exceed the budget. Called with counts from a file, an edit, a script
+    /// or the command line before anything is allocated for them.
+    pub fn check_build(&self, what: impl std::fmt::Display, bytes: u128) -> Result<(), String> {
+        if bytes > u128::from(self.bytes) {
+            return Err(format!(
+                "{what} need about {} to build, over the memory budget of {}",
+                format_bytes(u64::try_from(bytes).unwrap_or(u64::MAX)),
+                self.describe()
+            ));
         }
-    })
-}
-
-/// Sets the budget [`check_build`] uses on this thread; returns the previous one.
-pub fn set_build_budget(budget: MemoryBudget) -> Option<MemoryBudget> {
-    BUILD_BUDGET.with(|b| b.replace(Some(budget)))
-}
-
-/// Refuses, as one line, building `what` (e.g. "1000000000000 local curves of degree 3") when
-/// its `bytes` exceed the build budget. Called with counts from a file, an edit, a script or the
-/// command line before anything is allocated for them.
-pub fn check_build(what: impl std::fmt::Display, bytes: u128) -> Result<(), String> {
-    let budget = build_budget();
-    if bytes > u128::from(budget.bytes) {
-        return Err(format!(
-            "{what} need about {} to build, over the memory budget of {}",
-            format_bytes(u64::try_from(bytes).unwrap_or(u64::MAX)),
-            budget.describe()
-        ));
+        Ok(())
     }
-    Ok(())
 }
 
 /// The soft "Max address space" limit in bytes from /proc/self/limits text; `None` when
@@ -1109,12 +1080,9 @@ mod tests {
 
     #[test]
     fn builds_over_the_build_budget_are_refused_in_one_line() {
-        let before = set_build_budget(MemoryBudget::from_flag(Some(1 << 20)));
-        let refused = check_build("3 things", 2 << 20);
-        let fits = check_build("3 things", 1 << 20);
-        if let Some(b) = before {
-            set_build_budget(b);
-        }
+        let budget = MemoryBudget::from_flag(Some(1 << 20));
+        let refused = budget.check_build("3 things", 2 << 20);
+        let fits = budget.check_build("3 things", 1 << 20);
         let e = refused.unwrap_err();
         assert!(e.starts_with("3 things need about 2.0 MiB"), "{e}");
         assert!(!e.contains('\n'));

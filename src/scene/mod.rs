@@ -1,17 +1,14 @@
-//! Scenes: named objects with sample counts and display style, the JSON scene file format
-//! (the contract in docs/scene-format.md), edits, and the built-in demo.
+//! Scenes: named objects with sample counts, display style and what their file kept, and
+//! the edits files (docs/scene-format.md). The file formats that read and write scenes live
+//! one floor up, in `formats`.
 
-pub mod demo;
 pub mod edit;
-pub mod obj;
-mod parse;
-mod write;
+mod kept;
 
-pub use crate::format::json::{self, At, SceneError};
+pub use crate::fields::json::{self, At, SceneError};
 pub use crate::model::{Index2, MAX_CURVE_SAMPLES, MAX_DEGREE, MAX_SURFACE_SAMPLES, Model};
 pub use edit::{EditList, parse_edits};
-pub use parse::{SampleDefaults, parse_scene, parse_scene_with};
-pub use write::scene_to_json;
+pub use kept::{Carried, Kept, SceneNames};
 
 use std::borrow::Cow;
 use std::path::Path;
@@ -43,38 +40,19 @@ pub struct Scene {
 }
 
 /// One named object: its model (geometry with sample counts), display colour, and what its
-/// OBJ source held that prespline does not use.
+/// file held that prespline does not use.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SceneObject {
     pub name: String,
     pub model: Model,
     /// Optional display colour (linear RGB in [0, 1]); the viewer picks one per object otherwise.
     pub color: Option<[f64; 3]>,
-    /// Trims, `curv2`, `vp`, `con`, techniques from an OBJ file, kept for every save (the JSON
-    /// field `obj`); empty for everything else.
-    pub obj: obj::carried::Carried,
+    /// What the object's file held that prespline does not use (OBJ's `curv2`, `vp`, `con`,
+    /// techniques), kept for every save; empty for objects from anywhere else.
+    pub kept: Carried,
 }
 
 impl Scene {
-    /// Reads and validates a scene file.
-    pub fn load(path: &Path) -> Result<Scene, SceneError> {
-        Self::load_with(path, SampleDefaults::default())
-    }
-
-    /// [`Scene::load`] with sample counts for objects that give none.
-    pub fn load_with(path: &Path, defaults: SampleDefaults) -> Result<Scene, SceneError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| SceneError(format!("cannot read {}: {e}", path.display())))?;
-        parse_scene_with(&text, defaults)
-    }
-
-    /// Writes the scene file atomically and durably (see [`write_durably`]), so neither a
-    /// failed save nor a crash or power loss right after it destroys the previous file.
-    pub fn save(&self, path: &Path) -> Result<(), SceneError> {
-        write_durably(path, scene_to_json(self).as_bytes())
-            .map_err(|e| SceneError(format!("cannot write {}: {e}", path.display())))
-    }
-
     /// Refuses, as one line naming the object, a scene whose objects do not fit `budget`
     /// together; returns the estimated total otherwise.
     pub fn check_budget(

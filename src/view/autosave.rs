@@ -652,7 +652,7 @@ impl Autosave {
         if self.foreign(&target) {
             self.move_aside(&place)?;
         }
-        scene.save(&target).map_err(|e| e.to_string())?;
+        crate::formats::save_json(scene, &target)?;
         let id = file_id(&target).ok_or_else(|| format!("{} vanished", target.display()))?;
         // The file this session wrote before, elsewhere, holds an older revision now.
         if let Some((old, old_id)) = self.own.replace((target.clone(), id))
@@ -776,7 +776,7 @@ mod tests {
         // Negative control: the raw fields do hold control characters.
         assert!(kept.command.chars().any(char::is_control));
     }
-    use crate::scene::parse_scene;
+    use crate::formats::parse_scene;
 
     fn scene(x: f64) -> Scene {
         parse_scene(&format!(
@@ -940,7 +940,7 @@ mod tests {
         let t0 = Instant::now();
         a.edited(t0);
         assert!(a.write(&scene(1.0), t0 + AUTOSAVE_DELAY));
-        assert_eq!(Scene::load(&target).unwrap(), scene(1.0));
+        assert_eq!(crate::formats::read_json(&target).unwrap(), scene(1.0));
         let notes = a.take_notes();
         assert_eq!(notes.len(), 1, "{notes:?}");
         assert!(
@@ -988,17 +988,19 @@ mod tests {
         // Newest first: this session's, then the earlier ones in order; session 0's dropped.
         let xs: Vec<f64> = waiting
             .iter()
-            .map(|p| match &Scene::load(p).unwrap().objects[0].model {
-                crate::model::Model::Curve(c) => c.curve().points()[1].x,
-                _ => unreachable!(),
-            })
+            .map(
+                |p| match &crate::formats::read_json(p).unwrap().objects[0].model {
+                    crate::model::Model::Curve(c) => c.curve().points()[1].x,
+                    _ => unreachable!(),
+                },
+            )
             .collect();
         let expected: Vec<f64> = (1..=KEEP + 1).rev().map(|k| k as f64).collect();
         assert_eq!(xs, expected);
 
         // One kept by viewers before timestamped names waits too, and is never dropped.
         let legacy = dir.join("scene.autosave.previous.json");
-        scene(0.5).save(&legacy).unwrap();
+        crate::formats::save_json(&scene(0.5), &legacy).unwrap();
         let mut a = Autosave::new(places.clone());
         a.edited(Instant::now());
         a.finish(&scene(9.0)).unwrap().unwrap();

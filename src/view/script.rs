@@ -362,7 +362,7 @@ fn local_path(v: &Value, surface: bool) -> Option<LocalPath<Index2>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::demo::demo_scene;
+    use crate::formats::demo::demo_scene;
 
     fn parse(text: &str) -> Result<Vec<ScriptEvent>, String> {
         parse_script(text, &Document::new(&demo_scene()))

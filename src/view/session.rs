@@ -605,7 +605,7 @@ impl Session {
     /// Writes the scene (exact control data) to the save path, as OBJ when it ends in `.obj`.
     pub fn save(&mut self) {
         let scene = self.to_scene();
-        match crate::scene::obj::save_scene_file(&scene, &self.save_path) {
+        match crate::formats::save(&scene, &self.save_path) {
             Ok(dropped) => {
                 if let Some(a) = self.autosave.as_mut() {
                     a.saved();

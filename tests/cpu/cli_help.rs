@@ -41,7 +41,7 @@ fn help_view_names_the_viewer_docs_and_the_erbs_torus() {
     ] {
         assert!(text.contains(part), "help view lacks {part:?}: {text}");
     }
-    let demo = prespline::scene::demo::demo_scene();
+    let demo = prespline::formats::demo::demo_scene();
     assert!(demo.objects.iter().any(|o| o.name == "erbs_torus"));
 }
 

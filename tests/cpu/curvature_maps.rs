@@ -337,7 +337,7 @@ fn surface_families_are_numbered_names_that_touch() {
         serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
     let families = |objects: Vec<serde_json::Value>| {
         let text = serde_json::json!({ "objects": objects }).to_string();
-        let scene = prespline::scene::parse_scene(&text).unwrap();
+        let scene = prespline::formats::parse_scene(&text).unwrap();
         surface_families(&common::editor(&scene, None).into_document())
     };
     let one = families(moved(&teapot, 0.0, str::to_string));

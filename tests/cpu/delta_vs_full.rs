@@ -10,6 +10,7 @@ use oracle::random::{
     Kind, Options, StructuralMix, random_edits, random_edits_with_structure, random_scene,
 };
 use oracle::rng::Rng;
+use prespline::formats::parse_scene;
 use prespline::geom::point::{Point, nan_max};
 use prespline::model::SampledObject;
 use prespline::model::{
@@ -17,7 +18,7 @@ use prespline::model::{
     merge_edits,
 };
 use prespline::sampling::{SampleGrid, SampleMode};
-use prespline::scene::{Scene, parse_edits, parse_scene};
+use prespline::scene::{Scene, parse_edits};
 
 /// A random one-object scene of `kind` and `count` random edits for it, through the product's
 /// own parsers (so the edits are validated exactly as `prespline sample --edits` does).

@@ -13,10 +13,11 @@ use oracle::erbs_tree::{Curve, Surface};
 use oracle::eval::Point3;
 use oracle::rng::Rng;
 use oracle::scene::Object;
+use prespline::formats::parse_scene;
 use prespline::geom::erbs::{ErbsCurve, ErbsSurface, LocalCurve, LocalPatch, MAX_NESTING};
 use prespline::model::SampledObject;
 use prespline::sampling::SampleMode;
-use prespline::scene::{Model, Scene, parse_edits, parse_scene};
+use prespline::scene::{Model, Scene, parse_edits};
 use serde_json::{Value, json};
 use std::process::Command;
 

@@ -11,8 +11,8 @@
 //! points (clamped knots, nothing to clamp).
 
 use crate::oracle::eval::bspline_derivatives;
+use prespline::formats::obj::parse_obj;
 use prespline::model::Model;
-use prespline::scene::obj::parse_obj;
 use std::path::{Path, PathBuf};
 
 fn file() -> PathBuf {
@@ -177,5 +177,5 @@ fn blender_curves_convert() {
     let back = parse_obj(&std::fs::read_to_string(&obj).unwrap()).unwrap();
     assert!(back.warnings.is_empty(), "{:?}", back.warnings);
     assert_eq!(back.scene, original);
-    assert_eq!(prespline::scene::Scene::load(&json).unwrap(), original);
+    assert_eq!(prespline::formats::read_json(&json).unwrap(), original);
 }

@@ -6,11 +6,11 @@
 use crate::common;
 
 use common::Rng;
-use prespline::cli::files::SampleOverride;
+use prespline::cli::samples::SampleOverride;
+use prespline::formats::obj::{parse_obj, parse_obj_bytes, scene_to_obj};
 use prespline::model::Model;
 use prespline::model::SampledObject;
 use prespline::sampling::SampleMode;
-use prespline::scene::obj::{parse_obj, parse_obj_bytes, scene_to_obj};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 

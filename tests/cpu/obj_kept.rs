@@ -6,12 +6,14 @@
 //! with their own vertices, the surfaces a `con` joins), so renumbering is checked, not trusted.
 
 use prespline::editor::{Editor, EditorOptions};
+use prespline::formats::json::scene_to_json;
+use prespline::formats::obj::{parse_obj, scene_to_obj, write_obj};
+use prespline::formats::parse_scene;
 use prespline::model::Model;
 use prespline::sampling::SampleMode;
 use prespline::sampling::budget::{MemoryBudget, Uses};
+use prespline::scene::Scene;
 use prespline::scene::edit::{apply_all, parse_edits};
-use prespline::scene::obj::{parse_obj, save_scene_file, scene_to_obj, write_obj};
-use prespline::scene::{Scene, parse_scene, scene_to_json};
 use std::path::{Path, PathBuf};
 
 fn data(name: &str) -> PathBuf {
@@ -359,7 +361,7 @@ fn convert_obj_to_obj_and_through_json_keeps_every_statement() {
 fn the_json_scene_keeps_the_data_exactly() {
     for name in FILES {
         let scene = parse_obj(&read(name)).unwrap().scene;
-        assert!(scene.objects.iter().any(|o| !o.obj.is_empty()), "{name}");
+        assert!(scene.objects.iter().any(|o| !o.kept.is_empty()), "{name}");
         let json = scene_to_json(&scene);
         assert!(json.contains("\"obj\": {"), "{name}");
         let back = parse_scene(&json).unwrap_or_else(|e| panic!("{name}: {e}\n{json}"));
@@ -418,7 +420,7 @@ fn edits_keep_the_data() {
     let dir = temp_dir("ctrl-s");
     let path = dir.join("saved.obj");
     assert_eq!(
-        save_scene_file(&saved, &path).unwrap(),
+        prespline::formats::save(&saved, &path).unwrap(),
         Vec::<String>::new()
     );
     assert_eq!(resolve(&std::fs::read_to_string(&path).unwrap()), original);
@@ -445,12 +447,15 @@ fn a_con_whose_surface_vanished_is_named_when_dropped() {
 
     let dir = temp_dir("vanished");
     let path = dir.join("left.obj");
-    assert_eq!(save_scene_file(&scene, &path).unwrap(), out.dropped);
+    assert_eq!(
+        prespline::formats::save(&scene, &path).unwrap(),
+        out.dropped
+    );
     assert_eq!(std::fs::read_to_string(&path).unwrap(), out.text);
     // JSON keeps everything, so its save drops nothing (and the JSON reader refuses the
     // dangling name, see below).
     assert!(
-        save_scene_file(&scene, &dir.join("left.json"))
+        prespline::formats::save(&scene, &dir.join("left.json"))
             .unwrap()
             .is_empty()
     );
@@ -604,5 +609,13 @@ fn connections_on_a_curve_are_refused() {
     );
     assert_ne!(ok, text);
     let scene: Scene = parse_scene(&ok).unwrap();
-    assert_eq!(scene.objects[0].obj.curves2.len(), 1);
+    assert_eq!(
+        scene.objects[0]
+            .kept
+            .get::<prespline::formats::obj::kept::ObjKept>()
+            .unwrap()
+            .curves2
+            .len(),
+        1
+    );
 }

@@ -7,13 +7,15 @@ use crate::common;
 
 use common::Rng;
 use glam::DVec3;
+use prespline::formats::json::scene_to_json;
+use prespline::formats::obj::model::{Basis, FreeForm};
+use prespline::formats::obj::{parse_obj, read_elements, scene_to_obj};
+use prespline::formats::parse_scene;
 use prespline::geom::{BFunctionKind, BSplineCurve, ErbsCurve, ErbsSurface, TensorSurface};
 use prespline::model::{
     CurveModel, ErbsCurveModel, ErbsSurfaceModel, Model, SplineForm, SurfaceModel,
 };
-use prespline::scene::obj::model::{Basis, FreeForm};
-use prespline::scene::obj::{parse_obj, read_elements, scene_to_obj};
-use prespline::scene::{Scene, SceneObject, parse_scene, scene_to_json};
+use prespline::scene::{Scene, SceneObject};
 use std::path::Path;
 
 fn example(name: &str) -> String {
@@ -136,7 +138,7 @@ fn random_object(rng: &mut Rng, i: usize) -> SceneObject {
         name: format!("{}{i}", names[rng.range(0, names.len())]),
         model,
         color: (rng.range(0, 2) == 1).then_some([0.25, 1.0, 0.0]),
-        obj: Default::default(),
+        kept: Default::default(),
     }
 }
 
@@ -509,8 +511,8 @@ fn convert_goes_both_ways_exactly_and_applies_samples() {
             .unwrap()
             .contains("cstype rat bspline")
     );
-    let original = Scene::load(&src).unwrap();
-    assert_eq!(Scene::load(&json).unwrap(), original);
+    let original = prespline::formats::read_json(&src).unwrap();
+    assert_eq!(prespline::formats::read_json(&json).unwrap(), original);
 
     let out = convert(&[
         obj.as_os_str(),
@@ -521,7 +523,7 @@ fn convert_goes_both_ways_exactly_and_applies_samples() {
         "5x6".as_ref(),
     ]);
     assert!(out.status.success());
-    let resampled = Scene::load(&json).unwrap();
+    let resampled = prespline::formats::read_json(&json).unwrap();
     let (Model::Curve(a), Model::Curve(b)) =
         (&resampled.objects[0].model, &original.objects[0].model)
     else {

@@ -592,7 +592,7 @@ fn drawing_samples_and_the_shading_fast_path_agree_with_oracle() {
             .into_iter()
             .filter(|e| !matches!(e, Edit::Weight { .. }))
             .collect();
-        let product = prespline::scene::parse_scene(&scene.to_json().to_string())
+        let product = prespline::formats::parse_scene(&scene.to_json().to_string())
             .expect("generator makes valid scenes");
         let edits_json = Value::Array(edits.iter().map(Edit::to_json).collect()).to_string();
         let product_edits = parse_edits(&edits_json, &product).expect("valid edits");

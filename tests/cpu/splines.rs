@@ -3,13 +3,14 @@
 //! segment's points, derivatives from forward differences), never `prespline::geom`.
 
 use glam::DVec3;
+use prespline::formats::parse_scene;
 use prespline::model::SampledObject;
 use prespline::model::exact::exact_grid;
 use prespline::model::{
     BezierSplineEdit, CatmullRomEdit, KindEdit, Model, ModelRef, ObjectEdit, PointEdit,
 };
 use prespline::sampling::{PartialSet, SampleMode};
-use prespline::scene::{Scene, parse_scene};
+use prespline::scene::Scene;
 
 use crate::common;
 use common::Rng;
@@ -519,8 +520,8 @@ fn conversion_to_bspline_keeps_the_shape_and_undoes_exactly() {
 fn files_round_trip_bit_for_bit() {
     for f in ["examples/catmull_rom.json", "examples/bezier_spline.json"] {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(f);
-        let scene = Scene::load(&path).unwrap();
-        let text = prespline::scene::scene_to_json(&scene);
+        let scene = prespline::formats::read_json(&path).unwrap();
+        let text = prespline::formats::json::scene_to_json(&scene);
         assert_eq!(parse_scene(&text).unwrap(), scene, "{f}");
     }
 }

@@ -8,10 +8,11 @@
 use crate::common::Rng;
 use glam::{DMat4, DVec3};
 use prespline::editor::{Document, Handle};
+use prespline::formats::demo::demo_scene;
+use prespline::formats::parse_scene;
 use prespline::model::{Index2, ObjectEdit, SampledObject, Target};
 use prespline::sampling::{DirtyRegion, SampleGrid};
-use prespline::scene::demo::demo_scene;
-use prespline::scene::{Scene, parse_scene};
+use prespline::scene::Scene;
 
 /// Closed and open ERBS curves and surfaces, small enough to nest.
 const ERBS: &str = r#"{"objects": [

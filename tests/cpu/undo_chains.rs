@@ -9,12 +9,12 @@
 use crate::common;
 use glam::{DMat4, DQuat, DVec3};
 use prespline::editor::Editor;
+use prespline::formats::parse_scene;
 use prespline::geom::erbs::{LocalCurve, LocalPatch};
 use prespline::model::{
     BezierSplineEdit, CatmullRomEdit, CurveEdit, Edit, ErbsCurveEdit, ErbsSurfaceEdit, KindEdit,
     LocalEdit, LocalPath, ModelRef, ObjectEdit, PointEdit, SurfaceEdit,
 };
-use prespline::scene::parse_scene;
 use std::collections::BTreeSet;
 
 /// A `nu × nv` net (JSON) of a gently curved sheet, and positive weights for it.

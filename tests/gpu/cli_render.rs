@@ -303,8 +303,10 @@ fn the_budget_estimate_agrees_with_the_resident_size_on_teapots() {
     use glam::DVec3;
     use prespline::model::Model;
     use prespline::scene::Scene;
-    let teapot =
-        Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/teapot.json")).unwrap();
+    let teapot = prespline::formats::read_json(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/teapot.json"),
+    )
+    .unwrap();
     let n = 16;
     let mut objects = Vec::new();
     for k in 0..n * n {
@@ -320,7 +322,7 @@ fn the_budget_estimate_agrees_with_the_resident_size_on_teapots() {
     }
     let scratch = common::Scratch::new("cli-render-memory");
     let scene = scratch.path().join("teapots256.json");
-    Scene { objects }.save(&scene).unwrap();
+    prespline::formats::save_json(&Scene { objects }, &scene).unwrap();
     let one = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/teapot.json");
     for scene in [one, scene] {
         let r = prespline()
@@ -382,7 +384,7 @@ fn render_map(
         .unwrap();
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     let px = prespline::gpu::Pixels::read_png(out).unwrap();
-    let loaded = prespline::scene::Scene::load(scene).unwrap();
+    let loaded = prespline::formats::read_json(scene).unwrap();
     let doc = common::editor(&loaded, Some(SurfaceMap::Gaussian)).into_document();
     let shot = prespline::render::offscreen::Shot {
         width: 960,

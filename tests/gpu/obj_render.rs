@@ -5,11 +5,11 @@
 use crate::common;
 
 use prespline::editor::Document;
+use prespline::formats::obj::{load_obj, parse_obj};
 use prespline::model::Model;
 use prespline::render::offscreen::{Shot, render_document};
 use prespline::render::{NetMode, ViewOptions};
 use prespline::scene::Scene;
-use prespline::scene::obj::{load_obj, parse_obj};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -49,7 +49,7 @@ fn imported_vase_matches_the_golden() {
 
 #[test]
 fn teapot_obj_renders_exactly_like_teapot_json() {
-    let json = Scene::load(&example("teapot.json")).unwrap();
+    let json = prespline::formats::read_json(&example("teapot.json")).unwrap();
     let obj = load_obj(&example("teapot.obj")).unwrap().scene;
     assert_eq!(obj, json, "the converted teapot holds the same scene");
     let (a, b) = (

@@ -23,7 +23,7 @@ use prespline::scene::Scene;
 use std::path::Path;
 
 fn load(path: &str) -> Scene {
-    Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(path)).unwrap()
+    prespline::formats::read_json(&Path::new(env!("CARGO_MANIFEST_DIR")).join(path)).unwrap()
 }
 
 /// `scene` rendered as `prespline render --analysis` does: curvature maps re-sample the
@@ -469,7 +469,7 @@ fn curves_with_a_gap_are_drawn_apart() {
     use prespline::render::analysis::curve_pieces;
     use prespline::render::camera::OrbitCamera;
     let scene = |knots: &str, samples: usize| {
-        prespline::scene::parse_scene(&format!(
+        prespline::formats::parse_scene(&format!(
             r#"{{"objects": [{{"name": "c", "type": "bspline_curve", "degree": 1, "knots": {knots},
             "points": [[-3, 0, 0], [-1, 0, 0], [1, 2, 0], [3, 2, 0]], "samples": {samples}, "color": [1, 1, 1]}}]}}"#
         ))
@@ -549,7 +549,7 @@ fn curves_with_a_gap_are_drawn_apart() {
 
 /// The bumpy B-spline surface (moved to the left) next to the 32 teapot patches, Gaussian map.
 pub(crate) fn bumps_beside_the_teapot() -> Scene {
-    prespline::scene::parse_scene(&bumps_beside_the_teapot_json()).unwrap()
+    prespline::formats::parse_scene(&bumps_beside_the_teapot_json()).unwrap()
 }
 
 /// [`bumps_beside_the_teapot`] as a scene file's text.
@@ -697,7 +697,7 @@ fn six_separate_surfaces() -> Scene {
         })
         .collect();
     let scene = serde_json::json!({ "objects": objects });
-    prespline::scene::parse_scene(&scene.to_string()).unwrap()
+    prespline::formats::parse_scene(&scene.to_string()).unwrap()
 }
 
 /// Separate surfaces whose names differ only in a trailing number (Blender's `Surface.001` …)

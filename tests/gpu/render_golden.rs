@@ -8,17 +8,18 @@
 use crate::common;
 
 use prespline::editor::Document;
+use prespline::formats::parse_scene;
 use prespline::gpu::Pixels;
 use prespline::render::offscreen::{Shot, render_document};
 use prespline::render::{NetMode, OrbitCamera, ViewOptions, Wire};
-use prespline::scene::{Scene, parse_scene};
+use prespline::scene::Scene;
 use std::path::Path;
 
 fn example(name: &str) -> Scene {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("examples")
         .join(name);
-    Scene::load(&path).unwrap()
+    prespline::formats::read_json(&path).unwrap()
 }
 
 fn render_scene(scene: &Scene, camera: Option<OrbitCamera>, options: ViewOptions) -> Pixels {

@@ -8,12 +8,12 @@ use crate::common;
 
 use glam::DVec3;
 use prespline::editor::Document;
+use prespline::formats::demo::demo_scene;
 use prespline::gpu::{OffscreenDesc, Pixels, Renderer};
 use prespline::model::{Edit, KindEdit, PointEdit, SurfaceEdit};
 use prespline::render::lod::{Lod, LodTolerance};
 use prespline::render::offscreen::{Shot, shot_camera};
 use prespline::render::{DrawReport, GpuScene, Highlight, ViewOptions};
-use prespline::scene::demo::demo_scene;
 
 /// The golden tolerance of the render tests: 2 levels per channel on at most 0.2 % of pixels.
 const TOLERANCE: u8 = 2;

@@ -6,12 +6,12 @@ use crate::common;
 
 use glam::{DMat4, DVec3};
 use prespline::editor::{Document, Handle};
+use prespline::formats::demo::demo_scene;
 use prespline::gpu::{OffscreenDesc, OffscreenTarget, Pixels, Renderer};
 use prespline::model::{CurveEdit, Edit, KindEdit, ModelRef, ObjectEdit, PointEdit, SurfaceEdit};
 use prespline::render::offscreen::{Shot, shot_camera};
 use prespline::render::{GpuScene, Highlight, Lod, NetMode, ViewOptions, Wire};
 use prespline::scene::Scene;
-use prespline::scene::demo::demo_scene;
 
 /// The demo scene without the teapot (keeps the test fast): B-spline surface, ERBS surface,
 /// ERBS curve, NURBS circle.
@@ -458,9 +458,10 @@ fn a_missed_update_is_detected() {
 fn mirror_fills_on_n_threads_equal_one_thread() {
     let (mut renderer, sink) = common::renderer();
     let mut scene = demo_scene();
-    let teapot =
-        Scene::load(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/teapot.json"))
-            .unwrap();
+    let teapot = prespline::formats::read_json(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/teapot.json"),
+    )
+    .unwrap();
     for k in 0..3 {
         for o in teapot.objects.iter().take(16) {
             let mut o = o.clone();

@@ -10,11 +10,12 @@
 
 use crate::common::{self, Rng, compare_images};
 use prespline::editor::Handle;
+use prespline::formats::parse_scene;
 use prespline::gpu::{OffscreenDesc, OffscreenTarget, Pixels, Renderer, ValidationSink};
 use prespline::render::Redraw;
 use prespline::render::maps::SurfaceMap;
 use prespline::sampling::budget::MemoryBudget;
-use prespline::scene::{Scene, parse_scene};
+use prespline::scene::Scene;
 use prespline::view::Session;
 use prespline::view::input::{InputEvent, Key, Modifiers, MouseButton};
 use prespline::view::script::Action;

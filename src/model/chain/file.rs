@@ -1,8 +1,8 @@
 //! Catmull–Rom and Bézier splines in scene and edit files (docs/scene-format.md).
 
 use super::{BezierSplineEdit, BezierSplineModel, CatmullRomEdit, CatmullRomModel};
-use crate::format::json::*;
-use crate::format::write::{field, numbers, points};
+use crate::fields::json::*;
+use crate::fields::write::{field, numbers, points};
 use crate::geom::{BezierSpline, CatmullRom, JoinContinuity, Parametrization};
 use crate::model::PointEdit;
 use crate::model::file::*;

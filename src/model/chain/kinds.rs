@@ -4,8 +4,9 @@
 use super::file;
 use super::sampler::ChainCurveSampler;
 use super::{BezierSplineEdit, BezierSplineModel, CatmullRomEdit, CatmullRomModel, ChainModel};
-use crate::format::{At, SceneError};
+use crate::fields::{At, ReadCtx, SceneError};
 use crate::model::controls::{ControlDisplay, Grip};
+use crate::model::edit::EditError;
 use crate::model::index::Index2;
 use crate::model::kind::Kind;
 use crate::model::points::PointEdit;
@@ -35,9 +36,9 @@ macro_rules! chain_kind {
                 _: &str,
                 at: &At,
                 obj: &Map<String, Value>,
-                common: &[&'static str],
+                ctx: &ReadCtx<'_>,
             ) -> Result<Self, SceneError> {
-                file::$read(at, obj, common)
+                file::$read(at, obj, ctx.common)
             }
 
             fn write(&self, out: &mut String) {
@@ -50,6 +51,10 @@ macro_rules! chain_kind {
 
             fn sample_dims(&self) -> [usize; 2] {
                 [self.samples(), 1]
+            }
+
+            fn with_samples(&self, samples: [usize; 2]) -> Result<Self, EditError> {
+                Self::new(self.spline().clone(), samples[0])
             }
 
             fn domain(&self) -> Vec<(f64, f64)> {

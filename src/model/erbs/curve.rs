@@ -6,7 +6,6 @@ use crate::geom::shape::{ShapeChange, erbs_knot_probes, erbs_probes, shape_chang
 use crate::geom::{BFunctionKind, GeomError};
 use crate::model::edit::EditError;
 use crate::model::{MAX_CURVE_SAMPLES, check_samples};
-use crate::sampling::budget::check_build;
 use glam::{DMat4, DVec3};
 use std::fmt::Debug;
 
@@ -126,16 +125,16 @@ impl ErbsNet for ErbsCurve {
         bf: BFunctionKind,
     ) -> Result<Self, GeomError> {
         match local {
-            LocalCurve::Spline { curve, .. } => {
-                check_build(
-                    format_args!("{n} local curves of degree {degree}"),
-                    ErbsCurve::from_curve_bytes(n, degree),
-                )
-                .map_err(|e| GeomError::new("to_erbs", e))?;
-                ErbsCurve::from_curve(curve, n, degree, bf, false)
-            }
+            LocalCurve::Spline { curve, .. } => ErbsCurve::from_curve(curve, n, degree, bf, false),
             LocalCurve::Erbs(_) => Err(GeomError::new("to_erbs", "already an ERBS local")),
         }
+    }
+
+    fn build_size(n: usize, degree: usize) -> (String, u128) {
+        (
+            format!("{n} local curves of degree {degree}"),
+            ErbsCurve::from_curve_bytes(n, degree),
+        )
     }
 
     fn bfunction(&self) -> BFunctionKind {

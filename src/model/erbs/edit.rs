@@ -4,7 +4,7 @@ use super::*;
 use crate::geom::erbs::{ErbsCurve, ErbsSurface, MAX_NESTING};
 use crate::geom::shape::ShapeChange;
 use crate::geom::{BFunctionKind, GeomError};
-use crate::model::edit::{EditError, IntoObject, KindEdit, Target, check_shape_kept};
+use crate::model::edit::{Build, EditError, IntoObject, KindEdit, Target, check_shape_kept};
 use crate::model::points::check_vector;
 use crate::model::{Index2, MAX_DEGREE};
 use glam::{DMat4, DVec3, DVec4};
@@ -53,6 +53,8 @@ pub trait ErbsNet: Clone + PartialEq + Debug + Sized {
         degree: Self::Degree,
         bf: BFunctionKind,
     ) -> Result<Self, GeomError>;
+    /// What [`ErbsNet::build`] with these counts allocates, in words and bytes.
+    fn build_size(count: Self::Count, degree: Self::Degree) -> (String, u128);
     fn bfunction(&self) -> BFunctionKind;
     fn check_degree(d: Self::Degree) -> Result<(), EditError>;
 
@@ -393,6 +395,20 @@ where
     fn merge(&self, next: &Self) -> Option<Self> {
         match (self, next) {
             (ErbsEdit::Local(a), ErbsEdit::Local(b)) => a.merge(b).map(ErbsEdit::Local),
+            _ => None,
+        }
+    }
+
+    fn builds(&self) -> Option<Build> {
+        match self {
+            ErbsEdit::ToErbs { count, degree, .. } => {
+                let (what, bytes) = N::build_size(*count, *degree);
+                Some(Build {
+                    field: "to_erbs",
+                    what,
+                    bytes,
+                })
+            }
             _ => None,
         }
     }

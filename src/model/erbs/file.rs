@@ -6,8 +6,9 @@
 use super::{
     ErbsCurveEdit, ErbsCurveModel, ErbsSurfaceEdit, ErbsSurfaceModel, LocalEdit, LocalPath,
 };
-use crate::format::json::*;
-use crate::format::write::{field, numbers, points};
+use crate::fields::ReadCtx;
+use crate::fields::json::*;
+use crate::fields::write::{field, numbers, points};
 use crate::geom::BFunctionKind;
 use crate::geom::erbs::{ErbsCurve, ErbsKnots, ErbsSurface, LocalCurve, LocalPatch};
 use crate::model::SplineForm;
@@ -16,7 +17,7 @@ use crate::model::file::{
     surface_samples, usize_pair, with,
 };
 use crate::model::spline::file::{point_grid_text, spline_curve, spline_surface};
-use crate::sampling::budget::check_build;
+use crate::sampling::budget::MemoryBudget;
 use glam::DMat4;
 use serde_json::{Map, Value};
 use std::fmt::Write;
@@ -46,6 +47,7 @@ pub fn erbs_curve(
     at: &At,
     obj: &Map<String, Value>,
     outer: &[&'static str],
+    budget: &MemoryBudget,
 ) -> Result<ErbsCurve, SceneError> {
     let bf = bfunction(at, obj)?;
     let closed = flag(at, obj, "closed")?;
@@ -68,11 +70,12 @@ pub fn erbs_curve(
         )?;
         check_degree(at, "local_degree", d)?;
         check_count(at, "local_curves", "", n)?;
-        check_build(
-            format_args!("{n} local curves of degree {d}"),
-            ErbsCurve::from_curve_bytes(n, d),
-        )
-        .map_err(|e| at.err("local_curves", e))?;
+        budget
+            .check_build(
+                format_args!("{n} local curves of degree {d}"),
+                ErbsCurve::from_curve_bytes(n, d),
+            )
+            .map_err(|e| at.err("local_curves", e))?;
         ErbsCurve::from_curve(&c, n, d, bf, closed).map_err(|e| geom(at, e))?
     } else {
         check_fields(at, obj, &with(outer, &CURVE_FIELDS))?;
@@ -81,7 +84,7 @@ pub fn erbs_curve(
         let locals = local
             .iter()
             .enumerate()
-            .map(|(l, v)| local_curve(at, &format!("local[{l}]"), v))
+            .map(|(l, v)| local_curve(at, &format!("local[{l}]"), v, budget))
             .collect::<Result<Vec<_>, _>>()?;
         let n = locals.len();
         let knots = if closed {
@@ -135,7 +138,12 @@ fn typed_local<'v>(
 
 /// One `local` entry of an ERBS curve: `{"points": …}` (a Bézier curve, the original form), or
 /// a typed body: `bezier_curve`, `bspline_curve` (polynomial), or `erbs_curve`.
-fn local_curve(at: &At, which: &str, v: &Value) -> Result<LocalCurve, SceneError> {
+fn local_curve(
+    at: &At,
+    which: &str,
+    v: &Value,
+    budget: &MemoryBudget,
+) -> Result<LocalCurve, SceneError> {
     let (la, obj, ty) = typed_local(at, which, v, "bezier_curve")?;
     match ty {
         "bezier_curve" | "bspline_curve" => {
@@ -155,6 +163,7 @@ fn local_curve(at: &At, which: &str, v: &Value) -> Result<LocalCurve, SceneError
             &la,
             obj,
             &NESTED_FIELDS,
+            budget,
         )?))),
         other => Err(la.err(
             "type",
@@ -168,6 +177,7 @@ pub fn erbs_surface(
     at: &At,
     obj: &Map<String, Value>,
     outer: &[&'static str],
+    budget: &MemoryBudget,
 ) -> Result<ErbsSurface, SceneError> {
     let bf = bfunction(at, obj)?;
     let closed = match opt(obj, "closed") {
@@ -202,14 +212,15 @@ pub fn erbs_surface(
         check_degree(at, "local_degree", degree[0].max(degree[1]))?;
         check_count(at, "local_patches", "u direction: ", count[0])?;
         check_count(at, "local_patches", "v direction: ", count[1])?;
-        check_build(
-            format_args!(
-                "{}×{} local patches of degree [{}, {}]",
-                count[0], count[1], degree[0], degree[1]
-            ),
-            ErbsSurface::from_surface_bytes(count, degree),
-        )
-        .map_err(|e| at.err("local_patches", e))?;
+        budget
+            .check_build(
+                format_args!(
+                    "{}×{} local patches of degree [{}, {}]",
+                    count[0], count[1], degree[0], degree[1]
+                ),
+                ErbsSurface::from_surface_bytes(count, degree),
+            )
+            .map_err(|e| at.err("local_patches", e))?;
         return ErbsSurface::from_surface(&s, count, degree, bf, closed).map_err(|e| geom(at, e));
     }
     check_fields(at, obj, &with(outer, &CURVE_FIELDS))?;
@@ -224,7 +235,7 @@ pub fn erbs_surface(
         ));
     }
     let (count, patches) = as_grid(at, "local", require(at, obj, "local")?, |idx, v| {
-        local_patch(at, &format!("local{idx}"), v)
+        local_patch(at, &format!("local{idx}"), v, budget)
     })?;
     let mut knots = Vec::with_capacity(2);
     for (dir, name) in ["u", "v"].into_iter().enumerate() {
@@ -263,7 +274,12 @@ pub fn erbs_surface(
 
 /// One `local` entry of an ERBS surface: `{"points": [a][b][3]}` (a Bézier patch), or a typed
 /// body: `bezier_surface`, `bspline_surface` (polynomial), or `erbs_surface`.
-fn local_patch(at: &At, which: &str, v: &Value) -> Result<LocalPatch, SceneError> {
+fn local_patch(
+    at: &At,
+    which: &str,
+    v: &Value,
+    budget: &MemoryBudget,
+) -> Result<LocalPatch, SceneError> {
     let (la, obj, ty) = typed_local(at, which, v, "bezier_surface")?;
     match ty {
         "bezier_surface" | "bspline_surface" => {
@@ -283,6 +299,7 @@ fn local_patch(at: &At, which: &str, v: &Value) -> Result<LocalPatch, SceneError
             &la,
             obj,
             &NESTED_FIELDS,
+            budget,
         )?))),
         other => Err(la.err(
             "type",
@@ -672,9 +689,9 @@ fn affine(at: &At, v: &Value) -> Result<DMat4, SceneError> {
 pub fn read_curve(
     at: &At,
     obj: &Map<String, Value>,
-    common: &[&'static str],
+    ctx: &ReadCtx<'_>,
 ) -> Result<ErbsCurveModel, SceneError> {
-    let c = erbs_curve(at, obj, common)?;
+    let c = erbs_curve(at, obj, ctx.common, &ctx.budget)?;
     ErbsCurveModel::new(c, curve_samples(at, obj)?).map_err(|e| edit(at, e))
 }
 
@@ -682,8 +699,8 @@ pub fn read_curve(
 pub fn read_surface(
     at: &At,
     obj: &Map<String, Value>,
-    common: &[&'static str],
+    ctx: &ReadCtx<'_>,
 ) -> Result<ErbsSurfaceModel, SceneError> {
-    let s = erbs_surface(at, obj, common)?;
+    let s = erbs_surface(at, obj, ctx.common, &ctx.budget)?;
     ErbsSurfaceModel::new(s, surface_samples(at, obj)?).map_err(|e| edit(at, e))
 }

@@ -8,9 +8,10 @@ use super::surface_sampler::ErbsSurfaceSampler;
 use super::{
     ErbsCurveEdit, ErbsCurveModel, ErbsSurfaceEdit, ErbsSurfaceModel, LocalEdit, LocalPath,
 };
-use crate::format::{At, SceneError};
+use crate::fields::{At, ReadCtx, SceneError};
 use crate::geom::{ErbsCurve, ErbsSurface};
 use crate::model::controls::{ControlDisplay, Grip};
+use crate::model::edit::EditError;
 use crate::model::index::Index2;
 use crate::model::kind::Kind;
 use crate::sampling::SampleMode;
@@ -30,9 +31,9 @@ impl Kind for ErbsCurveModel {
         _: &str,
         at: &At,
         obj: &Map<String, Value>,
-        common: &[&'static str],
+        ctx: &ReadCtx<'_>,
     ) -> Result<Self, SceneError> {
-        file::read_curve(at, obj, common)
+        file::read_curve(at, obj, ctx)
     }
 
     fn write(&self, out: &mut String) {
@@ -45,6 +46,10 @@ impl Kind for ErbsCurveModel {
 
     fn sample_dims(&self) -> [usize; 2] {
         [self.samples(), 1]
+    }
+
+    fn with_samples(&self, samples: [usize; 2]) -> Result<Self, EditError> {
+        Self::new(self.curve().clone(), samples[0])
     }
 
     fn domain(&self) -> Vec<(f64, f64)> {
@@ -110,9 +115,9 @@ impl Kind for ErbsSurfaceModel {
         _: &str,
         at: &At,
         obj: &Map<String, Value>,
-        common: &[&'static str],
+        ctx: &ReadCtx<'_>,
     ) -> Result<Self, SceneError> {
-        file::read_surface(at, obj, common)
+        file::read_surface(at, obj, ctx)
     }
 
     fn write(&self, out: &mut String) {
@@ -125,6 +130,10 @@ impl Kind for ErbsSurfaceModel {
 
     fn sample_dims(&self) -> [usize; 2] {
         self.samples()
+    }
+
+    fn with_samples(&self, samples: [usize; 2]) -> Result<Self, EditError> {
+        Self::new(self.surface().clone(), samples)
     }
 
     fn domain(&self) -> Vec<(f64, f64)> {

@@ -6,7 +6,6 @@ use crate::geom::shape::{ShapeChange, erbs_knot_probes, erbs_probes, shape_chang
 use crate::geom::{BFunctionKind, GeomError};
 use crate::model::check_surface_samples;
 use crate::model::edit::EditError;
-use crate::sampling::budget::check_build;
 use glam::{DMat4, DVec3};
 use std::fmt::Debug;
 
@@ -133,18 +132,20 @@ impl ErbsNet for ErbsSurface {
     ) -> Result<Self, GeomError> {
         match local {
             LocalPatch::Spline { surface, .. } => {
-                check_build(
-                    format_args!(
-                        "{}×{} local patches of degree [{}, {}]",
-                        count[0], count[1], degree[0], degree[1]
-                    ),
-                    ErbsSurface::from_surface_bytes(count, degree),
-                )
-                .map_err(|e| GeomError::new("to_erbs", e))?;
                 ErbsSurface::from_surface(surface, count, degree, bf, [false, false])
             }
             LocalPatch::Erbs(_) => Err(GeomError::new("to_erbs", "already an ERBS local")),
         }
+    }
+
+    fn build_size(count: [usize; 2], degree: [usize; 2]) -> (String, u128) {
+        (
+            format!(
+                "{}×{} local patches of degree [{}, {}]",
+                count[0], count[1], degree[0], degree[1]
+            ),
+            ErbsSurface::from_surface_bytes(count, degree),
+        )
     }
 
     fn bfunction(&self) -> BFunctionKind {

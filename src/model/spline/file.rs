@@ -2,8 +2,8 @@
 
 use super::curve::{CurveEdit, CurveModel};
 use super::surface::{SurfaceEdit, SurfaceModel};
-use crate::format::json::*;
-use crate::format::write::{field, numbers, points};
+use crate::fields::json::*;
+use crate::fields::write::{field, numbers, points};
 use crate::geom::{BSplineCurve, KnotVector, TensorSurface};
 use crate::model::SplineForm;
 use crate::model::file::*;

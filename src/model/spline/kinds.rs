@@ -7,8 +7,9 @@ use super::file;
 use super::form::SplineForm;
 use super::surface::{SurfaceEdit, SurfaceModel};
 use super::surface_sampler::SplineSurfaceSampler;
-use crate::format::{At, SceneError};
+use crate::fields::{At, ReadCtx, SceneError};
 use crate::model::controls::{ControlDisplay, Grip};
+use crate::model::edit::EditError;
 use crate::model::index::Index2;
 use crate::model::kind::Kind;
 use crate::model::points::PointEdit;
@@ -29,9 +30,9 @@ impl Kind for CurveModel {
         ty: &str,
         at: &At,
         obj: &Map<String, Value>,
-        common: &[&'static str],
+        ctx: &ReadCtx<'_>,
     ) -> Result<Self, SceneError> {
-        file::read_curve(ty, at, obj, common)
+        file::read_curve(ty, at, obj, ctx.common)
     }
 
     fn write(&self, out: &mut String) {
@@ -51,6 +52,10 @@ impl Kind for CurveModel {
 
     fn sample_dims(&self) -> [usize; 2] {
         [self.samples(), 1]
+    }
+
+    fn with_samples(&self, samples: [usize; 2]) -> Result<Self, EditError> {
+        Self::new(self.form(), self.curve().clone(), samples[0])
     }
 
     fn domain(&self) -> Vec<(f64, f64)> {
@@ -125,9 +130,9 @@ impl Kind for SurfaceModel {
         ty: &str,
         at: &At,
         obj: &Map<String, Value>,
-        common: &[&'static str],
+        ctx: &ReadCtx<'_>,
     ) -> Result<Self, SceneError> {
-        file::read_surface(ty, at, obj, common)
+        file::read_surface(ty, at, obj, ctx.common)
     }
 
     fn write(&self, out: &mut String) {
@@ -147,6 +152,10 @@ impl Kind for SurfaceModel {
 
     fn sample_dims(&self) -> [usize; 2] {
         self.samples()
+    }
+
+    fn with_samples(&self, samples: [usize; 2]) -> Result<Self, EditError> {
+        Self::new(self.form(), self.surface().clone(), samples)
     }
 
     fn domain(&self) -> Vec<(f64, f64)> {

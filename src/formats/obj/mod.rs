@@ -3,13 +3,13 @@
 //! Bézier geometry. Reading goes text → statements (`lex`) → free-form elements as written
 //! (`read`, [`model::FreeForm`]) → scene objects (`map`); writing goes the other way.
 //! What a file holds that prespline does not use (trims, `curv2`, `vp`, `con`, techniques) is
-//! kept with its scene object ([`carried::Carried`]) and written back. Everything a user can
+//! kept with its scene object ([`kept::ObjKept`]) and written back. Everything a user can
 //! rely on — which constructs map, how exactly, what is kept, what is refused — is in
 //! docs/obj.md.
 
-pub mod carried;
 mod check;
 mod erbs;
+pub mod kept;
 mod lex;
 mod map;
 pub mod model;
@@ -18,7 +18,8 @@ mod write;
 
 pub use map::{default_curve_samples, default_surface_samples};
 
-use super::{Scene, SceneError};
+use super::context::{FileFormat, FormatError, Import, LoadContext, Located, Written};
+use crate::scene::{Scene, SceneError};
 use model::FreeForm;
 use std::collections::{HashMap, HashSet};
 use std::path::Path;
@@ -143,40 +144,60 @@ pub fn load_obj(path: &Path) -> Result<ObjImport, SceneError> {
     parse_obj_bytes(&bytes).map_err(|e| SceneError(e.in_file(path)))
 }
 
-/// Scene file formats, told apart by extension.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Format {
-    Json,
-    Obj,
-}
+/// The Wavefront OBJ format.
+#[derive(Debug, Clone, Copy)]
+pub struct Obj;
 
-impl Format {
-    /// `.obj` and `.json` (any case); `None` for anything else.
-    #[must_use]
-    pub fn of(path: &Path) -> Option<Format> {
-        let ext = path.extension()?.to_str()?;
-        if ext.eq_ignore_ascii_case("obj") {
-            Some(Format::Obj)
-        } else if ext.eq_ignore_ascii_case("json") {
-            Some(Format::Json)
-        } else {
-            None
-        }
+impl FileFormat for Obj {
+    fn name(&self) -> &'static str {
+        "Wavefront OBJ"
     }
-}
 
-/// Writes the scene in the format the path names — OBJ for `.obj`, the JSON scene format
-/// otherwise — atomically (temporary file + rename), so a failed save never destroys the
-/// previous file. Nothing is written when an object has no OBJ form. Returns what the file
-/// could not hold (see [`ObjText::dropped`]; always empty for JSON), for one warning line.
-pub fn save_scene_file(scene: &Scene, path: &Path) -> Result<Vec<String>, SceneError> {
-    if Format::of(path) != Some(Format::Obj) {
-        return scene.save(path).map(|()| Vec::new());
+    fn extensions(&self) -> &'static [&'static str] {
+        &["obj"]
     }
-    let out = write_obj(scene)?;
-    super::write_durably(path, out.text.as_bytes())
-        .map_err(|e| SceneError(format!("cannot write {}: {e}", path.display())))?;
-    Ok(out.dropped)
+
+    fn read(&self, bytes: &[u8], _ctx: &LoadContext<'_>) -> Result<Import, FormatError> {
+        let import = parse_obj_bytes(bytes).map_err(|e| FormatError::at_line(e.line, e.message))?;
+        Ok(Import {
+            scene: import.scene,
+            warnings: import
+                .warnings
+                .into_iter()
+                .map(|w| Located {
+                    line: Some(w.line),
+                    message: format!("warning: {}", w.message),
+                })
+                .collect(),
+            skipped: Vec::new(),
+            unit: None,
+        })
+    }
+
+    fn write(&self, scene: &Scene) -> Result<Written, FormatError> {
+        let out = write_obj(scene)?;
+        Ok(Written {
+            bytes: out.text.into_bytes(),
+            dropped: out.dropped,
+        })
+    }
+
+    fn writes(&self) -> bool {
+        true
+    }
+
+    fn kept_key(&self) -> Option<&'static str> {
+        Some("obj")
+    }
+
+    fn read_kept(
+        &self,
+        at: &crate::fields::At,
+        v: &serde_json::Value,
+        surface: bool,
+    ) -> Result<Box<dyn crate::scene::Kept>, SceneError> {
+        kept::from_json(at, v, surface).map(|k| Box::new(k) as Box<dyn crate::scene::Kept>)
+    }
 }
 
 /// The element's `o`/`g` name (or "curve"/"surface"), made unique with ".2", ".3", ….

@@ -2,7 +2,7 @@
 //! element, with its `cstype`, degrees, parameter ranges, `parm` vectors and control vertices.
 //! Nothing here knows the scene model; `map.rs` is the only bridge.
 
-use super::carried::Carried;
+use super::kept::ObjKept;
 use glam::DVec3;
 
 /// The polynomial basis named by `cstype` (the supported ones).
@@ -99,7 +99,7 @@ pub struct FreeForm {
     /// Line of the `curv`/`surf` statement.
     pub line: usize,
     /// What the element holds that prespline does not use, written back on save.
-    pub carried: Carried,
+    pub carried: ObjKept,
 }
 
 impl FreeForm {

@@ -2,13 +2,13 @@
 //! ([`element_to_object`], [`object_to_element`]); the mapping rules are in docs/obj.md.
 
 use super::ObjError;
-use super::carried::Carried;
 use super::erbs;
+use super::kept::ObjKept;
 use super::model::{Basis, Direction, FreeForm};
 use crate::geom::error::GeomResult;
 use crate::geom::{BSplineCurve, GeomError, TensorSurface};
 use crate::model::{CurveModel, EditError, Model, ModelRef, SplineForm, SurfaceModel};
-use crate::scene::{SceneError, SceneObject};
+use crate::scene::{Carried, SceneError, SceneObject};
 use glam::DVec3;
 
 /// An OBJ element as a scene object. A single Bézier segment on [0, 1] stays a Bézier object;
@@ -54,7 +54,11 @@ pub fn element_to_object(e: &FreeForm, name: String) -> Result<SceneObject, ObjE
         name,
         model,
         color: e.color,
-        obj: e.carried.clone(),
+        kept: if e.carried.is_empty() {
+            Carried::default()
+        } else {
+            Carried::of(Box::new(e.carried.clone()))
+        },
     })
 }
 
@@ -93,7 +97,7 @@ pub fn object_to_element(o: &SceneObject) -> Result<FreeForm, SceneError> {
         vec![dims[0]]
     });
     e.color = o.color;
-    e.carried = o.obj.clone();
+    e.carried = o.kept.get::<ObjKept>().cloned().unwrap_or_default();
     Ok(e)
 }
 
@@ -211,7 +215,7 @@ fn curve_element(c: &BSplineCurve, basis: Basis) -> FreeForm {
         samples: None,
         color: None,
         line: 0,
-        carried: Carried::default(),
+        carried: ObjKept::default(),
     }
 }
 
@@ -246,7 +250,7 @@ fn surface_element(s: &TensorSurface, basis: Basis) -> FreeForm {
         samples: None,
         color: None,
         line: 0,
-        carried: Carried::default(),
+        carried: ObjKept::default(),
     }
 }
 

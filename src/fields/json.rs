@@ -12,6 +12,15 @@ use std::fmt::Display;
 #[error("{0}")]
 pub struct SceneError(pub String);
 
+/// What reading an object's fields needs besides them: the fields every object has (which
+/// the kinds accept without reading), and the memory budget counts read from the file are
+/// held to before anything is built from them.
+#[derive(Debug, Clone, Copy)]
+pub struct ReadCtx<'a> {
+    pub common: &'a [&'static str],
+    pub budget: crate::sampling::budget::MemoryBudget,
+}
+
 /// Where we are, e.g. "object 'c' (objects[2])"; prefixes every message.
 #[derive(Clone)]
 pub struct At(pub String);

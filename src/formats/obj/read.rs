@@ -3,10 +3,10 @@
 //! `curv2` and surface numbers are checked once the whole file is read, since a positive number
 //! may name one written later. What prespline does not use — `trim`, `hole`, `scrv`, `sp`,
 //! `curv2`, `vp`, `con`, `ctech`, `stech` — is resolved then and kept with the element it
-//! belongs to ([`Carried`]).
+//! belongs to ([`ObjKept`]).
 
-use super::carried::{Body, Carried, Connection, Curve2, CurveRef, Technique};
 use super::check;
+use super::kept::{Body, Connection, Curve2, CurveRef, ObjKept, Technique};
 use super::lex::{Statement, Token};
 use super::model::{Basis, FreeForm};
 use super::{ObjError, ObjWarning, Warnings};
@@ -926,9 +926,9 @@ impl Reader {
                 samples,
                 color: open.pending.color.map(|(c, _)| c),
                 line,
-                carried: Carried {
+                carried: ObjKept {
                     technique: open.technique,
-                    ..Carried::default()
+                    ..ObjKept::default()
                 },
             },
             refs: open.refs,
@@ -1134,7 +1134,7 @@ impl Reader {
     }
 
     /// Writes the kept data of one element with its local numbers (connections come after).
-    fn fill(&self, carried: &mut Carried, body: &[BodyRead], local: &Local) {
+    fn fill(&self, carried: &mut ObjKept, body: &[BodyRead], local: &Local) {
         carried.parameter_vertices = local
             .vertices
             .iter()

@@ -5,4 +5,4 @@
 pub mod json;
 pub mod write;
 
-pub use json::{At, SceneError};
+pub use json::{At, ReadCtx, SceneError};

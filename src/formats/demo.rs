@@ -2,11 +2,12 @@
 //! net, an ERBS surface with visible local patches, an ERBS curve with its local curves, an exact
 //! NURBS circle, a closed ERBS torus built from a NURBS torus, and the Utah teapot.
 
-use super::{Model, Scene, SceneObject, parse_scene};
+use super::parse_scene;
 use crate::geom::{
     BFunctionKind, BSplineCurve, BezierCurve, ErbsCurve, ErbsSurface, KnotVector, TensorSurface,
 };
 use crate::model::{CurveModel, ErbsCurveModel, ErbsSurfaceModel, SplineForm, SurfaceModel};
+use crate::scene::{Model, Scene, SceneObject};
 use glam::DVec3;
 
 /// Newell's teapot (32 bicubic Bézier patches), the file shipped in `examples/`.
@@ -19,7 +20,7 @@ pub fn demo_scene() -> Scene {
         name: name.into(),
         model,
         color: Some(color),
-        obj: Default::default(),
+        kept: Default::default(),
     };
     let valid = "the demo's sample counts are valid";
     let mut objects = vec![
@@ -211,7 +212,7 @@ mod tests {
     fn demo_scene_is_complete_and_round_trips() {
         let scene = demo_scene();
         assert_eq!(scene.objects.len(), 5 + 32);
-        let text = super::super::scene_to_json(&scene);
+        let text = super::super::json::scene_to_json(&scene);
         let back = parse_scene(&text).unwrap();
         assert_eq!(back, scene);
     }

@@ -1,10 +1,11 @@
 //! Scene file → [`Scene`], validating everything with one-line errors.
 
-use super::json::*;
-use super::{Scene, SceneError, SceneObject};
+use super::super::context::{LoadContext, SampleDefaults};
+use crate::fields::ReadCtx;
+use crate::fields::json::*;
 use crate::model::Model;
 use crate::model::file::opt;
-use crate::profile::{LOAD_PROGRESS_AFTER, Progress};
+use crate::scene::{Carried, Scene, SceneError, SceneNames, SceneObject};
 use serde::Deserialize;
 use serde_json::{Map, Value};
 use std::collections::HashMap;
@@ -15,21 +16,7 @@ use std::collections::HashMap;
 /// dropped before the next, so that a large scene never holds a `Value` tree of the whole file
 /// (which took more time to build and free than the parsing itself, and four times the memory
 /// of the models).
-pub fn parse_scene(text: &str) -> Result<Scene, SceneError> {
-    parse_scene_with(text, SampleDefaults::default())
-}
-
-/// Sample counts for the objects of a scene file that give none (`--samples` on the command
-/// line): curves take `curve`, surfaces `surface`. An object without `samples` and without a
-/// default is an error, as the format asks.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct SampleDefaults {
-    pub curve: Option<usize>,
-    pub surface: Option<[usize; 2]>,
-}
-
-/// [`parse_scene`] with `defaults` for objects that give no sample count.
-pub fn parse_scene_with(text: &str, defaults: SampleDefaults) -> Result<Scene, SceneError> {
+pub fn parse_scene(text: &str, ctx: &LoadContext<'_>) -> Result<Scene, SceneError> {
     if !text.trim_start().starts_with('{') {
         // Not an object (or not JSON): the whole-value path words the message.
         return parse_scene_value(text);
@@ -40,14 +27,14 @@ pub fn parse_scene_with(text: &str, defaults: SampleDefaults) -> Result<Scene, S
         &mut de,
         SceneVisitor {
             failed: &failed,
-            defaults,
+            ctx,
         },
     )
     .and_then(|objects| de.end().map(|()| objects));
     match (parsed, failed.into_inner()) {
         (_, Some(e)) => Err(e),
         (Ok(objects), None) => {
-            check_connections(&objects)?;
+            check_kept(&objects)?;
             Ok(Scene { objects })
         }
         (Err(e), None) => Err(SceneError(format!("invalid JSON: {e}"))),
@@ -77,7 +64,7 @@ fn fail<E: serde::de::Error>(failed: Failed<'_>, e: SceneError) -> E {
 /// The top-level `{"objects": [...]}`.
 struct SceneVisitor<'a> {
     failed: Failed<'a>,
-    defaults: SampleDefaults,
+    ctx: &'a LoadContext<'a>,
 }
 
 impl<'de> serde::de::Visitor<'de> for SceneVisitor<'_> {
@@ -98,7 +85,7 @@ impl<'de> serde::de::Visitor<'de> for SceneVisitor<'_> {
                 "objects" => {
                     objects = Some(map.next_value_seed(ObjectsSeed {
                         failed: self.failed,
-                        defaults: self.defaults,
+                        ctx: self.ctx,
                     })?);
                 }
                 _ => {
@@ -118,7 +105,7 @@ impl<'de> serde::de::Visitor<'de> for SceneVisitor<'_> {
 /// The `objects` array, parsed one object at a time.
 struct ObjectsSeed<'a> {
     failed: Failed<'a>,
-    defaults: SampleDefaults,
+    ctx: &'a LoadContext<'a>,
 }
 
 impl<'de> serde::de::DeserializeSeed<'de> for ObjectsSeed<'_> {
@@ -143,11 +130,12 @@ impl<'de> serde::de::Visitor<'de> for ObjectsSeed<'_> {
         // Name → index, so that uniqueness costs one hash per object, not a scan of all before
         // it.
         let mut names: HashMap<String, usize> = HashMap::new();
-        let progress = Progress::delayed("parsing", None, LOAD_PROGRESS_AFTER).unit("objects");
+        let progress = self.ctx.progress.start("parsing", None, "objects");
+        let fields = ObjectFields::of(self.ctx);
         while let Some(item) = seq.next_element::<Value>()? {
             progress.inc(1);
             let i = objects.len();
-            let obj = parse_object(i, &item, self.defaults).map_err(|e| fail(self.failed, e))?;
+            let obj = parse_object(i, &item, &fields).map_err(|e| fail(self.failed, e))?;
             if let Some(j) = names.insert(obj.name.clone(), i) {
                 return Err(fail(
                     self.failed,
@@ -202,45 +190,37 @@ impl ObjectsSeed<'_> {
     }
 }
 
-/// Every kept OBJ `con` joins two surfaces of the scene along curves they keep.
-fn check_connections(objects: &[SceneObject]) -> Result<(), SceneError> {
+/// What each object's file kept that names other objects (OBJ's `con`) names them rightly.
+fn check_kept(objects: &[SceneObject]) -> Result<(), SceneError> {
+    let names = SceneNames { objects };
     for (i, o) in objects.iter().enumerate() {
-        for (k, c) in o.obj.connections.iter().enumerate() {
-            let at = At(format!("object '{}' (objects[{i}])", o.name));
-            let other = objects
-                .iter()
-                .find(|p| p.name == c.surface)
-                .ok_or_else(|| {
-                    at.err(
-                        "obj",
-                        format!("connections[{k}]: no object named '{}'", c.surface),
-                    )
-                })?;
-            if !other.model.is_surface() {
-                return Err(at.err(
-                    "obj",
-                    format!("connections[{k}]: '{}' is not a surface", c.surface),
-                ));
-            }
-            let curves = other.obj.curves2.len();
-            if c.surface_curve.curve >= curves {
-                return Err(at.err(
-                    "obj",
-                    format!(
-                        "connections[{k}]: '{}' keeps no curve {} ({curves} curves)",
-                        c.surface, c.surface_curve.curve
-                    ),
-                ));
-            }
+        for k in o.kept.iter() {
+            k.check_scene(&names, i)
+                .map_err(|e| At(format!("object '{}' (objects[{i}])", o.name)).err(k.key(), e))?;
         }
     }
     Ok(())
 }
 
 /// Fields every object has besides its geometry.
-const OBJECT_FIELDS: [&str; 5] = ["name", "type", "samples", "color", "obj"];
+const OBJECT_FIELDS: [&str; 4] = ["name", "type", "samples", "color"];
 
-fn parse_object(i: usize, v: &Value, defaults: SampleDefaults) -> Result<SceneObject, SceneError> {
+/// The fields every object may have: [`OBJECT_FIELDS`] and each format's kept field.
+struct ObjectFields<'a> {
+    common: Vec<&'static str>,
+    ctx: &'a LoadContext<'a>,
+}
+
+impl<'a> ObjectFields<'a> {
+    fn of(ctx: &'a LoadContext<'a>) -> Self {
+        let mut common = OBJECT_FIELDS.to_vec();
+        common.extend(ctx.formats.iter().filter_map(|f| f.kept_key()));
+        Self { common, ctx }
+    }
+}
+
+fn parse_object(i: usize, v: &Value, fields: &ObjectFields<'_>) -> Result<SceneObject, SceneError> {
+    let defaults = fields.ctx.samples;
     let at = At(format!("objects[{i}]"));
     let obj = v.as_object().ok_or_else(|| {
         SceneError(format!(
@@ -264,7 +244,11 @@ fn parse_object(i: usize, v: &Value, defaults: SampleDefaults) -> Result<SceneOb
         }
         None => obj,
     };
-    let model = Model::read(ty, &at, obj, &OBJECT_FIELDS).unwrap_or_else(|| {
+    let ctx = ReadCtx {
+        common: &fields.common,
+        budget: fields.ctx.budget,
+    };
+    let model = Model::read(ty, &at, obj, &ctx).unwrap_or_else(|| {
         Err(at.err(
             "type",
             format!(
@@ -274,15 +258,17 @@ fn parse_object(i: usize, v: &Value, defaults: SampleDefaults) -> Result<SceneOb
         ))
     })?;
     let color = opt(obj, "color").map(|c| parse_color(&at, c)).transpose()?;
-    let kept = opt(obj, "obj")
-        .map(|v| super::obj::carried::from_json(&at, v, model.is_surface()))
-        .transpose()?
-        .unwrap_or_default();
+    let mut kept = Carried::default();
+    for format in fields.ctx.formats {
+        if let Some(v) = format.kept_key().and_then(|key| opt(obj, key)) {
+            kept.set(format.read_kept(&at, v, model.is_surface())?);
+        }
+    }
     Ok(SceneObject {
         name: name.to_string(),
         model,
         color,
-        obj: kept,
+        kept,
     })
 }
 

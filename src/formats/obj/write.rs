@@ -4,9 +4,9 @@
 //! round-trip form, so reading the file back reproduces every value bit for bit; every vertex,
 //! `curv2` and `surf` number is absolute (counted from 1 through the file).
 
-use super::carried::{Body, Carried, Curve2, CurveRef, Technique};
+use super::kept::{Body, Curve2, CurveRef, ObjKept, Technique};
 use super::model::FreeForm;
-use crate::format::write::number;
+use crate::fields::write::number;
 use std::fmt::Write;
 
 /// Statement lines longer than this are continued with `\`.
@@ -27,7 +27,7 @@ struct Writer<'a> {
     s: String,
     elements: &'a [FreeForm],
     /// Per element: its kept data when that is consistent (otherwise it is left out).
-    kept: Vec<Option<&'a Carried>>,
+    kept: Vec<Option<&'a ObjKept>>,
     /// Per element: the file-wide number of its first `curv2` minus one.
     curve_base: Vec<usize>,
     /// Per element: its `surf` number, for surfaces.
@@ -44,7 +44,7 @@ struct Writer<'a> {
 impl<'a> Writer<'a> {
     fn new(elements: &'a [FreeForm]) -> Self {
         let mut dropped = Vec::new();
-        let kept: Vec<Option<&Carried>> = elements
+        let kept: Vec<Option<&ObjKept>> = elements
             .iter()
             .map(|e| match e.carried.check(e.is_surface()) {
                 Ok(()) => Some(&e.carried),
@@ -154,7 +154,7 @@ impl<'a> Writer<'a> {
         self.s.push_str("end\n");
     }
 
-    fn parameter_vertices(&mut self, k: &Carried) {
+    fn parameter_vertices(&mut self, k: &ObjKept) {
         for p in &k.parameter_vertices {
             let _ = writeln!(self.s, "vp {}", join(p));
         }

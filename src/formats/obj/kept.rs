@@ -9,14 +9,14 @@
 //! Trims live in the surface's parameter space, and knot insertion, degree elevation and point
 //! moves keep the domain, so they stay valid through edits.
 
-use crate::format::write::number;
+use crate::fields::write::number;
 use crate::scene::SceneError;
 use crate::scene::json::{At, as_array, as_f64, as_object, as_str, as_usize, check_fields};
 use serde_json::{Map, Value};
 
 /// The kept data of one object; empty for objects that came from anywhere else.
 #[derive(Debug, Clone, PartialEq, Default)]
-pub struct Carried {
+pub struct ObjKept {
     /// `vp u [v [w]]`: one to three values each, in file order.
     pub parameter_vertices: Vec<Vec<f64>>,
     /// The `curv2` elements the object's statements name, and `curv2` elements nothing names
@@ -182,10 +182,10 @@ pub struct Connection {
     pub surface_curve: CurveRef,
 }
 
-impl Carried {
+impl ObjKept {
     #[must_use]
     pub fn is_empty(&self) -> bool {
-        *self == Carried::default()
+        *self == ObjKept::default()
     }
 
     /// Every local reference in range, every technique and `cstype` known, every parameter
@@ -275,10 +275,46 @@ impl Carried {
     }
 }
 
+impl crate::scene::Kept for ObjKept {
+    fn key(&self) -> &'static str {
+        "obj"
+    }
+
+    fn to_json(&self) -> String {
+        to_json(self)
+    }
+
+    crate::kept_boilerplate!();
+
+    /// Every `con` joins this surface to a surface of the scene along a curve that one keeps.
+    fn check_scene(&self, names: &crate::scene::SceneNames<'_>, _me: usize) -> Result<(), String> {
+        for (k, c) in self.connections.iter().enumerate() {
+            let other = names
+                .find(&c.surface)
+                .and_then(|i| names.objects.get(i))
+                .ok_or_else(|| format!("connections[{k}]: no object named '{}'", c.surface))?;
+            if !other.model.is_surface() {
+                return Err(format!(
+                    "connections[{k}]: '{}' is not a surface",
+                    c.surface
+                ));
+            }
+            let curves = other.kept.get::<ObjKept>().map_or(0, |o| o.curves2.len());
+            if c.surface_curve.curve >= curves {
+                return Err(format!(
+                    "connections[{k}]: '{}' keeps no curve {} ({curves} curves)",
+                    c.surface, c.surface_curve.curve
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
 // ---- JSON (docs/scene-format.md, field `obj`) ---------------------------------------------
 
 /// The `obj` field's value.
-pub fn to_json(c: &Carried) -> String {
+pub fn to_json(c: &ObjKept) -> String {
     let mut fields = Vec::new();
     if !c.parameter_vertices.is_empty() {
         let vp: Vec<String> = c.parameter_vertices.iter().map(|p| numbers(p)).collect();
@@ -368,7 +404,7 @@ fn numbers(v: &[f64]) -> String {
 }
 
 /// Parses the `obj` field of an object (`surface`: whether the object is one).
-pub fn from_json(at: &At, v: &Value, surface: bool) -> Result<Carried, SceneError> {
+pub fn from_json(at: &At, v: &Value, surface: bool) -> Result<ObjKept, SceneError> {
     const FIELD: &str = "obj";
     let obj = as_object(at, FIELD, v)?;
     let inner = At(format!("{}: field 'obj'", at.0));
@@ -408,7 +444,7 @@ pub fn from_json(at: &At, v: &Value, surface: bool) -> Result<Carried, SceneErro
         .enumerate()
         .map(|(k, c)| connection_from_json(at, k, c))
         .collect::<Result<_, _>>()?;
-    let carried = Carried {
+    let carried = ObjKept {
         parameter_vertices,
         curves2,
         body,

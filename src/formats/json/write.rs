@@ -1,8 +1,8 @@
 //! [`Scene`] → scene file text. Numbers are written in Rust's shortest round-trip form, so
 //! loading a saved scene reproduces every control value bit for bit.
 
-use super::{Scene, SceneObject};
-use crate::format::write::{field, json_string, numbers};
+use crate::fields::write::{field, json_string, numbers};
+use crate::scene::{Scene, SceneObject};
 use std::fmt::Write;
 
 /// Serialises a scene in the format of docs/scene-format.md, one object per line.
@@ -37,8 +37,8 @@ fn write_object(s: &mut String, o: &SceneObject) {
     if let Some(c) = o.color {
         field(s, "color", &numbers(&c));
     }
-    if !o.obj.is_empty() {
-        field(s, "obj", &super::obj::carried::to_json(&o.obj));
+    for k in o.kept.iter() {
+        field(s, k.key(), &k.to_json());
     }
     s.push('}');
 }
