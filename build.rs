@@ -1,6 +1,8 @@
 //! Compiles every GLSL shader in `shaders/` to SPIR-V in `OUT_DIR` (`NAME.EXT.spv`) through the
 //! `glslang` crate, so no system shader compiler is needed. A GLSL error fails the build with
-//! lines formatted `shaders/NAME:LINE: message`.
+//! lines formatted `shaders/NAME:LINE: message`. A line `#include "NAME.glsl"` is replaced by
+//! that file of `shaders/` (expanded in turn, a few levels deep; line numbers then count the
+//! spliced text), so shaders that differ only in their inputs share one body.
 
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -64,7 +66,7 @@ fn compile(compiler: &Compiler, path: &Path) -> Result<Vec<u32>, Vec<String>> {
     );
     let stage = stage_of(path).ok_or_else(|| vec![format!("{display}:0: unknown stage")])?;
     let text = fs::read_to_string(path).map_err(|e| vec![format!("{display}:0: {e}")])?;
-    let source = ShaderSource::from(text);
+    let source = ShaderSource::from(expand_includes(&text, &display)?);
     let options = CompilerOptions {
         target: Target::Vulkan {
             version: VulkanVersion::Vulkan1_3,
@@ -84,6 +86,37 @@ fn compile(compiler: &Compiler, path: &Path) -> Result<Vec<u32>, Vec<String>> {
         .create_shader(input)
         .map_err(|e| format_log(&display, &e))?;
     shader.compile().map_err(|e| format_log(&display, &e))
+}
+
+/// `text` with each `#include "NAME.glsl"` line replaced by `shaders/NAME.glsl`, itself
+/// expanded.
+fn expand_includes(text: &str, display: &str) -> Result<String, Vec<String>> {
+    expand_nested(text, display, 0)
+}
+
+fn expand_nested(text: &str, display: &str, depth: usize) -> Result<String, Vec<String>> {
+    if depth > 4 {
+        return Err(vec![format!("{display}:1: #include nested too deeply")]);
+    }
+    let mut out = String::with_capacity(text.len());
+    for (n, line) in text.lines().enumerate() {
+        let included = line
+            .trim()
+            .strip_prefix("#include")
+            .map(|rest| rest.trim().trim_matches('"'));
+        match included {
+            Some(name) => {
+                let path = Path::new("shaders").join(name);
+                println!("cargo:rerun-if-changed={}", path.display());
+                let body = fs::read_to_string(&path)
+                    .map_err(|e| vec![format!("{display}:{}: {name}: {e}", n + 1)])?;
+                out.push_str(&expand_nested(&body, display, depth + 1)?);
+            }
+            None => out.push_str(line),
+        }
+        out.push('\n');
+    }
+    Ok(out)
 }
 
 /// glslang reports `ERROR: 0:LINE: message`; rewrite that to `shaders/NAME:LINE: message`.

@@ -1,11 +1,2 @@
 #version 450
-// One colour from the push constants (offset 64, after the view-projection matrix).
-layout(push_constant) uniform Push {
-    layout(offset = 64) vec4 color;
-} pc;
-
-layout(location = 0) out vec4 out_color;
-
-void main() {
-    out_color = pc.color;
-}
+#include "flat_frag.glsl"

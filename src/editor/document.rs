@@ -11,7 +11,9 @@ use crate::model::{
 use crate::progress::{ProgressSink, Silent};
 use crate::sampling::SampleMode;
 use crate::scene::{Scene, SceneObject};
+use crate::geom::trim::{Coverage, Trimmed};
 use glam::DVec3;
+use std::sync::Arc;
 
 /// One object of the document.
 #[derive(Debug, Clone)]
@@ -23,6 +25,33 @@ pub struct DocObject {
     pub sampled: SampledObject,
     /// What is drawn and picked besides the samples, kept up to date by every apply.
     pub controls: ControlDisplay,
+    /// A trimmed surface's trim and which of its samples and cells lie inside: worked out
+    /// once, since no edit moves a trim in parameter space nor the sample parameters.
+    pub trim: Option<Arc<TrimCoverage>>,
+}
+
+/// A trim with its coverage of an object's sample grid.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrimCoverage {
+    pub trimmed: Trimmed,
+    pub coverage: Coverage,
+}
+
+impl TrimCoverage {
+    /// The coverage of a sampled surface's grid by `trimmed`; `None` for a curve or a grid
+    /// the coverage cannot take (over 32,768 samples a side, which no sample limit allows).
+    #[must_use]
+    pub fn of(trimmed: &Trimmed, sampled: &SampledObject) -> Option<Self> {
+        let params = sampled.params();
+        let [u, v] = params.as_slice() else {
+            return None;
+        };
+        let coverage = Coverage::new(trimmed.regions(), u, v).ok()?;
+        Some(Self {
+            trimmed: trimmed.clone(),
+            coverage,
+        })
+    }
 }
 
 impl DocObject {
@@ -31,12 +60,18 @@ impl DocObject {
     pub fn new(o: &SceneObject, mode: SampleMode) -> Self {
         let sampled = SampledObject::new(&o.model, mode);
         let controls = ControlDisplay::of(sampled.model());
+        let trim = o
+            .trim
+            .as_ref()
+            .and_then(|t| TrimCoverage::of(t, &sampled))
+            .map(Arc::new);
         Self {
             name: o.name.clone(),
             color: o.color,
             kept: o.kept.clone(),
             sampled,
             controls,
+            trim,
         }
     }
 
@@ -48,6 +83,7 @@ impl DocObject {
             model: self.sampled.model().to_model(),
             color: self.color,
             kept: self.kept.clone(),
+            trim: self.trim.as_ref().map(|t| t.trimmed.clone()),
         }
     }
 }

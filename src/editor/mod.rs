@@ -17,5 +17,5 @@ pub use crate::model::controls::{
     ControlDisplay, ControlLayout, Grip, LOCAL_CURVE_SAMPLES, LOCAL_PATCH_SAMPLES, LocalEntry,
 };
 pub use applied::{Applied, ControlsChange, ObjectChange};
-pub use document::{DocObject, Document, Handle};
+pub use document::{DocObject, Document, Handle, TrimCoverage};
 pub use pipeline::{Editor, EditorOptions, ListRefused, Refused};

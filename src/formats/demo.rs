@@ -21,6 +21,7 @@ pub fn demo_scene() -> Scene {
         model,
         color: Some(color),
         kept: Default::default(),
+        trim: None,
     };
     let valid = "the demo's sample counts are valid";
     let mut objects = vec![

@@ -7,9 +7,11 @@
 
 mod context;
 pub mod demo;
+pub mod iges;
 pub mod json;
 pub mod obj;
 mod registry;
+pub mod step;
 
 pub use context::{
     FileFormat, FormatError, Import, LoadContext, Located, SampleDefaults, Skipped, Written,

@@ -4,6 +4,7 @@
 //! Nothing here knows about Vulkan, files or the sampling engine; every function is a plain
 //! computation on f64 data so that it can be checked against independent evaluators.
 
+pub mod analytic;
 pub mod basis;
 pub mod bezier;
 pub mod bezier_spline;
@@ -22,6 +23,7 @@ pub mod refine;
 pub mod shape;
 pub mod spline;
 pub mod surface;
+pub mod trim;
 
 pub use basis::HermiteMatrix;
 pub use bezier::BezierCurve;

@@ -10,13 +10,22 @@ use super::frame::{DrawStats, Frame};
 use super::grid::GridStride;
 use super::mirror::Mirror;
 use super::pipeline::{
-    Lines3dPush, MapPush, OverlayPush, PUSH_STAGES, PointsPush, PolylinePush, SurfacePush, WirePush,
+    Lines3dPush, MASK_BINDING, MapPush, OverlayPush, PUSH_STAGES, PointsPush, PolylinePush,
+    SurfacePush, WirePush,
 };
 use super::pod::{Pod, bytes_of};
 use super::region::{PointRun, SurfaceBatch, SurfaceGrid};
 use super::style::{MapStyle, PointStyle, PolylineStyle, SurfaceStyle};
 use super::transient::TransientAlloc;
 use super::vertex::{LineVertex, OverlayVertex};
+
+/// The pipeline for a batch: `trimmed` when it has a coverage mask (checked against it).
+fn masked(batch: &SurfaceBatch, whole: vk::Pipeline, trimmed: vk::Pipeline) -> GpuResult<vk::Pipeline> {
+    match batch.mask {
+        Some(mask) => mask.check(batch.offsets.len()).map(|()| trimmed),
+        None => Ok(whole),
+    }
+}
 
 /// Packs a linear colour into RGBA8 (for `unpackUnorm4x8` in shaders).
 fn pack_unorm(c: [f32; 4]) -> u32 {
@@ -111,6 +120,7 @@ impl Frame<'_> {
             shape: grid.shape,
             stride: GridStride::FULL,
             offsets: &[grid.offset],
+            mask: None,
         };
         self.draw_surface_batch(mirror, &batch, style)
     }
@@ -170,8 +180,11 @@ impl Frame<'_> {
             back: style.back,
         };
         let cells = check_cells(cells, count, &runs)?;
-        self.bind_and_push(self.ctx.pipelines.surface, &push);
-        let indices = self.draw_indexed(mirror, base, index_buffer, count, &runs, cells);
+        let pipelines = &self.ctx.pipelines;
+        let pipeline = masked(batch, pipelines.surface, pipelines.surface_trim)?;
+        self.bind_and_push(pipeline, &push);
+        let instance = self.bind_mask(batch);
+        let indices = self.draw_indexed(mirror, base, index_buffer, count, &runs, cells, instance);
         self.stats.surface_triangles += indices / 3;
         Ok(())
     }
@@ -255,7 +268,9 @@ impl Frame<'_> {
             params,
         };
         let cells = check_cells(cells, count, &runs)?;
-        self.bind_and_push(self.ctx.pipelines.surface_map, &push);
+        let pipelines = &self.ctx.pipelines;
+        let pipeline = masked(batch, pipelines.surface_map, pipelines.surface_map_trim)?;
+        self.bind_and_push(pipeline, &push);
         let scalar_buffer = scalars.slot(self.slot).raw();
         // SAFETY: recording inside a rendering scope; the scalar mirror has VERTEX_BUFFER
         // usage, lives until this slot's fence signals (mirrors are released through the
@@ -266,9 +281,28 @@ impl Frame<'_> {
                 .raw
                 .cmd_bind_vertex_buffers(self.cmd, 1, &[scalar_buffer], &[0])
         };
-        let indices = self.draw_indexed(mirror, base, index_buffer, count, &runs, cells);
+        let instance = self.bind_mask(batch);
+        let indices = self.draw_indexed(mirror, base, index_buffer, count, &runs, cells, instance);
         self.stats.surface_triangles += indices / 3;
         Ok(())
+    }
+
+    /// Binds a masked batch's mask table (instance-rate binding 2) and returns the instance
+    /// that selects its entry; 0 for a batch without a mask.
+    fn bind_mask(&mut self, batch: &SurfaceBatch) -> u32 {
+        let Some(mask) = batch.mask else {
+            return 0;
+        };
+        let buffer = mask.table.slot(self.slot).raw();
+        // SAFETY: recording; the table mirror has VERTEX_BUFFER usage and outlives the frame;
+        // the bound pipeline reads binding 2 per instance.
+        unsafe {
+            self.ctx
+                .device
+                .raw
+                .cmd_bind_vertex_buffers(self.cmd, MASK_BINDING, &[buffer], &[0])
+        };
+        mask.entry
     }
 
     /// Draws isolines every `every` samples (1 = full wireframe) over a grid surface, in
@@ -284,6 +318,7 @@ impl Frame<'_> {
             shape: grid.shape,
             stride: GridStride::FULL,
             offsets: &[grid.offset],
+            mask: None,
         };
         self.draw_wire_batch(mirror, &batch, every, color)
     }
@@ -311,15 +346,20 @@ impl Frame<'_> {
             view_proj: self.view_proj(),
             color,
         };
-        self.bind_and_push(self.ctx.pipelines.wire, &push);
-        self.draw_indexed(mirror, base, index_buffer, count, &runs, None);
+        let pipelines = &self.ctx.pipelines;
+        let pipeline = masked(batch, pipelines.wire, pipelines.wire_trim)?;
+        self.bind_and_push(pipeline, &push);
+        let instance = self.bind_mask(batch);
+        self.draw_indexed(mirror, base, index_buffer, count, &runs, None, instance);
         Ok(())
     }
 
     /// For each run (vertex offset, surfaces), the first `surfaces · count` indices of
     /// `index_buffer` (copies of one grid's `count`), or with `cells` the given index ranges
     /// of the first run's surface: one `vkCmdDrawMultiIndexedEXT` (per `maxMultiDrawCount`
-    /// draws) where supported, else one draw each.
+    /// draws) where supported, else one draw each; one instance, `instance` (a masked
+    /// batch's mask entry).
+    #[allow(clippy::too_many_arguments)]
     fn draw_indexed(
         &mut self,
         mirror: &Mirror,
@@ -328,6 +368,7 @@ impl Frame<'_> {
         count: u32,
         runs: &[(i32, u32)],
         cells: Option<&[(u32, u32)]>,
+        instance: u32,
     ) -> u64 {
         self.bind_vertices(mirror.slot(self.slot).raw(), base);
         self.bind_indices(index_buffer);
@@ -361,7 +402,7 @@ impl Frame<'_> {
                             infos.len() as u32,
                             infos.as_ptr(),
                             1,
-                            0,
+                            instance,
                             size_of::<vk::MultiDrawIndexedInfoEXT>() as u32,
                             std::ptr::null(),
                         )
@@ -379,7 +420,7 @@ impl Frame<'_> {
                             1,
                             first_index,
                             vertex_offset,
-                            0,
+                            instance,
                         )
                     };
                     self.stats.draws += 1;

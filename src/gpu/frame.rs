@@ -212,6 +212,21 @@ impl<'a> Frame<'a> {
         Ok(fresh)
     }
 
+    /// Writes `data` into slot `slot` of a mirror this frame created and the GPU has not used
+    /// yet (any slot may be written then).
+    pub(crate) fn write_new_mirror_slot(
+        &mut self,
+        mirror: &mut Mirror,
+        slot: usize,
+        data: &[f32],
+    ) -> GpuResult<()> {
+        let atom = self.ctx.device.caps.non_coherent_atom_size;
+        let track = self.ctx.always_flush || mirror.slot(slot).buffer.needs_flush();
+        mirror
+            .writer(slot, atom, track, &mut self.flushes)
+            .write(0, data)
+    }
+
     /// Gives a mirror back; each slot's buffer is released when that slot's fence next
     /// signals (this frame's included), so this never waits.
     pub fn destroy_mirror(&mut self, mirror: Mirror) {

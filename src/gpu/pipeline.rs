@@ -171,6 +171,11 @@ pub(crate) struct PipelineSet {
     pub overlay: vk::Pipeline,
     /// Surfaces coloured by an analysis map (a second vertex stream of one scalar each).
     pub surface_map: vk::Pipeline,
+    /// The surface, map and wire pipelines of trimmed surfaces: a third, instance-rate
+    /// stream names the object's coverage mask, which every fragment is tested against.
+    pub surface_trim: vk::Pipeline,
+    pub surface_map_trim: vk::Pipeline,
+    pub wire_trim: vk::Pipeline,
 }
 
 /// The shared layout and the pipeline sets built so far.
@@ -268,6 +273,9 @@ impl Pipelines {
                 set.lines3d,
                 set.overlay,
                 set.surface_map,
+                set.surface_trim,
+                set.surface_map_trim,
+                set.wire_trim,
             ] {
                 // SAFETY: the renderer waited for the GPU before destroying pipelines.
                 unsafe { device.raw.destroy_pipeline(p, None) };
@@ -287,6 +295,13 @@ struct VertexInputs {
     /// Analysis maps: the surface vertices plus one f32 per vertex from a second buffer.
     map: [vk::VertexInputBindingDescription; 2],
     map_attrs: [vk::VertexInputAttributeDescription; 3],
+    /// The trimmed variants: the same, plus one `uvec4` per instance (binding 2, location 4)
+    /// naming the object's coverage mask (see `shaders/trim.glsl`).
+    surface_trim: [vk::VertexInputBindingDescription; 2],
+    surface_trim_attrs: [vk::VertexInputAttributeDescription; 3],
+    map_trim: [vk::VertexInputBindingDescription; 3],
+    map_trim_attrs: [vk::VertexInputAttributeDescription; 4],
+    wire_trim_attrs: [vk::VertexInputAttributeDescription; 2],
     /// `LineVertex`: position and RGBA8 colour.
     lines: [vk::VertexInputBindingDescription; 1],
     lines_attrs: [vk::VertexInputAttributeDescription; 2],
@@ -314,11 +329,27 @@ impl VertexInputs {
             format: F::R32_SFLOAT,
             offset: 0,
         };
+        let mask = vk::VertexInputBindingDescription {
+            binding: MASK_BINDING,
+            stride: 16,
+            input_rate: vk::VertexInputRate::INSTANCE,
+        };
+        let mask_attr = vk::VertexInputAttributeDescription {
+            location: 4,
+            binding: MASK_BINDING,
+            format: F::R32G32B32A32_UINT,
+            offset: 0,
+        };
         Self {
             surface,
             surface_attrs,
             map: [surface[0], scalar],
             map_attrs: [surface_attrs[0], surface_attrs[1], scalar_attr],
+            surface_trim: [surface[0], mask],
+            surface_trim_attrs: [surface_attrs[0], surface_attrs[1], mask_attr],
+            map_trim: [surface[0], scalar, mask],
+            map_trim_attrs: [surface_attrs[0], surface_attrs[1], scalar_attr, mask_attr],
+            wire_trim_attrs: [surface_attrs[0], mask_attr],
             lines: binding(16),
             lines_attrs: [
                 attribute(0, F::R32G32B32_SFLOAT, 0),
@@ -334,11 +365,15 @@ impl VertexInputs {
     }
 }
 
+/// The vertex binding of the coverage-mask stream of trimmed pipelines.
+pub(crate) const MASK_BINDING: u32 = 2;
+
 /// The pipelines of a set, in the order of [`set_specs`].
-const SET_SIZE: usize = 8;
+const SET_SIZE: usize = 11;
 
 /// What each pipeline of a set is made of, in the order [`PipelineSet::from_built`] reads:
-/// surface, wire, polyline, points, thin lines, 3D lines, overlay, surface map.
+/// surface, wire, polyline, points, thin lines, 3D lines, overlay, surface map, and the
+/// trimmed surface, surface map and wire.
 fn set_specs(inputs: &VertexInputs, large_points: bool) -> [Spec<'_>; SET_SIZE] {
     let tri = vk::PrimitiveTopology::TRIANGLE_LIST;
     let lines = vk::PrimitiveTopology::LINE_LIST;
@@ -410,6 +445,33 @@ fn set_specs(inputs: &VertexInputs, large_points: bool) -> [Spec<'_>; SET_SIZE] 
             depth: Depth::Biased,
             blend: false,
         },
+        Spec {
+            vs: ShaderId::SurfaceTrimVert,
+            fs: ShaderId::SurfaceTrimFrag,
+            bindings: &inputs.surface_trim,
+            attributes: &inputs.surface_trim_attrs,
+            topology: tri,
+            depth: Depth::Biased,
+            blend: false,
+        },
+        Spec {
+            vs: ShaderId::MapTrimVert,
+            fs: ShaderId::MapTrimFrag,
+            bindings: &inputs.map_trim,
+            attributes: &inputs.map_trim_attrs,
+            topology: tri,
+            depth: Depth::Biased,
+            blend: false,
+        },
+        Spec {
+            vs: ShaderId::WireTrimVert,
+            fs: ShaderId::FlatTrimFrag,
+            bindings: &inputs.surface_trim,
+            attributes: &inputs.wire_trim_attrs,
+            topology: lines,
+            depth: Depth::On,
+            blend: false,
+        },
     ]
 }
 
@@ -425,6 +487,9 @@ impl PipelineSet {
             lines3d,
             overlay,
             surface_map,
+            surface_trim,
+            surface_map_trim,
+            wire_trim,
         ] = p;
         Self {
             surface,
@@ -435,6 +500,9 @@ impl PipelineSet {
             lines3d,
             overlay,
             surface_map,
+            surface_trim,
+            surface_map_trim,
+            wire_trim,
         }
     }
 }

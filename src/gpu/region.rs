@@ -3,6 +3,7 @@
 
 use super::error::{GpuError, GpuResult};
 use super::grid::{GridShape, GridStride};
+use super::mirror::Mirror;
 
 /// A surface's vertices inside a mirror: `shape.rows × shape.cols` vertices of 6 floats
 /// (position xyz, normal xyz), row-major, starting at float `offset`.
@@ -39,6 +40,50 @@ pub struct SurfaceBatch<'a> {
     pub stride: GridStride,
     /// Float offset of each surface's vertex (0, 0).
     pub offsets: &'a [usize],
+    /// The coverage mask every fragment is tested against (a trimmed surface: the batch holds
+    /// that one surface), `None` for surfaces drawn whole.
+    pub mask: Option<MaskRef<'a>>,
+}
+
+/// A per-fragment coverage mask in grid coordinates: entry `entry` of `table`, a mirror of
+/// `uvec4`s written as f32 bits — the device address of the mask's words (low, high), the
+/// vertices per grid row, and the surface's first vertex in the mirror its vertices are
+/// bound from (`shaders/trim.glsl` reads the words).
+#[derive(Clone, Copy)]
+pub struct MaskRef<'a> {
+    pub table: &'a Mirror,
+    pub entry: u32,
+}
+
+impl std::fmt::Debug for MaskRef<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "MaskRef {{ entry: {} }}", self.entry)
+    }
+}
+
+impl PartialEq for MaskRef<'_> {
+    fn eq(&self, other: &Self) -> bool {
+        std::ptr::eq(self.table, other.table) && self.entry == other.entry
+    }
+}
+
+impl Eq for MaskRef<'_> {}
+
+impl MaskRef<'_> {
+    /// Floats per table entry.
+    pub const FLOATS: usize = 4;
+
+    /// Checks the entry against the table and that the batch is one surface.
+    pub(crate) fn check(&self, surfaces: usize) -> GpuResult<()> {
+        let entries = self.table.len() / Self::FLOATS;
+        if self.entry as usize >= entries || surfaces != 1 {
+            return Err(GpuError::InvalidArgument(format!(
+                "coverage mask {} of {entries} for a batch of {surfaces} surfaces (one expected)",
+                self.entry
+            )));
+        }
+        Ok(())
+    }
 }
 
 impl SurfaceBatch<'_> {
@@ -175,6 +220,7 @@ mod tests {
             shape,
             stride: GridStride::FULL,
             offsets: &offsets,
+            mask: None,
         };
         let (base, runs) = batch.runs(502 * floats).unwrap();
         assert_eq!(base, 0);

@@ -29,9 +29,16 @@ pub(crate) enum ShaderId {
     OverlayFrag,
     MapVert,
     MapFrag,
+    /// The trimmed variants: the same bodies with a coverage-mask test (shaders/trim.glsl).
+    SurfaceTrimVert,
+    SurfaceTrimFrag,
+    MapTrimVert,
+    MapTrimFrag,
+    WireTrimVert,
+    FlatTrimFrag,
 }
 
-const SOURCES: [(ShaderId, &str, &[u8]); 13] = [
+const SOURCES: [(ShaderId, &str, &[u8]); 19] = [
     (
         ShaderId::SurfaceVert,
         "surface.vert",
@@ -69,6 +76,36 @@ const SOURCES: [(ShaderId, &str, &[u8]); 13] = [
     ),
     (ShaderId::MapVert, "map.vert", spirv!("map.vert")),
     (ShaderId::MapFrag, "map.frag", spirv!("map.frag")),
+    (
+        ShaderId::SurfaceTrimVert,
+        "surface_trim.vert",
+        spirv!("surface_trim.vert"),
+    ),
+    (
+        ShaderId::SurfaceTrimFrag,
+        "surface_trim.frag",
+        spirv!("surface_trim.frag"),
+    ),
+    (
+        ShaderId::MapTrimVert,
+        "map_trim.vert",
+        spirv!("map_trim.vert"),
+    ),
+    (
+        ShaderId::MapTrimFrag,
+        "map_trim.frag",
+        spirv!("map_trim.frag"),
+    ),
+    (
+        ShaderId::WireTrimVert,
+        "wire_trim.vert",
+        spirv!("wire_trim.vert"),
+    ),
+    (
+        ShaderId::FlatTrimFrag,
+        "flat_trim.frag",
+        spirv!("flat_trim.frag"),
+    ),
 ];
 
 /// The shader modules, created once; pipelines for new target formats are built from them.

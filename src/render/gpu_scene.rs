@@ -14,9 +14,11 @@ use crate::editor::{
     Applied, ControlLayout, ControlsChange, Document, Handle, LOCAL_CURVE_SAMPLES,
     LOCAL_PATCH_SAMPLES, LocalEntry,
 };
+use super::trim_mask::mask_words;
 use crate::gpu::{
     FRAMES_IN_FLIGHT, Frame, GpuError, GpuResult, GridShape, GridStride, LayerPart, MapStyle,
-    Mirror, PointRun, PointStyle, PolylineStyle, Renderer, Restore, SurfaceBatch, SurfaceStyle,
+    MaskRef, MaskSet, MaskWords, Mirror, PointRun, PointStyle, PolylineStyle, Renderer, Restore,
+    SurfaceBatch, SurfaceGrid, SurfaceStyle,
 };
 use crate::model::Index2;
 use crate::sampling::{DirtyRegion, DirtySet};
@@ -52,12 +54,15 @@ struct ObjectGpu {
 }
 
 /// Surfaces of one grid shape and colour in one arena: drawn with one multi-draw per stride.
+/// A trimmed surface is a group of its own, drawn through its coverage mask.
 #[derive(Debug, Clone, PartialEq)]
 struct SurfaceGroup {
     /// Object indices, in document order.
     members: Vec<usize>,
     shape: GridShape,
     arena: usize,
+    /// The trimmed member's entry in the scene's [`MaskSet`].
+    mask: Option<u32>,
 }
 
 /// Surfaces of one group drawn at one stride: one multi-draw in a full redraw.
@@ -137,6 +142,8 @@ pub struct GpuScene {
     local_displays: BTreeSet<usize>,
     /// Every object has its control mirror: nothing is left to make.
     controls_complete: bool,
+    /// The trimmed surfaces' coverage masks, made by the first frame that draws.
+    masks: Option<MaskSet>,
 }
 
 /// A static layer in the target and what it was built for.
@@ -194,6 +201,7 @@ impl GpuScene {
                 .filter(|&i| is_local_display(&doc.objects[i].controls.layout))
                 .collect(),
             controls_complete: doc.objects.is_empty(),
+            masks: None,
         };
         // On failure, give back what was created.
         match scene.fill(renderer, doc, &places, &sizes) {
@@ -531,6 +539,7 @@ impl GpuScene {
         lod: &Lod,
     ) -> GpuResult<DrawReport> {
         let mut report = DrawReport::default();
+        self.make_masks(frame, doc)?;
         self.make_controls(frame, doc, opts, hl)?;
         if self.lod_view != Some(*lod) {
             self.lod_view = Some(*lod);
@@ -555,6 +564,44 @@ impl GpuScene {
             self.draw_lines(frame, doc, opts, hl, &|_| true, None)?;
         }
         Ok(report)
+    }
+
+    /// Makes the coverage masks of the trimmed surfaces, once: trims never move in parameter
+    /// space, so a mask outlives every edit.
+    fn make_masks(&mut self, frame: &mut Frame<'_>, doc: &Document) -> GpuResult<()> {
+        if self.masks.is_some() || self.groups.iter().all(|g| g.mask.is_none()) {
+            return Ok(());
+        }
+        let masked: Vec<(usize, Vec<u32>)> = self
+            .groups
+            .iter()
+            .filter(|g| g.mask.is_some())
+            .filter_map(|g| {
+                let i = g.members[0];
+                let trim = doc.objects[i].trim.as_ref()?;
+                Some((i, mask_words(&trim.coverage)))
+            })
+            .collect();
+        let words: Vec<MaskWords<'_>> = masked
+            .iter()
+            .map(|(i, w)| {
+                let grid = doc.objects[*i].sampled.grid();
+                let offset = self.objects[*i].samples.offset;
+                MaskWords {
+                    words: w,
+                    cols: grid.dims[1] as u32,
+                    first_vertex: (offset / SurfaceGrid::FLOATS_PER_VERTEX) as u32,
+                }
+            })
+            .collect();
+        self.masks = Some(frame.create_mask_set(&words)?);
+        Ok(())
+    }
+
+    /// The coverage mask group `g` is drawn through.
+    fn group_mask(&self, g: usize) -> Option<MaskRef<'_>> {
+        let entry = self.groups[g].mask?;
+        Some(self.masks.as_ref()?.entry(entry))
     }
 
     /// Makes the control mirrors a frame drawn with `opts` and `hl` needs and does not have
@@ -745,6 +792,7 @@ impl GpuScene {
             shape: group.shape,
             stride: b.stride,
             offsets: &offsets,
+            mask: self.group_mask(b.group),
         };
         self.draw_surfaces(
             frame,
@@ -779,6 +827,7 @@ impl GpuScene {
             shape: group.shape,
             stride: b.stride,
             offsets: &offsets,
+            mask: self.group_mask(b.group),
         };
         let style = self.group_style(doc, b.group);
         self.draw_surfaces(frame, group.arena, &batch, Some(cells), &style)
@@ -1117,6 +1166,9 @@ impl GpuScene {
         for m in self.objects.into_iter().filter_map(|o| o.controls) {
             renderer.destroy_mirror(m);
         }
+        if let Some(m) = self.masks {
+            m.destroy_with(|b| renderer.destroy_mirror(b));
+        }
     }
 }
 
@@ -1293,6 +1345,7 @@ impl<'a> ControlPass<'a> {
                 shape: GridShape { rows: k, cols: k },
                 stride: GridStride::FULL,
                 offsets,
+                mask: None,
             };
             frame.draw_wire_batch(self.controls, &batch, (k - 1) / 2, color)
         };
@@ -1579,6 +1632,7 @@ fn fill_runs(members: &[(usize, usize, usize)], threads: usize) -> Vec<std::ops:
 /// Surfaces grouped by arena, grid shape and colour (in order of first appearance).
 fn surface_groups(doc: &Document, places: &[Place]) -> Vec<SurfaceGroup> {
     let mut groups: Vec<SurfaceGroup> = Vec::new();
+    let mut masks = 0;
     for (i, o) in doc.objects.iter().enumerate() {
         let grid = o.sampled.grid();
         if grid.normals.is_none() {
@@ -1589,8 +1643,21 @@ fn surface_groups(doc: &Document, places: &[Place]) -> Vec<SurfaceGroup> {
             cols: grid.dims[1] as u32,
         };
         let arena = places[i].arena;
+        if o.trim.is_some() {
+            groups.push(SurfaceGroup {
+                members: vec![i],
+                shape,
+                arena,
+                mask: Some(masks),
+            });
+            masks += 1;
+            continue;
+        }
         let same = |g: &&mut SurfaceGroup| {
-            g.shape == shape && g.arena == arena && doc.objects[g.members[0]].color == o.color
+            g.mask.is_none()
+                && g.shape == shape
+                && g.arena == arena
+                && doc.objects[g.members[0]].color == o.color
         };
         match groups.iter_mut().find(same) {
             Some(g) => g.members.push(i),
@@ -1598,6 +1665,7 @@ fn surface_groups(doc: &Document, places: &[Place]) -> Vec<SurfaceGroup> {
                 members: vec![i],
                 shape,
                 arena,
+                mask: None,
             }),
         }
     }

@@ -14,6 +14,7 @@ pub mod offscreen;
 pub mod overlays;
 pub mod retained;
 pub mod style;
+mod trim_mask;
 
 pub use camera::{Bounds, OrbitCamera};
 pub use gpu_scene::{DrawReport, GpuScene, UploadStats};

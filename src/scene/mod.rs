@@ -50,6 +50,8 @@ pub struct SceneObject {
     /// What the object's file held that prespline does not use (OBJ's `curv2`, `vp`, `con`,
     /// techniques), kept for every save; empty for objects from anywhere else.
     pub kept: Carried,
+    /// A surface's trim loops in its parameter space (`None`: drawn whole).
+    pub trim: Option<crate::geom::trim::Trimmed>,
 }
 
 impl Scene {

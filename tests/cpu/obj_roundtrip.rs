@@ -139,6 +139,7 @@ fn random_object(rng: &mut Rng, i: usize) -> SceneObject {
         model,
         color: (rng.range(0, 2) == 1).then_some([0.25, 1.0, 0.0]),
         kept: Default::default(),
+        trim: None,
     }
 }
 

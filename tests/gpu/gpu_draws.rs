@@ -37,6 +37,7 @@ fn draws_and_binds_are_counted_once() {
         shape,
         stride: GridStride { rows: 2, cols: 2 },
         offsets: &offsets,
+        mask: None,
     };
     frame
         .draw_surface_batch(&mirror, &batch, &SurfaceStyle::default())

@@ -2,6 +2,7 @@
 //! kind exactly and is what the viewer's autosaves are written in.
 
 mod read;
+mod trim;
 mod write;
 
 pub use read::parse_scene;

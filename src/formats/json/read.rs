@@ -3,6 +3,7 @@
 use super::super::context::{LoadContext, SampleDefaults};
 use crate::fields::ReadCtx;
 use crate::fields::json::*;
+use crate::geom::trim::Trimmed;
 use crate::model::Model;
 use crate::model::file::opt;
 use crate::scene::{Carried, Scene, SceneError, SceneNames, SceneObject};
@@ -203,7 +204,7 @@ fn check_kept(objects: &[SceneObject]) -> Result<(), SceneError> {
 }
 
 /// Fields every object has besides its geometry.
-const OBJECT_FIELDS: [&str; 4] = ["name", "type", "samples", "color"];
+const OBJECT_FIELDS: [&str; 5] = ["name", "type", "samples", "color", "trim"];
 
 /// The fields every object may have: [`OBJECT_FIELDS`] and each format's kept field.
 struct ObjectFields<'a> {
@@ -264,12 +265,27 @@ fn parse_object(i: usize, v: &Value, fields: &ObjectFields<'_>) -> Result<SceneO
             kept.set(format.read_kept(&at, v, model.is_surface())?);
         }
     }
+    let trim = opt(obj, "trim")
+        .map(|v| read_trimmed(&at, v, &model))
+        .transpose()?;
     Ok(SceneObject {
         name: name.to_string(),
         model,
         color,
         kept,
+        trim,
     })
+}
+
+/// A surface's `trim`, validated against its parameter domain.
+fn read_trimmed(at: &At, v: &Value, model: &Model) -> Result<Trimmed, SceneError> {
+    if !model.is_surface() {
+        return Err(at.err("trim", "only surfaces have trims"));
+    }
+    let spec = super::trim::read_trim(at, v)?;
+    let d = model.domain();
+    let domain = [d[0], d.get(1).copied().unwrap_or(d[0])];
+    Trimmed::new(spec, domain).map_err(|e| at.err("trim", e))
 }
 
 /// The sample count `defaults` give an object of type `ty` that has none of its own.

@@ -37,6 +37,9 @@ fn write_object(s: &mut String, o: &SceneObject) {
     if let Some(c) = o.color {
         field(s, "color", &numbers(&c));
     }
+    if let Some(t) = &o.trim {
+        field(s, "trim", &super::trim::trim_json(t.spec()));
+    }
     for k in o.kept.iter() {
         field(s, k.key(), &k.to_json());
     }

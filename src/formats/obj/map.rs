@@ -59,6 +59,7 @@ pub fn element_to_object(e: &FreeForm, name: String) -> Result<SceneObject, ObjE
         } else {
             Carried::of(Box::new(e.carried.clone()))
         },
+        trim: None,
     })
 }
 

@@ -1,0 +1,63 @@
+// Trimmed surfaces: the fragment's grid coordinate g (row, column in units of the sample
+// spacing, from the vertex shader) is tested against the object's coverage mask, built once
+// per structure on the CPU (src/geom/trim/coverage.rs, which has this test in f32 operation for
+// operation). Words from the object's record start:
+//   [0] cells offset, [1] records offset, [2] segments offset (words, from the record start),
+//   [3] cell rows (mu - 1), [4] cell columns (mv - 1);
+//   cells:    one word per cell (row-major): 0 outside, 1 inside, 2 | (record << 2) boundary;
+//   records:  4 words per boundary cell: first segment, (count << 1) | reference inside,
+//             reference point x, y (float bits, cell-local);
+//   segments: 4 words each, (a.x, a.y, b.x, b.y) in cell-local coordinates (float bits).
+// A boundary cell's fragment is inside iff the reference point's flag XOR the parity of the
+// crossings of the path fragment -> reference with the cell's segments.
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer TrimWords {
+    uint w[];
+};
+
+layout(location = 5) in vec2 v_grid;
+layout(location = 6) flat in uvec4 v_trim;
+
+vec4 trim_vec4(TrimWords t, uint at) {
+    return uintBitsToFloat(uvec4(t.w[at], t.w[at + 1u], t.w[at + 2u], t.w[at + 3u]));
+}
+
+// Whether the path p -> r crosses segment s = (a, b); half-open at the segment's ends, so a
+// path through a vertex two segments share counts once or twice exactly as the boundary
+// passes or bounces. `precise`: no fused multiply-add, as on the CPU.
+bool trim_crosses(vec2 p, vec2 r, vec4 s) {
+    precise float ex = s.z - s.x;
+    precise float ey = s.w - s.y;
+    precise float d1 = ex * (p.y - s.y) - ey * (p.x - s.x);
+    precise float d2 = ex * (r.y - s.y) - ey * (r.x - s.x);
+    precise float fx = r.x - p.x;
+    precise float fy = r.y - p.y;
+    precise float d3 = fx * (s.y - p.y) - fy * (s.x - p.x);
+    precise float d4 = fx * (s.w - p.y) - fy * (s.z - p.x);
+    return ((d1 > 0.0) != (d2 > 0.0)) && ((d3 > 0.0) != (d4 > 0.0));
+}
+
+bool trim_inside() {
+    TrimWords t = TrimWords(v_trim.xy);
+    int ncu = int(t.w[3]);
+    int ncv = int(t.w[4]);
+    int cx = clamp(int(floor(v_grid.x)), 0, ncu - 1);
+    int cy = clamp(int(floor(v_grid.y)), 0, ncv - 1);
+    vec2 p = v_grid - vec2(float(cx), float(cy));
+    uint word = t.w[t.w[0] + uint(cx * ncv + cy)];
+    uint tag = word & 3u;
+    if (tag != 2u) {
+        return tag == 1u;
+    }
+    uint rec = t.w[1] + (word >> 2) * 4u;
+    vec4 head = uintBitsToFloat(uvec4(t.w[rec], t.w[rec + 1u], t.w[rec + 2u], t.w[rec + 3u]));
+    uint first = t.w[rec];
+    uint count = t.w[rec + 1u] >> 1;
+    bool inside = (t.w[rec + 1u] & 1u) == 1u;
+    vec2 r = head.zw;
+    for (uint k = 0u; k < count; ++k) {
+        if (trim_crosses(p, r, trim_vec4(t, t.w[2] + (first + k) * 4u))) {
+            inside = !inside;
+        }
+    }
+    return inside;
+}

@@ -1,0 +1,3 @@
+#version 450
+#define TRIMMED
+#include "wire_vert.glsl"
