@@ -5,6 +5,7 @@
 pub mod args;
 pub mod bench;
 pub mod convert;
+pub mod info;
 pub mod load;
 pub mod render;
 pub mod resident;
@@ -52,6 +53,7 @@ commands! {
     Bench(bench::BenchArgs),
     Render(render::RenderArgs),
     Convert(convert::ConvertArgs),
+    Info(info::InfoArgs),
 }
 
 /// Writes `text` to stdout in one piece.

@@ -3,6 +3,7 @@
 //! bounds, the edits a gesture stands for).
 
 use crate::geom::Bounds;
+use crate::geom::trim::{Coverage, Trimmed};
 use crate::model::SampledObject;
 use crate::model::{
     ControlDisplay, Edit, ErbsCurveEdit, ErbsSurfaceEdit, Grip, Index2, KindEdit, LocalEdit,
@@ -11,7 +12,6 @@ use crate::model::{
 use crate::progress::{ProgressSink, Silent};
 use crate::sampling::SampleMode;
 use crate::scene::{Scene, SceneObject};
-use crate::geom::trim::{Coverage, Trimmed};
 use glam::DVec3;
 use std::sync::Arc;
 

@@ -20,7 +20,11 @@ use super::transient::TransientAlloc;
 use super::vertex::{LineVertex, OverlayVertex};
 
 /// The pipeline for a batch: `trimmed` when it has a coverage mask (checked against it).
-fn masked(batch: &SurfaceBatch, whole: vk::Pipeline, trimmed: vk::Pipeline) -> GpuResult<vk::Pipeline> {
+fn masked(
+    batch: &SurfaceBatch,
+    whole: vk::Pipeline,
+    trimmed: vk::Pipeline,
+) -> GpuResult<vk::Pipeline> {
     match batch.mask {
         Some(mask) => mask.check(batch.offsets.len()).map(|()| trimmed),
         None => Ok(whole),

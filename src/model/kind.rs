@@ -60,6 +60,19 @@ pub trait Kind: Clone + Debug + PartialEq + Sized + 'static {
     /// Parameter domain per direction (one entry for curves).
     fn domain(&self) -> Vec<(f64, f64)>;
 
+    /// The polynomial degree per direction, where the kind has one (B-spline and Bézier
+    /// curves and surfaces); empty otherwise. For `info` and messages.
+    fn degrees(&self) -> Vec<usize> {
+        Vec::new()
+    }
+
+    /// Per direction, the parameters where the geometry's pieces meet, ends included (the
+    /// distinct knots in the domain): quadrature lines its cells up with them, since the
+    /// geometry is smooth only in between. Default: the domain's ends.
+    fn breakpoints(&self) -> Vec<Vec<f64>> {
+        self.domain().iter().map(|&(a, b)| vec![a, b]).collect()
+    }
+
     /// Pre-evaluates and fully samples the model.
     fn sampler(&self, mode: SampleMode) -> Self::Sampler;
 

@@ -226,6 +226,10 @@ pub trait DynKind {
     fn type_name(&self) -> &'static str;
     fn is_surface(&self) -> bool;
     fn sample_dims(&self) -> [usize; 2];
+    /// The degree per direction, where the kind has one ([`Kind::degrees`]).
+    fn degrees(&self) -> Vec<usize>;
+    /// Where the geometry's pieces meet, per direction ([`Kind::breakpoints`]).
+    fn breakpoints(&self) -> Vec<Vec<f64>>;
     /// The model with other sample counts ([`Kind::with_samples`]).
     fn with_samples(&self, samples: [usize; 2]) -> Result<Model, EditError>;
     fn domain(&self) -> Vec<(f64, f64)>;
@@ -283,6 +287,14 @@ where
 
     fn sample_dims(&self) -> [usize; 2] {
         Kind::sample_dims(self)
+    }
+
+    fn breakpoints(&self) -> Vec<Vec<f64>> {
+        Kind::breakpoints(self)
+    }
+
+    fn degrees(&self) -> Vec<usize> {
+        Kind::degrees(self)
     }
 
     fn with_samples(&self, samples: [usize; 2]) -> Result<Model, EditError> {

@@ -10,11 +10,11 @@ use super::retained::{
     screen_rect, screen_rect_with, split_cells, touched_vertices, union_rect, vertex_bounds,
 };
 use super::style::{Highlight, NetMode, Palette, ViewOptions, Wire};
+use super::trim_mask::mask_words;
 use crate::editor::{
     Applied, ControlLayout, ControlsChange, Document, Handle, LOCAL_CURVE_SAMPLES,
     LOCAL_PATCH_SAMPLES, LocalEntry,
 };
-use super::trim_mask::mask_words;
 use crate::gpu::{
     FRAMES_IN_FLIGHT, Frame, GpuError, GpuResult, GridShape, GridStride, LayerPart, MapStyle,
     MaskRef, MaskSet, MaskWords, Mirror, PointRun, PointStyle, PolylineStyle, Renderer, Restore,

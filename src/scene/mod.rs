@@ -4,11 +4,13 @@
 
 pub mod edit;
 mod kept;
+mod measure;
 
 pub use crate::fields::json::{self, At, SceneError};
 pub use crate::model::{Index2, MAX_CURVE_SAMPLES, MAX_DEGREE, MAX_SURFACE_SAMPLES, Model};
 pub use edit::{EditList, parse_edits};
 pub use kept::{Carried, Kept, SceneNames};
+pub use measure::Measure;
 
 use std::borrow::Cow;
 use std::path::Path;

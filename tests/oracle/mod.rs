@@ -45,3 +45,4 @@ pub mod eval;
 pub mod random;
 pub mod rng;
 pub mod scene;
+pub mod trim_area;

@@ -16,8 +16,10 @@ use super::{De, IgesFile, Transform, Unit};
 
 /// Where the real files are; `PRESPLINE_CAD_DIR` overrides it (the main repository keeps its own copy).
 fn cad_dir() -> PathBuf {
-    std::env::var_os("PRESPLINE_CAD_DIR")
-        .map_or_else(|| PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/cad")), PathBuf::from)
+    std::env::var_os("PRESPLINE_CAD_DIR").map_or_else(
+        || PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/cad")),
+        PathBuf::from,
+    )
 }
 
 fn iges_files() -> Vec<PathBuf> {

@@ -13,8 +13,10 @@ use super::test_support::{GLOBAL, build, ent, error_line, lines, small_file, unl
 use super::{De, IgesFile};
 
 fn real_file(name: &str) -> Vec<u8> {
-    let dir = std::env::var_os("PRESPLINE_CAD_DIR")
-        .map_or_else(|| concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/cad").into(), std::path::PathBuf::from);
+    let dir = std::env::var_os("PRESPLINE_CAD_DIR").map_or_else(
+        || concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/cad").into(),
+        std::path::PathBuf::from,
+    );
     std::fs::read(dir.join(name)).unwrap()
 }
 

@@ -20,7 +20,10 @@ const CURVE_KEYS: [&str; 4] = ["line", "polyline", "bezier", "bspline"];
 pub fn read_trim(at: &At, v: &Value) -> Result<Trim, SceneError> {
     let items = as_array(at, FIELD, v)?;
     if items.is_empty() {
-        return Err(at.err(FIELD, "no loops (leave the field out for an untrimmed surface)"));
+        return Err(at.err(
+            FIELD,
+            "no loops (leave the field out for an untrimmed surface)",
+        ));
     }
     let loops = items
         .iter()
@@ -68,8 +71,12 @@ fn read_loop(at: &At, k: usize, v: &Value) -> Result<LoopSpec, SceneError> {
 /// `{"bspline": [p, …], "degree", "knots", "weights"?}`, each with an optional `"range":
 /// [t0, t1]` (reversed runs it backwards).
 fn read_piece(at: &At, what: &str, v: &Value) -> Result<TrimPiece, SceneError> {
-    let obj = as_object(at, FIELD, v)
-        .map_err(|_| at.err(FIELD, format!("{what}: expected a curve object, found {}", kind(v))))?;
+    let obj = as_object(at, FIELD, v).map_err(|_| {
+        at.err(
+            FIELD,
+            format!("{what}: expected a curve object, found {}", kind(v)),
+        )
+    })?;
     let key = CURVE_KEYS
         .into_iter()
         .find(|k| obj.contains_key(*k))
@@ -84,7 +91,10 @@ fn read_piece(at: &At, what: &str, v: &Value) -> Result<TrimPiece, SceneError> {
         "bezier" => &["weights", "range"],
         _ => &["degree", "knots", "weights", "range"],
     };
-    if let Some(other) = obj.keys().find(|k| *k != key && !allowed.contains(&k.as_str())) {
+    if let Some(other) = obj
+        .keys()
+        .find(|k| *k != key && !allowed.contains(&k.as_str()))
+    {
         return Err(at.err(
             FIELD,
             format!(
@@ -141,7 +151,10 @@ fn read_points(at: &At, what: &str, v: &Value) -> Result<Vec<DVec2>, SceneError>
                 [u, v] => Ok(DVec2::new(u, v)),
                 _ => Err(at.err(
                     FIELD,
-                    format!("{what} point {i}: expected [u, v], found {} numbers", c.len()),
+                    format!(
+                        "{what} point {i}: expected [u, v], found {} numbers",
+                        c.len()
+                    ),
                 )),
             }
         })

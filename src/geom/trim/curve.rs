@@ -73,6 +73,19 @@ pub fn flatten(
     tol: f64,
     out: &mut Vec<DVec2>,
 ) -> Result<(), TrimError> {
+    flatten_tracked(c, range, tol, out, None)
+}
+
+/// [`flatten`], also appending to `params` the curve parameter of every point appended to
+/// `out` (so each chord of the polyline is known with the stretch of curve it replaces: the
+/// area measure corrects for the lens between them).
+pub fn flatten_tracked(
+    c: &dyn Curve2,
+    range: (f64, f64),
+    tol: f64,
+    out: &mut Vec<DVec2>,
+    mut params: Option<&mut Vec<f64>>,
+) -> Result<(), TrimError> {
     if !(tol.is_finite() && tol > 0.0) {
         return Err(TrimError::BadTolerance {
             name: "flattening",
@@ -82,6 +95,9 @@ pub fn flatten(
     let spans = span_ends(c, range)?;
     let start = out.len();
     out.push(eval(c, range.0)?);
+    if let Some(p) = params.as_deref_mut() {
+        p.push(range.0);
+    }
     for pair in spans.windows(2) {
         let (t0, t1) = (pair[0], pair[1]);
         for k in 0..INITIAL_PIECES {
@@ -91,7 +107,7 @@ pub fn flatten(
             } else {
                 t0 + (t1 - t0) * (k + 1) as f64 / INITIAL_PIECES as f64
             };
-            subdivide(c, s0, s1, tol, start, out)?;
+            subdivide(c, s0, s1, tol, start, out, params.as_deref_mut())?;
         }
     }
     Ok(())
@@ -158,6 +174,7 @@ fn subdivide(
     tol: f64,
     start: usize,
     out: &mut Vec<DVec2>,
+    mut params: Option<&mut Vec<f64>>,
 ) -> Result<(), TrimError> {
     let (mut ta, mut pa) = (t0, eval(c, t0)?);
     let mut stack = vec![(t1, eval(c, t1)?)];
@@ -173,6 +190,9 @@ fn subdivide(
             continue;
         }
         out.push(pb);
+        if let Some(p) = params.as_deref_mut() {
+            p.push(tb);
+        }
         if out.len() - start > MAX_SEGMENTS {
             return Err(TrimError::TooManySegments {
                 limit: MAX_SEGMENTS,

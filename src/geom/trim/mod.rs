@@ -25,12 +25,12 @@ mod trimmed;
 
 pub use area::integrate;
 pub use coverage::{CellClass, Coverage};
-pub use curve::{Curve2, Piece, flatten, flatten_piece};
+pub use curve::{Curve2, Piece, flatten, flatten_piece, flatten_tracked};
 pub use error::TrimError;
 pub use loops::{LoopInput, Role, Tolerances};
 pub use regions::{TrimLoop, TrimRegions};
 pub use spec::{LoopSpec, Trim, TrimCurve, TrimPiece};
-pub use trimmed::{FLATTEN_TOLERANCE, Trimmed};
+pub use trimmed::{FLATTEN_TOLERANCE, Trimmed, flatten_tolerance};
 
 #[cfg(test)]
 mod tests;

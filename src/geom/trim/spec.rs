@@ -6,10 +6,10 @@
 //! Parameter-space curves are B-spline curves with z = 0, so one evaluator (de Boor in
 //! homogeneous coordinates, `geom::bspline`) serves trims and space curves alike.
 
+use super::loops::Role;
 use crate::geom::bspline::BSplineCurve;
 use crate::geom::error::{GeomError, GeomResult};
 use crate::geom::knots::KnotVector;
-use super::loops::Role;
 use glam::DVec2;
 
 /// One curve of a trim loop, in the surface's (u, v).
@@ -29,7 +29,10 @@ impl TrimCurve {
         if points.len() < 2 {
             return Err(GeomError::new(
                 "points",
-                format!("a line or polyline needs at least 2 points, found {}", points.len()),
+                format!(
+                    "a line or polyline needs at least 2 points, found {}",
+                    points.len()
+                ),
             ));
         }
         if let Some(k) = points.iter().position(|p| !p.is_finite()) {
@@ -51,10 +54,17 @@ impl TrimCurve {
 
     /// A 2D Bézier curve on [0, 1] (rational with weights).
     pub fn bezier(points: &[DVec2], weights: Option<Vec<f64>>) -> GeomResult<Self> {
-        let d = points.len().checked_sub(1).filter(|&d| d >= 1).ok_or_else(|| {
-            GeomError::new("points", "a Bézier curve needs at least 2 points")
-        })?;
-        Self::bspline(d, KnotVector::bezier(d, 0.0, 1.0).into_vec(), points, weights)
+        let d = points
+            .len()
+            .checked_sub(1)
+            .filter(|&d| d >= 1)
+            .ok_or_else(|| GeomError::new("points", "a Bézier curve needs at least 2 points"))?;
+        Self::bspline(
+            d,
+            KnotVector::bezier(d, 0.0, 1.0).into_vec(),
+            points,
+            weights,
+        )
     }
 
     /// The parameter domain.
@@ -80,6 +90,27 @@ impl TrimCurve {
             Self::Spline(c) => {
                 let (a, b) = c.domain();
                 c.eval(t.clamp(a, b)).truncate()
+            }
+        }
+    }
+
+    /// The derivative dc/dt at `t` (clamped to the domain; a polyline's on the segment `t`
+    /// falls in, the last one at its end).
+    #[must_use]
+    pub fn tangent(&self, t: f64) -> DVec2 {
+        match self {
+            Self::Polyline(p) => {
+                let last = p.len().saturating_sub(1);
+                let k = (t.clamp(0.0, last as f64).floor() as usize).min(last.saturating_sub(1));
+                p.get(k + 1)
+                    .zip(p.get(k))
+                    .map_or(DVec2::ZERO, |(b, a)| *b - *a)
+            }
+            Self::Spline(c) => {
+                let (a, b) = c.domain();
+                c.derivatives(t.clamp(a, b), 1)
+                    .get(1)
+                    .map_or(DVec2::ZERO, |d| d.truncate())
             }
         }
     }

@@ -16,6 +16,12 @@ use std::sync::Arc;
 /// until a zoom of 10,000×. It stays below the gap tolerance (1e-6), as flattening must.
 pub const FLATTEN_TOLERANCE: f64 = 1e-7;
 
+/// The flattening tolerance in parameter units for a surface of parameter `domain`.
+#[must_use]
+pub fn flatten_tolerance(domain: [(f64, f64); 2]) -> f64 {
+    FLATTEN_TOLERANCE * (domain[0].1 - domain[0].0).hypot(domain[1].1 - domain[1].0)
+}
+
 impl Curve2 for TrimCurve {
     fn domain(&self) -> (f64, f64) {
         TrimCurve::domain(self)
@@ -78,8 +84,7 @@ impl Trimmed {
         if spec.loops.is_empty() {
             return Err(TrimError::NoLoops);
         }
-        let diagonal = (domain[0].1 - domain[0].0).hypot(domain[1].1 - domain[1].0);
-        let tol = FLATTEN_TOLERANCE * diagonal;
+        let tol = flatten_tolerance(domain);
         let mut inputs = Vec::with_capacity(spec.loops.len());
         for (k, l) in spec.loops.iter().enumerate() {
             if l.pieces.is_empty() {

@@ -62,6 +62,15 @@ impl Kind for CurveModel {
         vec![self.curve().domain()]
     }
 
+    fn degrees(&self) -> Vec<usize> {
+        vec![self.curve().degree()]
+    }
+
+    fn breakpoints(&self) -> Vec<Vec<f64>> {
+        let (a, b) = self.curve().domain();
+        vec![distinct_in(self.curve().knots().as_slice(), a, b)]
+    }
+
     fn sampler(&self, mode: SampleMode) -> SplineCurveSampler {
         SplineCurveSampler::new(self.clone(), mode.layout().0)
     }
@@ -162,6 +171,20 @@ impl Kind for SurfaceModel {
         self.surface().domain().to_vec()
     }
 
+    fn degrees(&self) -> Vec<usize> {
+        self.surface().degree().to_vec()
+    }
+
+    fn breakpoints(&self) -> Vec<Vec<f64>> {
+        let s = self.surface();
+        (0..2)
+            .map(|dir| {
+                let (a, b) = s.domain()[dir];
+                distinct_in(s.knots()[dir].as_slice(), a, b)
+            })
+            .collect()
+    }
+
     fn sampler(&self, mode: SampleMode) -> SplineSurfaceSampler {
         let (_, set, normals) = mode.layout();
         SplineSurfaceSampler::new(self.clone(), set, normals)
@@ -240,4 +263,13 @@ fn table_key(directions: &[(&[f64], usize, usize, usize)]) -> u64 {
         (degree, count, samples).hash(&mut h);
     }
     h.finish()
+}
+
+/// The distinct values of `knots` in [a, b], a and b included.
+fn distinct_in(knots: &[f64], a: f64, b: f64) -> Vec<f64> {
+    let mut out = vec![a];
+    out.extend(knots.iter().copied().filter(|&k| k > a && k < b));
+    out.push(b);
+    out.dedup();
+    out
 }

@@ -8,8 +8,10 @@ use super::super::{EntityRef, StepFile};
 use super::{all_close, close, count_instances, ok, touch_all};
 
 fn cad_dir() -> PathBuf {
-    std::env::var_os("PRESPLINE_CAD_DIR")
-        .map_or_else(|| PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/cad")), PathBuf::from)
+    std::env::var_os("PRESPLINE_CAD_DIR").map_or_else(
+        || PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/cad")),
+        PathBuf::from,
+    )
 }
 
 /// Every `.stp`/`.step` file in the CAD folder, sorted; fails if there is none, so that a moved
