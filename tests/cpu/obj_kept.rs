@@ -578,8 +578,8 @@ fn bad_obj_fields_are_one_line_errors() {
         ),
         (
             "vp without values",
-            "[[0.0, 0.0], ",
-            "[[], ",
+            "\"parameter_vertices\": [[0.0, 0.0], ",
+            "\"parameter_vertices\": [[], ",
             "vp takes 1 to 3",
         ),
     ];

@@ -592,11 +592,6 @@ fn spec_trimming_example_reads_with_warnings_and_an_exact_cut() {
                 13,
                 "'sp' kept for saving, not applied (special point; on the curv) (3 times, first here)"
             ),
-            (23, "'curv2' (trimming curve) kept for saving, not drawn"),
-            (
-                41,
-                "'trim' kept for saving, not applied (outer trimming loop"
-            ),
         ],
         "{:?}",
         import.warnings

@@ -3,6 +3,8 @@
 
 use super::ObjError;
 use super::erbs;
+use super::trims;
+use crate::geom::trim::Trimmed;
 use super::kept::ObjKept;
 use super::model::{Basis, Direction, FreeForm};
 use crate::geom::error::GeomResult;
@@ -50,6 +52,16 @@ pub fn element_to_object(e: &FreeForm, name: String) -> Result<SceneObject, ObjE
             .map_or_else(|| default_surface_samples(&s), |m| [m[0], m[1]]);
         Model::Surface(SurfaceModel::new(form, s, m).map_err(invalid)?)
     };
+    let trim = match trims::trim_of(&e.carried) {
+        Ok(Some(spec)) if model.is_surface() => {
+            let d = model.domain();
+            Some(Trimmed::new(spec, [d[0], d[1]]).map_err(|t| {
+                ObjError::new(e.line, format!("{}: trim: {t}", e.keyword()))
+            })?)
+        }
+        Ok(_) => None,
+        Err(t) => return Err(ObjError::new(e.line, format!("{}: {t}", e.keyword()))),
+    };
     Ok(SceneObject {
         name,
         model,
@@ -59,7 +71,7 @@ pub fn element_to_object(e: &FreeForm, name: String) -> Result<SceneObject, ObjE
         } else {
             Carried::of(Box::new(e.carried.clone()))
         },
-        trim: None,
+        trim,
     })
 }
 

@@ -14,6 +14,7 @@ mod lex;
 mod map;
 pub mod model;
 mod read;
+mod trims;
 mod write;
 
 pub use map::{default_curve_samples, default_surface_samples};

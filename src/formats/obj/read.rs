@@ -670,16 +670,19 @@ impl Reader {
                 body.curves.push(([u0, u1], curve));
             }
         }
+        // `trim` and `hole` are applied (formats/obj/trims.rs); special curves and points are
+        // only kept.
         let what = match keyword {
-            "trim" => "outer trimming loop: the surface is shown untrimmed",
-            "hole" => "trimming hole: the surface is shown without it",
-            "scrv" => "special curve",
-            _ => "special point",
+            "trim" | "hole" => None,
+            "scrv" => Some("special curve"),
+            _ => Some("special point"),
         };
         let on = open.kind.word();
-        self.warnings.add(keyword, s.line, || {
-            format!("'{keyword}' kept for saving, not applied ({what}; on the {on})")
-        });
+        if let Some(what) = what {
+            self.warnings.add(keyword, s.line, || {
+                format!("'{keyword}' kept for saving, not applied ({what}; on the {on})")
+            });
+        }
         if let Some(open) = &mut self.open {
             open.body.push(body);
         }
@@ -760,10 +763,9 @@ impl Reader {
             ));
         };
         if open.kind == ElementKind::Curve2 {
+            // Trims draw with their curves; a curve nothing names is kept silently, like the
+            // `scrv` and `sp` statements that name the rest (warned about there).
             let c = Self::curve2(open)?;
-            self.warnings.add("curv2", c.line, || {
-                "'curv2' (trimming curve) kept for saving, not drawn".into()
-            });
             self.curves2.push(c);
             return Ok(());
         }
