@@ -4,7 +4,7 @@
 use super::CliError;
 use super::args::{MemoryArgs, SamplesArgs};
 use super::load::load_scene;
-use crate::editor::{Editor, EditorOptions, ListRefused};
+use crate::editor::{Editor, EditorOptions, ListRefused, TrimCoverage};
 use crate::model::SampledObject;
 use crate::sampling::SampleMode;
 use crate::sampling::budget::Uses;
@@ -89,14 +89,19 @@ fn sample_text(args: &SampleArgs) -> Result<String, CliError> {
     let mut out = String::with_capacity(1 << 16);
     out.push_str("{\"objects\": [\n");
     for (i, (meta, obj)) in doc.objects.iter().zip(&objects).enumerate() {
-        write_object(&mut out, &meta.name, obj)?;
+        write_object(&mut out, &meta.name, obj, meta.trim.as_deref())?;
         out.push_str(if i + 1 < objects.len() { ",\n" } else { "\n" });
     }
     out.push_str("]}\n");
     Ok(out)
 }
 
-fn write_object(out: &mut String, name: &str, obj: &SampledObject) -> Result<(), CliError> {
+fn write_object(
+    out: &mut String,
+    name: &str,
+    obj: &SampledObject,
+    trim: Option<&TrimCoverage>,
+) -> Result<(), CliError> {
     let grid = obj.grid();
     if let Some(bad) = grid.data.iter().position(|v| !v.is_finite()) {
         return Err(CliError(format!(
@@ -138,7 +143,27 @@ fn write_object(out: &mut String, name: &str, obj: &SampledObject) -> Result<(),
             }
             out.push(']');
         }
-        out.push_str("]}");
+        out.push(']');
+        if let Some(t) = trim {
+            // Which samples lie inside the trim (docs/scene-format.md, "Trims").
+            out.push_str(", \"inside\": [");
+            for i in 0..mu {
+                out.push_str(if i == 0 { "[" } else { ", [" });
+                for j in 0..mv {
+                    if j > 0 {
+                        out.push_str(", ");
+                    }
+                    out.push_str(if t.coverage.sample_inside(i, j) {
+                        "true"
+                    } else {
+                        "false"
+                    });
+                }
+                out.push(']');
+            }
+            out.push(']');
+        }
+        out.push('}');
     } else {
         numbers(out, params[0]);
         out.push_str(", \"samples\": [");

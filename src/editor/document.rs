@@ -75,6 +75,14 @@ impl DocObject {
         }
     }
 
+    /// Whether sample (i, j) is drawn: inside the trim of a trimmed surface, always otherwise.
+    #[must_use]
+    pub fn drawn(&self, i: usize, j: usize) -> bool {
+        self.trim
+            .as_ref()
+            .is_none_or(|t| t.coverage.sample_inside(i, j))
+    }
+
     /// The scene object it stands for now (every applied edit in).
     #[must_use]
     pub fn to_scene_object(&self) -> SceneObject {
@@ -240,7 +248,7 @@ impl Document {
         })
     }
 
-    /// Bounds of every sample and control point.
+    /// Bounds of every drawn sample (a trimmed surface's inside ones) and control point.
     #[must_use]
     pub fn bounds(&self) -> Bounds {
         // A pass over every sample of the scene: per object on every core, then merged (a
@@ -248,8 +256,20 @@ impl Document {
         let each = crate::parallel::map(&self.objects, |o| {
             let mut b = Bounds::EMPTY;
             let g = o.sampled.grid();
-            for p in g.data.iter().step_by(g.stride()) {
-                b.include(*p);
+            match &o.trim {
+                None => {
+                    for p in g.data.iter().step_by(g.stride()) {
+                        b.include(*p);
+                    }
+                }
+                Some(t) => {
+                    let [rows, cols] = g.dims;
+                    for i in 0..rows {
+                        for j in (0..cols).filter(|&j| t.coverage.sample_inside(i, j)) {
+                            b.include(g.position(i, j));
+                        }
+                    }
+                }
             }
             for p in o.controls.grip_points() {
                 b.include(p);

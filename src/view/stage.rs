@@ -174,8 +174,9 @@ impl Stage {
             .or_else(|| self.object_near_cursor());
     }
 
-    /// The object with a sample projecting within 24 pixels of the cursor (every 4th sample per
-    /// direction is enough to find an object), nearest in depth.
+    /// The object with a drawn sample projecting within 24 pixels of the cursor (every 4th
+    /// sample per direction is enough to find an object; outside a trim nothing is drawn, so
+    /// nothing is picked), nearest in depth.
     fn object_near_cursor(&self) -> Option<usize> {
         let view = self.view();
         let mut best: Option<(f64, usize)> = None;
@@ -183,7 +184,7 @@ impl Stage {
             let g = o.sampled.grid();
             let [rows, cols] = g.dims;
             for r in (0..rows).step_by(4) {
-                for c in (0..cols).step_by(4) {
+                for c in (0..cols).step_by(4).filter(|&c| o.drawn(r, c)) {
                     let Some((x, y, depth)) = view.project_depth(g.position(r, c)) else {
                         continue;
                     };

@@ -110,7 +110,13 @@ pub fn object_to_element(o: &SceneObject) -> Result<FreeForm, SceneError> {
         vec![dims[0]]
     });
     e.color = o.color;
-    e.carried = o.kept.get::<ObjKept>().cloned().unwrap_or_default();
+    // The statements an OBJ file gave are written back as they were; a trim from anywhere
+    // else is written as vp, curv2 and trim/hole statements.
+    e.carried = match (o.kept.get::<ObjKept>(), &o.trim) {
+        (Some(kept), _) => kept.clone(),
+        (None, Some(t)) if o.model.is_surface() => trims::kept_of(t),
+        (None, _) => ObjKept::default(),
+    };
     Ok(e)
 }
 
