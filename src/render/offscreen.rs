@@ -44,7 +44,7 @@ pub fn shot_camera(doc: &Document, shot: &Shot) -> OrbitCamera {
     })
 }
 
-/// What the default framing fits: the drawn samples, and the control points of the objects
+/// What the default framing fits: the drawn samples (a trimmed surface's inside ones), and the control points of the objects
 /// whose nets are drawn (`nets(i)`; hidden ones, such as ERBS local patches' points above a
 /// surface, would leave an empty band), every k-th of them so that at most about 8192 are
 /// projected per fitting step.
@@ -64,7 +64,19 @@ pub fn framing_points(doc: &Document, nets: impl Fn(usize) -> bool) -> Vec<DVec3
     let mut points: Vec<DVec3> = handles.into_iter().step_by(every).collect();
     for o in &doc.objects {
         let g = o.sampled.grid();
-        points.extend(g.data.iter().step_by(g.stride() * every).copied());
+        match &o.trim {
+            None => points.extend(g.data.iter().step_by(g.stride() * every).copied()),
+            // Only what is drawn: the samples inside the trim.
+            Some(_) => {
+                let cols = g.dims[1].max(1);
+                points.extend(
+                    (0..g.dims[0] * g.dims[1])
+                        .step_by(every)
+                        .filter(|k| o.drawn(k / cols, k % cols))
+                        .map(|k| g.position(k / cols, k % cols)),
+                );
+            }
+        }
     }
     points
 }

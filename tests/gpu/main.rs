@@ -18,3 +18,4 @@ mod render_golden;
 mod render_lod;
 mod render_mirror;
 mod retained;
+mod trims;
