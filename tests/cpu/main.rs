@@ -31,4 +31,5 @@ mod structural_edits;
 mod structural_shape;
 mod support;
 mod trim_area;
+mod trims;
 mod undo_chains;
