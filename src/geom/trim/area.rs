@@ -219,12 +219,22 @@ impl<F: Fn(f64, f64) -> f64> Ctx<'_, F> {
         }
         let c = self.coefficients(&fv);
         let to_local = |p: DVec2| DVec2::new((p.x - um) / hu, (p.y - vm) / hv);
+        // The rounding error of `to_local`, per coordinate: a few ulps of the cell's position
+        // relative to its size.
+        let slack = DVec2::new(
+            8.0 * f64::EPSILON * (um.abs() + hu) / hu,
+            8.0 * f64::EPSILON * (vm.abs() + hv) / hv,
+        );
         let mut s = 0.0;
         for &id in self.coverage.cell_segments(i, j) {
             let Some([a, b]) = self.regions.segment(id as usize) else {
                 continue;
             };
-            if let Some([a, b]) = clip(to_local(a), to_local(b), -1.0, 1.0) {
+            // A segment on the cell's edge (trims run along knot lines and domain edges) maps
+            // to local x or y = ±1 give or take the rounding of the transform: snapped onto
+            // the edge, it counts as lying on it rather than just outside (clipped away).
+            let (a, b) = (snap(to_local(a), slack), snap(to_local(b), slack));
+            if let Some([a, b]) = clip(a, b, -1.0, 1.0) {
                 s += segment_integral(&c, a, b);
             }
         }
@@ -296,6 +306,20 @@ impl<F: Fn(f64, f64) -> f64> Ctx<'_, F> {
     }
 }
 
+/// `p` with each coordinate within `slack` of ±1 set to ±1 (a point on the cell's edge).
+fn snap(p: DVec2, slack: DVec2) -> DVec2 {
+    let one = |x: f64, e: f64| {
+        if (x - 1.0).abs() <= e {
+            1.0
+        } else if (x + 1.0).abs() <= e {
+            -1.0
+        } else {
+            x
+        }
+    };
+    DVec2::new(one(p.x, slack.x), one(p.y, slack.y))
+}
+
 /// `∫ F dy` along the segment `a`–`b` (local coordinates), `F(x, y) = Σ c_kl Q_k(x) P_l(y)`:
 /// 6 Gauss nodes, exact for the degree-11 polynomial.
 #[must_use]
@@ -317,4 +341,44 @@ fn segment_integral(c: &[[f64; N]; N], a: DVec2, b: DVec2) -> f64 {
         s += 0.5 * GL_W[n] * fxy;
     }
     s * d.y
+}
+
+#[cfg(test)]
+mod grid_line_tests {
+    use super::*;
+    use crate::geom::trim::loops::{LoopInput, Role, Tolerances};
+    use std::f64::consts::PI;
+
+    fn area_of(rect: [f64; 4], domain: [(f64, f64); 2], cells: [usize; 2]) -> f64 {
+        let [a, b, c, d] = rect;
+        let input = LoopInput {
+            pieces: vec![vec![
+                DVec2::new(a, c),
+                DVec2::new(b, c),
+                DVec2::new(b, d),
+                DVec2::new(a, d),
+                DVec2::new(a, c),
+            ]],
+            role: Some(Role::Outer),
+        };
+        let regions = TrimRegions::new(&[input], domain, &Tolerances::default()).unwrap();
+        let axis = |(lo, hi): (f64, f64), n: usize| -> Vec<f64> {
+            (0..=n).map(|k| lo + (hi - lo) * k as f64 / n as f64).collect()
+        };
+        let (u, v) = (axis(domain[0], cells[0]), axis(domain[1], cells[1]));
+        let coverage = Coverage::new(&regions, &u, &v).unwrap();
+        integrate(&regions, &u, &v, &coverage, |_, _| 1.0).unwrap()
+    }
+
+    /// A trim edge lying on a grid line of the integration grid (trims along knot lines and
+    /// domain edges are common in CAD faces) is counted once, on either side.
+    #[test]
+    fn a_boundary_on_a_grid_line_is_counted_once() {
+        for cells in [8, 16, 32] {
+            let got = area_of([0.0, PI, 0.0, 1.0], [(0.0, 2.0 * PI), (0.0, 1.0)], [cells, cells]);
+            assert!((got - PI).abs() < 1e-12, "{cells} cells: {got}");
+        }
+        let got = area_of([0.25, 0.75, 0.25, 0.5], [(0.0, 1.0), (0.0, 1.0)], [4, 4]);
+        assert!((got - 0.125).abs() < 1e-14, "{got}");
+    }
 }
