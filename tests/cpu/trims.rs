@@ -24,7 +24,8 @@ fn scene_with(trim: &str) -> String {
     )
 }
 
-const SQUARE: &str = r#"{"polyline": [[0.1, 0.1], [0.9, 0.1], [0.9, 0.9], [0.1, 0.9], [0.1, 0.1]]}"#;
+const SQUARE: &str =
+    r#"{"polyline": [[0.1, 0.1], [0.9, 0.1], [0.9, 0.9], [0.1, 0.9], [0.1, 0.1]]}"#;
 
 /// `prespline info` of the scene: (success, stdout, stderr).
 fn info(scene: &str) -> (bool, String, String) {
@@ -96,7 +97,10 @@ fn bad_trims_are_one_line_errors() {
     let (ok, _, stderr) = info(&scene_with(
         r#"[{"outer": [{"polyline": [[0.1, 0.1], [1e999, 0.1], [0.5, 0.9], [0.1, 0.1]]}]}]"#,
     ));
-    assert!(!ok && stderr.lines().count() == 1 && stderr.contains("invalid JSON"), "{stderr}");
+    assert!(
+        !ok && stderr.lines().count() == 1 && stderr.contains("invalid JSON"),
+        "{stderr}"
+    );
     let dir = Scratch::new("trims");
     let obj = dir.file(
         "nan.obj",
@@ -148,12 +152,19 @@ fn trims_convert_to_obj_and_back_exactly() {
             .arg(to)
             .output()
             .unwrap();
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
     }
     let again = prespline::formats::read_json(&back).unwrap();
     let (a, b) = (&original.objects[0], &again.objects[0]);
     assert_eq!(a.model, b.model, "control data bit for bit");
-    let (ta, tb) = (a.trim.as_ref().unwrap().spec(), b.trim.as_ref().unwrap().spec());
+    let (ta, tb) = (
+        a.trim.as_ref().unwrap().spec(),
+        b.trim.as_ref().unwrap().spec(),
+    );
     assert_eq!(ta.loops.len(), tb.loops.len());
     for (la, lb) in ta.loops.iter().zip(&tb.loops) {
         // Every curve and range bit for bit (the roles OBJ writes are the ones nesting gave).
@@ -161,7 +172,13 @@ fn trims_convert_to_obj_and_back_exactly() {
     }
     let inside = |s: &Scene| {
         let doc = prespline::editor::Document::new(s);
-        doc.objects[0].trim.as_ref().unwrap().coverage.inside().to_vec()
+        doc.objects[0]
+            .trim
+            .as_ref()
+            .unwrap()
+            .coverage
+            .inside()
+            .to_vec()
     };
     assert_eq!(inside(&original), inside(&again));
 }
@@ -182,7 +199,13 @@ fn inside_after(scene: &Scene, edits: &str) -> (Vec<bool>, Scene) {
         .submit_list(&EditList::parse(edits).unwrap())
         .unwrap_or_else(|e| panic!("{e:?}"));
     let doc = editor.into_document();
-    let inside = doc.objects[0].trim.as_ref().unwrap().coverage.inside().to_vec();
+    let inside = doc.objects[0]
+        .trim
+        .as_ref()
+        .unwrap()
+        .coverage
+        .inside()
+        .to_vec();
     (inside, doc.to_scene())
 }
 
@@ -205,7 +228,10 @@ fn edits_keep_the_trim_and_what_lies_inside() {
         {"object": "face", "insert_knot": {"u": 0.37}},
         {"object": "face", "elevate_degree": {"u": 1, "v": 0}}]"#;
     let (after, edited) = inside_after(&scene, edits);
-    assert_eq!(before, after, "the samples inside the trim are the same after the edits");
+    assert_eq!(
+        before, after,
+        "the samples inside the trim are the same after the edits"
+    );
     assert_eq!(
         edited.objects[0].trim, scene.objects[0].trim,
         "the trim is unchanged in parameter space"
@@ -235,8 +261,14 @@ fn undo_after_edits_gives_back_the_trimmed_scene() {
     let edits = r#"[{"object": "face", "point": [3, 2], "delta": [0.1, 0.2, -0.3]},
         {"object": "face", "insert_knot": {"v": 0.6}},
         {"object": "face", "point": [0, 0], "delta": [0.5, 0, 0]}]"#;
-    editor.submit_list(&EditList::parse(edits).unwrap()).unwrap();
+    editor
+        .submit_list(&EditList::parse(edits).unwrap())
+        .unwrap();
     while editor.undo().is_some() {}
     let doc = editor.into_document();
-    assert_eq!(doc.to_scene(), scene, "undo restores model and trim exactly");
+    assert_eq!(
+        doc.to_scene(),
+        scene,
+        "undo restores model and trim exactly"
+    );
 }

@@ -575,10 +575,26 @@ fn trimmed_scene(rng: &mut Rng) -> Scene {
     let curved = r#""trim": [{"loop": [{"bspline": [[0.2, 0.1], [1.5, 0.02], [2.8, 0.1], [2.9, 0.9], [1.5, 0.98], [0.1, 0.9], [0.2, 0.1]], "degree": 3, "knots": [0, 0, 0, 0, 0.25, 0.5, 0.75, 1, 1, 1, 1]}]}], "#;
     let ring = r#""trim": [{"loop": [{"polyline": [[0.05, 0.1], [0.95, 0.1], [0.95, 2.9], [0.05, 2.9], [0.05, 0.1]]}]}, {"loop": [{"polyline": [[0.2, 0.5], [0.2, 2.5], [0.8, 2.5], [0.8, 0.5], [0.2, 0.5]]}]}, {"loop": [{"polyline": [[0.4, 1.0], [0.6, 1.0], [0.6, 2.0], [0.4, 2.0], [0.4, 1.0]]}]}], "#;
     let text = json
-        .replacen("{\"name\": \"bez\", ", &format!("{{\"name\": \"bez\", {unit}"), 1)
-        .replacen("{\"name\": \"twin\", ", &format!("{{\"name\": \"twin\", {unit}"), 1)
-        .replacen("{\"name\": \"bsp\", ", &format!("{{\"name\": \"bsp\", {curved}"), 1)
-        .replacen("{\"name\": \"nurbs\", ", &format!("{{\"name\": \"nurbs\", {ring}"), 1);
+        .replacen(
+            "{\"name\": \"bez\", ",
+            &format!("{{\"name\": \"bez\", {unit}"),
+            1,
+        )
+        .replacen(
+            "{\"name\": \"twin\", ",
+            &format!("{{\"name\": \"twin\", {unit}"),
+            1,
+        )
+        .replacen(
+            "{\"name\": \"bsp\", ",
+            &format!("{{\"name\": \"bsp\", {curved}"),
+            1,
+        )
+        .replacen(
+            "{\"name\": \"nurbs\", ",
+            &format!("{{\"name\": \"nurbs\", {ring}"),
+            1,
+        );
     let scene = parse_scene(&text).unwrap();
     assert_eq!(
         scene.objects.iter().filter(|o| o.trim.is_some()).count(),
@@ -603,7 +619,11 @@ fn trimmed_surfaces_redraw_retained_exactly_as_in_full() {
             for _ in 0..2 {
                 let h = handle_of(&pair, &mut rng, object);
                 let script = drag(&mut rng, h, object == 3, 5);
-                check(&mut pair, &script, &format!("seed {seed}: trimmed drag of {h:?}"));
+                check(
+                    &mut pair,
+                    &script,
+                    &format!("seed {seed}: trimmed drag of {h:?}"),
+                );
             }
         }
         assert!(

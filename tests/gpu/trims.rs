@@ -7,7 +7,7 @@ use crate::common;
 
 use glam::{DMat4, DVec2, DVec3, DVec4};
 use prespline::editor::Document;
-use prespline::formats::{load, parse_scene, LoadOptions, SampleDefaults};
+use prespline::formats::{LoadOptions, SampleDefaults, load, parse_scene};
 use prespline::gpu::Pixels;
 use prespline::render::offscreen::{Shot, render_document, shot_camera};
 use prespline::render::{OrbitCamera, ViewOptions};
@@ -46,9 +46,18 @@ fn render(scene: &Scene, shot: &Shot) -> Pixels {
 #[test]
 fn the_obj_specification_trimming_examples_render_trimmed() {
     for (file, golden) in [
-        ("tests/data/obj_spec_trimming_with_holes.obj", "trim_obj_holes"),
-        ("tests/data/obj_spec_special_curve.obj", "trim_obj_special_curve"),
-        ("tests/data/obj_spec_special_points.obj", "trim_obj_special_points"),
+        (
+            "tests/data/obj_spec_trimming_with_holes.obj",
+            "trim_obj_holes",
+        ),
+        (
+            "tests/data/obj_spec_special_curve.obj",
+            "trim_obj_special_curve",
+        ),
+        (
+            "tests/data/obj_spec_special_points.obj",
+            "trim_obj_special_points",
+        ),
         ("tests/data/obj_kept_statements.obj", "trim_obj_connected"),
         ("examples/trimmed_surface.json", "trim_json_example"),
     ] {
@@ -68,7 +77,11 @@ fn plane_disc(r: f64) -> Scene {
         let rr = if k % 2 == 0 { r } else { r * 2f64.sqrt() };
         let p = c + rr * DVec2::new(a.cos(), a.sin());
         pts.push(format!("[{:?}, {:?}]", p.x, p.y));
-        w.push(if k % 2 == 0 { 1.0 } else { std::f64::consts::FRAC_1_SQRT_2 });
+        w.push(if k % 2 == 0 {
+            1.0
+        } else {
+            std::f64::consts::FRAC_1_SQRT_2
+        });
     }
     let text = format!(
         r#"{{"objects": [{{"name": "plane", "type": "bspline_surface", "degree": [1, 1],
@@ -125,7 +138,10 @@ fn worst_boundary_error(scene: &Scene, r_exact: f64) -> f64 {
             }
         }
     }
-    assert!(crossings >= h / 2, "the boundary is not in the picture ({crossings} crossings)");
+    assert!(
+        crossings >= h / 2,
+        "the boundary is not in the picture ({crossings} crossings)"
+    );
     worst
 }
 

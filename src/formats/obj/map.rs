@@ -3,11 +3,11 @@
 
 use super::ObjError;
 use super::erbs;
-use super::trims;
-use crate::geom::trim::Trimmed;
 use super::kept::ObjKept;
 use super::model::{Basis, Direction, FreeForm};
+use super::trims;
 use crate::geom::error::GeomResult;
+use crate::geom::trim::Trimmed;
 use crate::geom::{BSplineCurve, GeomError, TensorSurface};
 use crate::model::{CurveModel, EditError, Model, ModelRef, SplineForm, SurfaceModel};
 use crate::scene::{Carried, SceneError, SceneObject};
@@ -55,9 +55,10 @@ pub fn element_to_object(e: &FreeForm, name: String) -> Result<SceneObject, ObjE
     let trim = match trims::trim_of(&e.carried) {
         Ok(Some(spec)) if model.is_surface() => {
             let d = model.domain();
-            Some(Trimmed::new(spec, [d[0], d[1]]).map_err(|t| {
-                ObjError::new(e.line, format!("{}: trim: {t}", e.keyword()))
-            })?)
+            Some(
+                Trimmed::new(spec, [d[0], d[1]])
+                    .map_err(|t| ObjError::new(e.line, format!("{}: trim: {t}", e.keyword())))?,
+            )
         }
         Ok(_) => None,
         Err(t) => return Err(ObjError::new(e.line, format!("{}: {t}", e.keyword()))),

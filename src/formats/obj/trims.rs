@@ -52,7 +52,11 @@ fn curve_of(kept: &ObjKept, c: &Curve2) -> Result<TrimCurve, String> {
     let basis = match c.basis.as_str() {
         "bezier" => Basis::Bezier,
         "bspline" => Basis::BSpline,
-        other => return Err(format!("a {other} curve cannot bound a trim (bezier or bspline)")),
+        other => {
+            return Err(format!(
+                "a {other} curve cannot bound a trim (bezier or bspline)"
+            ));
+        }
     };
     let mut points = Vec::with_capacity(c.vertices.len());
     let mut weights = Vec::with_capacity(c.vertices.len());

@@ -363,7 +363,9 @@ mod grid_line_tests {
         };
         let regions = TrimRegions::new(&[input], domain, &Tolerances::default()).unwrap();
         let axis = |(lo, hi): (f64, f64), n: usize| -> Vec<f64> {
-            (0..=n).map(|k| lo + (hi - lo) * k as f64 / n as f64).collect()
+            (0..=n)
+                .map(|k| lo + (hi - lo) * k as f64 / n as f64)
+                .collect()
         };
         let (u, v) = (axis(domain[0], cells[0]), axis(domain[1], cells[1]));
         let coverage = Coverage::new(&regions, &u, &v).unwrap();
@@ -375,7 +377,11 @@ mod grid_line_tests {
     #[test]
     fn a_boundary_on_a_grid_line_is_counted_once() {
         for cells in [8, 16, 32] {
-            let got = area_of([0.0, PI, 0.0, 1.0], [(0.0, 2.0 * PI), (0.0, 1.0)], [cells, cells]);
+            let got = area_of(
+                [0.0, PI, 0.0, 1.0],
+                [(0.0, 2.0 * PI), (0.0, 1.0)],
+                [cells, cells],
+            );
             assert!((got - PI).abs() < 1e-12, "{cells} cells: {got}");
         }
         let got = area_of([0.25, 0.75, 0.25, 0.5], [(0.0, 1.0), (0.0, 1.0)], [4, 4]);

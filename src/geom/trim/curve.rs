@@ -34,6 +34,14 @@ pub trait Curve2 {
     fn breaks(&self) -> &[f64] {
         &[]
     }
+
+    /// An upper bound of |c''(t)| on `[t0, t1]` (inside one span between breaks), where the
+    /// curve can give one: flattening then spaces the span's points evenly, as many as the
+    /// bound asks, instead of bisecting (half the points, a quarter of the evaluations).
+    /// Default: none.
+    fn second_derivative_bound(&self, _t0: f64, _t1: f64) -> Option<f64> {
+        None
+    }
 }
 
 /// One piece of a trim loop before flattening.
@@ -100,6 +108,9 @@ pub fn flatten_tracked(
     }
     for pair in spans.windows(2) {
         let (t0, t1) = (pair[0], pair[1]);
+        if even_span(c, t0, t1, tol, out, params.as_deref_mut())? {
+            continue;
+        }
         for k in 0..INITIAL_PIECES {
             let s0 = t0 + (t1 - t0) * k as f64 / INITIAL_PIECES as f64;
             let s1 = if k + 1 == INITIAL_PIECES {
@@ -111,6 +122,53 @@ pub fn flatten_tracked(
         }
     }
     Ok(())
+}
+
+/// Flattens `[t0, t1]` by evenly spaced parameters where the curve bounds its second
+/// derivative there: a chord over a parameter step `h` departs from the curve by at most
+/// `h² max|c''| / 8`, so `n = ⌈|t1 − t0| √(M / 8 tol)⌉` pieces meet `tol`; each piece's midpoint
+/// is checked besides, and any miss (an underestimated bound) leaves the span to bisection.
+/// Returns whether the span was done.
+fn even_span(
+    c: &dyn Curve2,
+    t0: f64,
+    t1: f64,
+    tol: f64,
+    out: &mut Vec<DVec2>,
+    mut params: Option<&mut Vec<f64>>,
+) -> Result<bool, TrimError> {
+    let Some(m) = c.second_derivative_bound(t0.min(t1), t0.max(t1)) else {
+        return Ok(false);
+    };
+    let n = ((t1 - t0).abs() * (m / (8.0 * tol)).sqrt()).ceil();
+    if !n.is_finite() || n > MAX_SEGMENTS as f64 {
+        return Ok(false);
+    }
+    let n = (n as usize).max(1);
+    let mark = (out.len(), params.as_ref().map(|p| p.len()));
+    let mut prev = eval(c, t0)?;
+    for k in 1..=n {
+        let t = if k == n {
+            t1
+        } else {
+            t0 + (t1 - t0) * k as f64 / n as f64
+        };
+        let tm = t0 + (t1 - t0) * (k as f64 - 0.5) / n as f64;
+        let (p, mid) = (eval(c, t)?, eval(c, tm)?);
+        if point_segment_distance(mid, prev, p) > tol {
+            out.truncate(mark.0);
+            if let (Some(p), Some(len)) = (params.as_deref_mut(), mark.1) {
+                p.truncate(len);
+            }
+            return Ok(false);
+        }
+        out.push(p);
+        if let Some(params) = params.as_deref_mut() {
+            params.push(t);
+        }
+        prev = p;
+    }
+    Ok(true)
 }
 
 /// The range's ends with the curve's breaks strictly between them, in the traversal's order.

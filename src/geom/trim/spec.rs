@@ -10,7 +10,7 @@ use super::loops::Role;
 use crate::geom::bspline::BSplineCurve;
 use crate::geom::error::{GeomError, GeomResult};
 use crate::geom::knots::KnotVector;
-use glam::DVec2;
+use glam::{DVec2, DVec3};
 
 /// One curve of a trim loop, in the surface's (u, v).
 #[derive(Debug, Clone, PartialEq)]
@@ -87,10 +87,7 @@ impl TrimCurve {
                 let (a, b) = (p[k], p[(k + 1).min(last)]);
                 a.lerp(b, t - k as f64)
             }
-            Self::Spline(c) => {
-                let (a, b) = c.domain();
-                c.eval(t.clamp(a, b)).truncate()
-            }
+            Self::Spline(c) => spline_point(c, t),
         }
     }
 
@@ -132,6 +129,40 @@ impl TrimCurve {
             Self::Spline(c) => c.points().iter().map(|p| p.truncate()).collect(),
         }
     }
+}
+
+/// Degrees up to which [`spline_point`] runs de Boor's algorithm in a stack array.
+const STACK_DEGREE: usize = 15;
+
+/// The 2D point of `c` at `t` (clamped to the domain): de Boor's algorithm on the active
+/// control points in homogeneous (wx, wy, w) form, in a stack array — flattening a trim
+/// evaluates its curves thousands of times, and `BSplineCurve::eval` allocates per call.
+fn spline_point(c: &BSplineCurve, t: f64) -> DVec2 {
+    let p = c.degree();
+    if p > STACK_DEGREE {
+        let (a, b) = c.domain();
+        return c.eval(t.clamp(a, b)).truncate();
+    }
+    let (points, knots) = (c.points(), c.knots());
+    let n = points.len();
+    let (a, b) = knots.domain(p, n);
+    let t = t.clamp(a, b);
+    let k = knots.find_span(p, n, t);
+    let w = |i: usize| c.weights().and_then(|w| w.get(i).copied()).unwrap_or(1.0);
+    let mut d = [DVec3::ZERO; STACK_DEGREE + 1];
+    for (j, slot) in d.iter_mut().enumerate().take(p + 1) {
+        let i = k - p + j;
+        let wi = w(i);
+        *slot = DVec3::new(points[i].x * wi, points[i].y * wi, wi);
+    }
+    for r in 1..=p {
+        for j in (r..=p).rev() {
+            let lo = knots[j + k - p];
+            let alpha = (t - lo) / (knots[j + 1 + k - r] - lo);
+            d[j] = d[j - 1] * (1.0 - alpha) + d[j] * alpha;
+        }
+    }
+    d[p].truncate() / d[p].z
 }
 
 /// A curve over a range of its parameter; `range.0 > range.1` runs it backwards (OBJ, IGES and

@@ -11,10 +11,13 @@ use glam::DVec2;
 use std::sync::Arc;
 
 /// The flattening tolerance, as a fraction of the parameter domain's diagonal: every point of
-/// a trim curve lies this close to the polyline that is drawn and integrated. A 1280-pixel view
-/// of the whole surface puts a pixel at about 1e-3 of it, so the boundary stays within a pixel
-/// until a zoom of 10,000×. It stays below the gap tolerance (1e-6), as flattening must.
-pub const FLATTEN_TOLERANCE: f64 = 1e-7;
+/// a trim curve lies this close to the polyline that is drawn (areas are exact regardless:
+/// `scene::measure` adds the lens between each chord and its curve). A 1280-pixel view of the
+/// whole surface puts a pixel at about 1e-3 of it, so the boundary stays within a pixel until
+/// a zoom of 2,500×. It stays below the gap tolerance (1e-6), as flattening must; the number
+/// of segments goes as its inverse square root, and building a model's trims with it (the
+/// 200-face benchmark, docs/performance.md) is what sets it.
+pub const FLATTEN_TOLERANCE: f64 = 4e-7;
 
 /// The flattening tolerance in parameter units for a surface of parameter `domain`.
 #[must_use]
@@ -29,6 +32,22 @@ impl Curve2 for TrimCurve {
 
     fn point(&self, t: f64) -> DVec2 {
         TrimCurve::point(self, t)
+    }
+
+    /// For splines: the largest |c''| of 33 evenly spaced points of the span, plus a fifth (a
+    /// span's second derivative varies smoothly; flattening checks every piece's midpoint
+    /// besides, and bisects where the bound fell short).
+    fn second_derivative_bound(&self, t0: f64, t1: f64) -> Option<f64> {
+        let TrimCurve::Spline(c) = self else {
+            return None;
+        };
+        let mut m: f64 = 0.0;
+        for k in 0..=32 {
+            let t = t0 + (t1 - t0) * f64::from(k) / 32.0;
+            let d = c.derivatives(t, 2);
+            m = m.max(d.get(2)?.truncate().length());
+        }
+        (m.is_finite()).then_some(1.2 * m)
     }
 
     fn breaks(&self) -> &[f64] {
