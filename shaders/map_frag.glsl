@@ -16,6 +16,7 @@ layout(location = 0) out vec4 out_color;
 
 #ifdef TRIMMED
 #include "trim.glsl"
+layout(location = 7) flat in uint v_fast;
 #endif
 
 // The diverging scale of src/render/maps.rs (SCALE): blue below zero, white at zero, red
@@ -40,7 +41,8 @@ vec3 scale_color(float s) {
 
 void main() {
 #ifdef TRIMMED
-    if (!trim_inside()) {
+    // Triangles wholly inside skip the test, wholly outside ones are dropped at once.
+    if (v_fast == 0u || (v_fast != 1u && !trim_inside())) {
         discard;
     }
 #endif

@@ -15,6 +15,7 @@ layout(location = 0) out vec4 out_color;
 
 #ifdef TRIMMED
 #include "trim.glsl"
+layout(location = 7) flat in uint v_fast;
 #endif
 
 // x^e: by repeated squaring for whole exponents up to 255 (the usual Blinn-Phong exponents),
@@ -38,7 +39,8 @@ float specular_power(float x, float e) {
 
 void main() {
 #ifdef TRIMMED
-    if (!trim_inside()) {
+    // Triangles wholly inside skip the test, wholly outside ones are dropped at once.
+    if (v_fast == 0u || (v_fast != 1u && !trim_inside())) {
         discard;
     }
 #endif

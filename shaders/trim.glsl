@@ -2,17 +2,18 @@
 // spacing, from the vertex shader) is tested against the object's coverage mask, built once
 // per structure on the CPU (src/geom/trim/coverage.rs, which has this test in f32 operation for
 // operation). Words from the object's record start:
-//   [0] cells offset, [1] records offset, [2] segments offset (words, from the record start),
-//   [3] cell rows (mu - 1), [4] cell columns (mv - 1);
+//   [0] cells offset, [1] records offset, [2] segments offset, [3] level table offset (words,
+//   from the record start), [4] cell rows (mu - 1), [5] cell columns (mv - 1);
 //   cells:    one word per cell (row-major): 0 outside, 1 inside, 2 | (record << 2) boundary;
 //   records:  4 words per boundary cell: first segment, (count << 1) | reference inside,
 //             reference point x, y (float bits, cell-local);
-//   segments: 4 words each, (a.x, a.y, b.x, b.y) in cell-local coordinates (float bits).
+//   segments: 4 words each, (a.x, a.y, b.x, b.y) in cell-local coordinates (float bits);
+//   level table: 25 words, the offset of the block classes of each (row, column) level of
+//   detail (strides 1 .. 16), 2 bits a block (0 outside, 1 inside, 2 mixed), 16 a word
+//   (shaders/trim_fast.glsl reads them).
 // A boundary cell's fragment is inside iff the reference point's flag XOR the parity of the
 // crossings of the path fragment -> reference with the cell's segments.
-layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer TrimWords {
-    uint w[];
-};
+#include "trim_words.glsl"
 
 layout(location = 5) in vec2 v_grid;
 layout(location = 6) flat in uvec4 v_trim;
@@ -38,8 +39,8 @@ bool trim_crosses(vec2 p, vec2 r, vec4 s) {
 
 bool trim_inside() {
     TrimWords t = TrimWords(v_trim.xy);
-    int ncu = int(t.w[3]);
-    int ncv = int(t.w[4]);
+    int ncu = int(t.w[4]);
+    int ncv = int(t.w[5]);
     int cx = clamp(int(floor(v_grid.x)), 0, ncu - 1);
     int cy = clamp(int(floor(v_grid.y)), 0, ncv - 1);
     vec2 p = v_grid - vec2(float(cx), float(cy));

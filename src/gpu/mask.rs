@@ -1,9 +1,10 @@
 //! Coverage masks: per-fragment inside tests in grid coordinates for surfaces drawn from a
 //! grid of vertices (trimmed surfaces). The words of every mask of a scene sit in one mirror;
-//! a table mirror holds one `uvec4` per mask — the device address of its words in that slot,
-//! the vertices per grid row and the surface's first vertex — which the trimmed pipelines read
-//! as an instance-rate attribute, so a masked draw needs no descriptor set and no push
-//! constants beyond the untrimmed one's (`shaders/trim.glsl` reads the words).
+//! a table mirror holds `uvec4` entries — the device address of a mask's words in that slot
+//! and two words the caller chooses (the shaders read the vertices per grid row, the level of
+//! detail drawn and the surface's first vertex there) — which the trimmed pipelines read as
+//! an instance-rate attribute, so a masked draw needs no descriptor set and no push constants
+//! beyond the untrimmed one's (`shaders/trim.glsl` reads the words).
 
 use super::FRAMES_IN_FLIGHT;
 use super::error::{GpuError, GpuResult};
@@ -11,14 +12,12 @@ use super::frame::Frame;
 use super::mirror::Mirror;
 use super::region::MaskRef;
 
-/// One surface's mask as the caller packed it (the layout `shaders/trim.glsl` documents).
-#[derive(Debug, Clone, Copy)]
+/// One surface's mask as the caller packed it (the layout `shaders/trim.glsl` documents), and
+/// its table entries: each the mask's address followed by these two words.
+#[derive(Debug, Clone)]
 pub struct MaskWords<'a> {
     pub words: &'a [u32],
-    /// Vertices per grid row.
-    pub cols: u32,
-    /// The surface's first vertex in the mirror its vertices are drawn from.
-    pub first_vertex: u32,
+    pub entries: Vec<[u32; 2]>,
 }
 
 /// Every mask of a scene: their words and the table the draws index.
@@ -29,7 +28,8 @@ pub struct MaskSet {
 }
 
 impl MaskSet {
-    /// Mask `k`, for a [`super::SurfaceBatch`] of its surface.
+    /// Table entry `k` (the masks' entries in order), for a [`super::SurfaceBatch`] of its
+    /// surface.
     #[must_use]
     pub fn entry(&self, k: u32) -> MaskRef<'_> {
         MaskRef {
@@ -38,7 +38,7 @@ impl MaskSet {
         }
     }
 
-    /// How many masks the set holds.
+    /// How many table entries the set holds.
     #[must_use]
     pub fn len(&self) -> u32 {
         self.count
@@ -69,8 +69,8 @@ impl Frame<'_> {
             words.extend(m.words.iter().map(|&w| f32::from_bits(w)));
         }
         let words = self.create_mirror("coverage masks", &words)?;
-        let mut table = match self.create_mirror("coverage mask table", &vec![0.0; masks.len() * 4])
-        {
+        let count: usize = masks.iter().map(|m| m.entries.len()).sum();
+        let mut table = match self.create_mirror("coverage mask table", &vec![0.0; count * 4]) {
             Ok(t) => t,
             Err(e) => {
                 self.destroy_mirror(words);
@@ -79,15 +79,17 @@ impl Frame<'_> {
         };
         let entries = |slot: usize| -> Result<Vec<f32>, GpuError> {
             let base = words.slot(slot).address();
-            let mut out = Vec::with_capacity(masks.len() * 4);
+            let mut out = Vec::with_capacity(count * 4);
             for (m, &start) in masks.iter().zip(&starts) {
                 let address = base + 4 * start as u64;
-                out.extend([
-                    f32::from_bits(address as u32),
-                    f32::from_bits((address >> 32) as u32),
-                    f32::from_bits(m.cols),
-                    f32::from_bits(m.first_vertex),
-                ]);
+                for &[z, w] in &m.entries {
+                    out.extend([
+                        f32::from_bits(address as u32),
+                        f32::from_bits((address >> 32) as u32),
+                        f32::from_bits(z),
+                        f32::from_bits(w),
+                    ]);
+                }
             }
             Ok(out)
         };
@@ -100,7 +102,7 @@ impl Frame<'_> {
             self.destroy_mirror(table);
             return Err(e);
         }
-        let count = u32::try_from(masks.len())
+        let count = u32::try_from(count)
             .map_err(|_| GpuError::InvalidArgument("too many coverage masks".into()))?;
         Ok(MaskSet {
             words,

@@ -10,7 +10,7 @@ use super::retained::{
     screen_rect, screen_rect_with, split_cells, touched_vertices, union_rect, vertex_bounds,
 };
 use super::style::{Highlight, NetMode, Palette, ViewOptions, Wire};
-use super::trim_mask::mask_words;
+use super::trim_mask::{level_entry, mask_entries, mask_words};
 use crate::editor::{
     Applied, ControlLayout, ControlsChange, Document, Handle, LOCAL_CURVE_SAMPLES,
     LOCAL_PATCH_SAMPLES, LocalEntry,
@@ -585,12 +585,12 @@ impl GpuScene {
         let words: Vec<MaskWords<'_>> = masked
             .iter()
             .map(|(i, w)| {
-                let grid = doc.objects[*i].sampled.grid();
-                let offset = self.objects[*i].samples.offset;
+                let cols = doc.objects[*i].sampled.grid().dims[1] as u32;
+                let first =
+                    (self.objects[*i].samples.offset / SurfaceGrid::FLOATS_PER_VERTEX) as u32;
                 MaskWords {
                     words: w,
-                    cols: grid.dims[1] as u32,
-                    first_vertex: (offset / SurfaceGrid::FLOATS_PER_VERTEX) as u32,
+                    entries: mask_entries(cols, first),
                 }
             })
             .collect();
@@ -598,9 +598,10 @@ impl GpuScene {
         Ok(())
     }
 
-    /// The coverage mask group `g` is drawn through.
-    fn group_mask(&self, g: usize) -> Option<MaskRef<'_>> {
-        let entry = self.groups[g].mask?;
+    /// The coverage mask group `g` is drawn through at `stride`.
+    fn group_mask(&self, g: usize, stride: GridStride) -> Option<MaskRef<'_>> {
+        let mask = self.groups[g].mask?;
+        let entry = level_entry(mask, [stride.rows, stride.cols]);
         Some(self.masks.as_ref()?.entry(entry))
     }
 
@@ -792,7 +793,7 @@ impl GpuScene {
             shape: group.shape,
             stride: b.stride,
             offsets: &offsets,
-            mask: self.group_mask(b.group),
+            mask: self.group_mask(b.group, b.stride),
         };
         self.draw_surfaces(
             frame,
@@ -827,7 +828,7 @@ impl GpuScene {
             shape: group.shape,
             stride: b.stride,
             offsets: &offsets,
-            mask: self.group_mask(b.group),
+            mask: self.group_mask(b.group, b.stride),
         };
         let style = self.group_style(doc, b.group);
         self.draw_surfaces(frame, group.arena, &batch, Some(cells), &style)
