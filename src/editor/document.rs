@@ -30,6 +30,9 @@ pub struct DocObject {
     pub trim: Option<Arc<TrimCoverage>>,
 }
 
+/// The most boundary vertices of a trimmed surface [`DocObject::drawn_points`] evaluates.
+pub const BOUNDARY_POINTS: usize = 256;
+
 /// A trim with its coverage of an object's sample grid.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrimCoverage {
@@ -81,6 +84,39 @@ impl DocObject {
         self.trim
             .as_ref()
             .is_none_or(|t| t.coverage.sample_inside(i, j))
+    }
+
+    /// Points of what is drawn, for framing and bounds: every `every`-th sample (a trimmed
+    /// surface's inside ones), and a trimmed surface's boundary, at most [`BOUNDARY_POINTS`]
+    /// of its vertices evaluated on the exact surface (a coarse grid of a large face, a plane's
+    /// 2 × 2, can have no sample inside its trim).
+    #[must_use]
+    pub fn drawn_points(&self, every: usize) -> Vec<DVec3> {
+        let g = self.sampled.grid();
+        let [rows, cols] = g.dims;
+        let every = every.max(1);
+        let Some(t) = &self.trim else {
+            return g.data.iter().step_by(g.stride() * every).copied().collect();
+        };
+        let mut out: Vec<DVec3> = (0..rows * cols)
+            .step_by(every)
+            .filter(|k| t.coverage.sample_inside(k / cols, k % cols))
+            .map(|k| g.position(k / cols, k % cols))
+            .collect();
+        let loops = t.trimmed.regions().loops();
+        let vertices: usize = loops.iter().map(|l| l.points().len()).sum();
+        let step = vertices.div_ceil(BOUNDARY_POINTS).max(1);
+        let model = self.sampled.model();
+        for p in loops.iter().flat_map(|l| l.points()).step_by(step) {
+            let mut d = [DVec3::ZERO];
+            model
+                .kind()
+                .derivatives_at([p.x, p.y], 0, &[(0, 0)], &mut d);
+            if d[0].is_finite() {
+                out.push(d[0]);
+            }
+        }
+        out
     }
 
     /// The scene object it stands for now (every applied edit in).
@@ -255,21 +291,8 @@ impl Document {
         // minimum and a maximum, so the order does not matter).
         let each = crate::parallel::map(&self.objects, |o| {
             let mut b = Bounds::EMPTY;
-            let g = o.sampled.grid();
-            match &o.trim {
-                None => {
-                    for p in g.data.iter().step_by(g.stride()) {
-                        b.include(*p);
-                    }
-                }
-                Some(t) => {
-                    let [rows, cols] = g.dims;
-                    for i in 0..rows {
-                        for j in (0..cols).filter(|&j| t.coverage.sample_inside(i, j)) {
-                            b.include(g.position(i, j));
-                        }
-                    }
-                }
+            for p in o.drawn_points(1) {
+                b.include(p);
             }
             for p in o.controls.grip_points() {
                 b.include(p);

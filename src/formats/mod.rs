@@ -5,6 +5,7 @@
 //! This floor sits on `scene` (the objects) and `model` (the kinds, which read and write their
 //! own fields); the command line and the viewer load and save through [`load`] and [`save`].
 
+pub mod cad;
 mod context;
 pub mod demo;
 pub mod iges;

@@ -63,20 +63,7 @@ pub fn framing_points(doc: &Document, nets: impl Fn(usize) -> bool) -> Vec<DVec3
     let every = (samples + handles.len()).div_ceil(MAX).max(1);
     let mut points: Vec<DVec3> = handles.into_iter().step_by(every).collect();
     for o in &doc.objects {
-        let g = o.sampled.grid();
-        match &o.trim {
-            None => points.extend(g.data.iter().step_by(g.stride() * every).copied()),
-            // Only what is drawn: the samples inside the trim.
-            Some(_) => {
-                let cols = g.dims[1].max(1);
-                points.extend(
-                    (0..g.dims[0] * g.dims[1])
-                        .step_by(every)
-                        .filter(|k| o.drawn(k / cols, k % cols))
-                        .map(|k| g.position(k / cols, k % cols)),
-                );
-            }
-        }
+        points.extend(o.drawn_points(every));
     }
     points
 }

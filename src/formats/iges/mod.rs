@@ -25,6 +25,7 @@ mod entity;
 mod error;
 mod free;
 mod global;
+pub mod map;
 mod names;
 mod records;
 mod transform;
@@ -150,5 +151,29 @@ impl IgesFile {
     #[must_use]
     pub fn mm_per_unit(&self) -> f64 {
         self.global.mm_per_unit()
+    }
+}
+
+/// The IGES format (read only): trimmed faces as trimmed NURBS surfaces in millimetres.
+#[derive(Debug, Clone, Copy)]
+pub struct Iges;
+
+impl super::FileFormat for Iges {
+    fn name(&self) -> &'static str {
+        "IGES"
+    }
+
+    fn extensions(&self) -> &'static [&'static str] {
+        &["igs", "iges"]
+    }
+
+    fn read(
+        &self,
+        bytes: &[u8],
+        _ctx: &super::LoadContext<'_>,
+    ) -> Result<super::Import, super::FormatError> {
+        map::read_iges(bytes)
+            .map(super::cad::to_import)
+            .map_err(super::FormatError::new)
     }
 }
