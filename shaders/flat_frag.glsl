@@ -11,7 +11,7 @@ layout(location = 0) out vec4 out_color;
 
 void main() {
 #ifdef TRIMMED
-    if (!trim_inside()) {
+    if (!trim_inside(trim_reach())) {
         discard;
     }
 #endif

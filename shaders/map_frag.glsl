@@ -42,7 +42,8 @@ vec3 scale_color(float s) {
 void main() {
 #ifdef TRIMMED
     // Triangles wholly inside skip the test, wholly outside ones are dropped at once.
-    if (v_fast == 0u || (v_fast != 1u && !trim_inside())) {
+    mat2 reach = trim_reach();
+    if (v_fast == 0u || (v_fast != 1u && !trim_inside(reach))) {
         discard;
     }
 #endif

@@ -37,7 +37,27 @@ bool trim_crosses(vec2 p, vec2 r, vec4 s) {
     return ((d1 > 0.0) != (d2 > 0.0)) && ((d3 > 0.0) != (d4 > 0.0));
 }
 
-bool trim_inside() {
+// The vector from segment s = (a, b) to p, in grid units.
+vec2 trim_segment_offset(vec2 p, vec4 s) {
+    vec2 e = s.zw - s.xy;
+    vec2 q = p - s.xy;
+    float t = clamp(dot(q, e) / max(dot(e, e), 1e-30), 0.0, 1.0);
+    return q - e * t;
+}
+
+// Pixels per grid unit as a matrix: the inverse of the screen-space derivatives of the grid
+// coordinate, so a grid-space vector's length on screen is |reach * v| (zero where the
+// triangle is seen edge-on: no growth). Call it where control flow is uniform.
+mat2 trim_reach() {
+    mat2 j = mat2(dFdx(v_grid), dFdy(v_grid));
+    float det = determinant(j);
+    return abs(det) > 1e-30 ? inverse(j) : mat2(0.0);
+}
+
+// Whether the fragment is inside the trim, the drawn region grown by half a pixel at the
+// boundary (faces that share an edge overlap by a sub-pixel sliver instead of leaving pinholes
+// where their two tessellations of the edge part); `reach` from trim_reach().
+bool trim_inside(mat2 reach) {
     TrimWords t = TrimWords(v_trim.xy);
     int ncu = int(t.w[4]);
     int ncv = int(t.w[5]);
@@ -59,6 +79,11 @@ bool trim_inside() {
         if (trim_crosses(p, r, trim_vec4(t, t.w[2] + (first + k) * 4u))) {
             inside = !inside;
         }
+    }
+    bool grows = reach != mat2(0.0);
+    for (uint k = 0u; k < count && !inside && grows; ++k) {
+        vec2 v = trim_segment_offset(p, trim_vec4(t, t.w[2] + (first + k) * 4u));
+        inside = dot(reach * v, reach * v) < 0.25;
     }
     return inside;
 }

@@ -726,12 +726,15 @@ impl GpuScene {
         let mut order = Vec::new();
         for (g, group) in self.groups.iter().enumerate() {
             let mut by_stride: BTreeMap<(u32, u32), Vec<usize>> = BTreeMap::new();
+            // Trimmed faces meet other faces at seams: a quarter of the deviation (Lod).
+            let factor = if group.mask.is_some() { 0.25 } else { 1.0 };
             for &i in &group.members {
                 let o = &mut self.objects[i];
                 let stride = if opts.lod {
                     let grid = doc.objects[i].sampled.grid();
                     let metrics = o.metrics.get_or_insert_with(|| GridMetrics::new(grid));
-                    *o.lod.get_or_insert_with(|| lod.stride(metrics.as_ref()))
+                    *o.lod
+                        .get_or_insert_with(|| lod.stride_within(metrics.as_ref(), factor))
                 } else {
                     GridStride::FULL
                 };

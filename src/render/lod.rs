@@ -182,6 +182,14 @@ impl Lod {
     /// bounding box reaches behind the eye, or that was not measurable, is drawn in full.
     #[must_use]
     pub fn stride(&self, metrics: Option<&GridMetrics>) -> GridStride {
+        self.stride_within(metrics, 1.0)
+    }
+
+    /// [`Lod::stride`] with the deviation allowed scaled by `factor` (≤ 1): trimmed faces of a
+    /// solid share their edges with other faces, each coarsened on its own, so that their
+    /// departures add up to less than a pixel at a seam they draw at a quarter of it.
+    #[must_use]
+    pub fn stride_within(&self, metrics: Option<&GridMetrics>, factor: f64) -> GridStride {
         let (Some(tol), Some(m)) = (self.tolerance, metrics) else {
             return GridStride::FULL;
         };
@@ -197,7 +205,7 @@ impl Lod {
                 if next as usize > reach {
                     break;
                 }
-                let ok = dev * scale <= tol.error_px
+                let ok = dev * scale <= tol.error_px * factor
                     && f64::from(next) * m.spacing[d] * scale <= tol.max_edge_px;
                 if !ok {
                     break;

@@ -20,7 +20,7 @@ use glam::{DVec2, DVec3};
 
 /// The largest departure of a drawn chord from the surface, as a fraction of the model's
 /// diagonal.
-pub const CHORD: f64 = 2e-4;
+pub const CHORD: f64 = 5e-5;
 /// Samples per direction: at least 2, at most this.
 const MAX_SAMPLES: usize = 257;
 

@@ -137,10 +137,13 @@ pub fn kept_of(trimmed: &Trimmed) -> ObjKept {
     kept
 }
 
+/// A `vp` of a written `curv2`: its (u, v) and, where rational, its weight.
+type Vertex = (DVec2, Option<f64>);
+
 /// A trim curve as a `curv2` whose vertices start at parameter vertex `first`, with those
 /// vertices (and their weights where rational).
-fn curve2_of(c: &TrimCurve, first: usize) -> (Curve2, Vec<(DVec2, Option<f64>)>) {
-    let (degree, parm, vertices): (usize, Vec<f64>, Vec<(DVec2, Option<f64>)>) = match c {
+fn curve2_of(c: &TrimCurve, first: usize) -> (Curve2, Vec<Vertex>) {
+    let (degree, parm, vertices): (usize, Vec<f64>, Vec<Vertex>) = match c {
         TrimCurve::Polyline(p) => (
             1,
             polyline_knots(p.len()),

@@ -390,6 +390,18 @@ impl Coverage {
     /// the module doc); `g` is the fragment's grid coordinate, in `[0, mu-1] × [0, mv-1]`.
     #[must_use]
     pub fn fragment_inside(&self, g: [f32; 2]) -> bool {
+        self.fragment_inside_within(g, [[0.0; 2]; 2])
+    }
+
+    /// [`Coverage::fragment_inside`] with the drawn region grown by half a pixel: a fragment
+    /// of a boundary cell outside the trim counts as inside when `reach` (pixels per grid
+    /// unit, the inverse of the screen-space derivatives of `g`, column-major as GLSL's `mat2`)
+    /// maps its offset from a boundary segment to less than half a pixel. So faces that share
+    /// an edge overlap by a sub-pixel sliver instead of leaving pinholes where the two
+    /// tessellations of the edge part, and the drawn boundary stays within half a pixel of
+    /// the trim on screen, at any angle (a pixel's footprint in the grid is anisotropic).
+    #[must_use]
+    pub fn fragment_inside_within(&self, g: [f32; 2], reach: [[f32; 2]; 2]) -> bool {
         let (ncu, ncv) = ((self.mu - 1) as i32, (self.mv - 1) as i32);
         let cx = (g[0].floor() as i32).clamp(0, ncu - 1);
         let cy = (g[1].floor() as i32).clamp(0, ncv - 1);
@@ -406,13 +418,32 @@ impl Coverage {
         let r = [f32::from_bits(rec[2]), f32::from_bits(rec[3])];
         let mut inside = rec[1] & 1 == 1;
         let (first, count) = (rec[0] as usize, (rec[1] >> 1) as usize);
-        for s in self.segments.get(first..first + count).unwrap_or(&[]) {
+        let segments = self.segments.get(first..first + count).unwrap_or(&[]);
+        for s in segments {
             if path_crosses(p, r, s) {
                 inside = !inside;
             }
         }
+        let grows = reach != [[0.0; 2]; 2];
         inside
+            || grows
+                && segments.iter().any(|s| {
+                    let v = segment_offset(p, s);
+                    let x = reach[0][0] * v[0] + reach[1][0] * v[1];
+                    let y = reach[0][1] * v[0] + reach[1][1] * v[1];
+                    x * x + y * y < 0.25
+                })
     }
+}
+
+/// The vector from segment `s = (a, b)` to `p`, in f32 as the shader computes it.
+#[must_use]
+fn segment_offset(p: [f32; 2], s: &[f32; 4]) -> [f32; 2] {
+    let (ex, ey) = (s[2] - s[0], s[3] - s[1]);
+    let (qx, qy) = (p[0] - s[0], p[1] - s[1]);
+    let len2 = (ex * ex + ey * ey).max(1e-30);
+    let t = ((qx * ex + qy * ey) / len2).clamp(0.0, 1.0);
+    [qx - ex * t, qy - ey * t]
 }
 
 /// Whether the path `p`–`r` crosses segment `s = (a, b)`, in f32 as the shader does it

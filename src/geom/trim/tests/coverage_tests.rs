@@ -264,3 +264,47 @@ fn bad_grids_are_refused() {
     // Negative control: the good axis is accepted.
     assert!(Coverage::new(&t, &good, &good).is_ok());
 }
+
+/// The drawn region grows by half a pixel at the boundary, measured on screen through the
+/// pixels-per-grid-unit matrix (anisotropic: a grazing view squeezes one direction), never
+/// more; a zero matrix (a triangle seen edge-on) grows nothing.
+#[test]
+fn the_drawn_region_grows_by_half_a_pixel_on_screen() {
+    // The unit square [0.25, 0.75]² inside [0, 1]², on 4 × 4 cells: its right edge is the
+    // grid line g.x = 3 (u = 0.75 → 0.75 · 4).
+    let domain = [(0.0, 1.0), (0.0, 1.0)];
+    let square = vec![
+        DVec2::new(0.25, 0.25),
+        DVec2::new(0.75, 0.25),
+        DVec2::new(0.75, 0.75),
+        DVec2::new(0.25, 0.75),
+        DVec2::new(0.25, 0.25),
+    ];
+    let input = LoopInput {
+        pieces: vec![square],
+        role: None,
+    };
+    let t = TrimRegions::new(&[input], domain, &Tolerances::default()).unwrap();
+    let (u, v) = (axis(0.0, 1.0, 5), axis(0.0, 1.0, 5));
+    let c = cover(&t, &u, &v);
+    // 10 pixels per grid unit along g.x, 2 along g.y (column-major, as GLSL's mat2).
+    let reach = [[10.0, 0.0], [0.0, 2.0]];
+    let right = |dx: f32| [3.0 + dx, 2.0];
+    assert!(!c.fragment_inside(right(0.03)), "outside without growth");
+    assert!(
+        c.fragment_inside_within(right(0.03), reach),
+        "0.3 px out: grown over"
+    );
+    assert!(
+        !c.fragment_inside_within(right(0.07), reach),
+        "0.7 px out: not"
+    );
+    // Along g.y a grid unit is 2 pixels: 0.2 grid units is 0.4 px, 0.3 is 0.6 px.
+    let top = |dy: f32| [2.0, 3.0 + dy];
+    assert!(c.fragment_inside_within(top(0.2), reach));
+    assert!(!c.fragment_inside_within(top(0.3), reach));
+    assert!(
+        !c.fragment_inside_within(right(0.03), [[0.0; 2]; 2]),
+        "edge-on: no growth"
+    );
+}
