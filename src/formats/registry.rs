@@ -1,7 +1,7 @@
 //! The registered file formats, listed once, and loading and saving by a path's extension.
 
 use super::context::{FileFormat, Import, LoadContext, SampleDefaults};
-use super::{iges, json, obj};
+use super::{iges, json, obj, step};
 use crate::progress::ProgressSink;
 use crate::sampling::budget::MemoryBudget;
 use crate::scene::{Scene, SceneError, write_durably};
@@ -9,7 +9,7 @@ use std::path::Path;
 
 /// Every file format prespline reads. A new format is a folder under formats/ and one entry
 /// here; the first is the default for a path with an unknown extension when writing.
-pub static FORMATS: &[&dyn FileFormat] = &[&json::JsonScene, &obj::Obj, &iges::Iges];
+pub static FORMATS: &[&dyn FileFormat] = &[&json::JsonScene, &obj::Obj, &step::Step, &iges::Iges];
 
 /// The format a path's extension names (any case), if any.
 #[must_use]

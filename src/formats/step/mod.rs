@@ -26,6 +26,7 @@ mod access;
 mod error;
 mod header;
 mod lexer;
+pub mod map;
 mod model;
 mod params;
 mod parser;
@@ -39,3 +40,28 @@ pub use parser::MAX_DEPTH;
 
 #[cfg(test)]
 mod tests;
+
+/// The STEP format (read only): every face instance of the product structure as a trimmed
+/// NURBS surface in millimetres.
+#[derive(Debug, Clone, Copy)]
+pub struct Step;
+
+impl super::FileFormat for Step {
+    fn name(&self) -> &'static str {
+        "STEP"
+    }
+
+    fn extensions(&self) -> &'static [&'static str] {
+        &["stp", "step", "p21"]
+    }
+
+    fn read(
+        &self,
+        bytes: &[u8],
+        _ctx: &super::LoadContext<'_>,
+    ) -> Result<super::Import, super::FormatError> {
+        map::read_step(bytes)
+            .map(super::cad::to_import)
+            .map_err(super::FormatError::new)
+    }
+}

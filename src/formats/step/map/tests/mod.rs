@@ -1,0 +1,4 @@
+//! Unit tests of the internals.
+
+mod geometry;
+mod trim_crate;
