@@ -456,6 +456,46 @@ impl TensorSurface {
         out
     }
 
+    /// S, S_u and S_v at (u, v) without allocating: BasisFuns (A2.2) of degree d and d − 1 in
+    /// stack arrays and N′ = d (N_{i,d−1}/(t_{i+d} − t_i) − N_{i+1,d−1}/(t_{i+d+1} − t_{i+1}))
+    /// (A2.3 for one derivative), the quotient rule for rational surfaces. What measures a
+    /// surface (areas, bounds) evaluates it thousands of times; degrees above 15 take
+    /// [`TensorSurface::derivatives`].
+    #[must_use]
+    pub fn first_partials(&self, u: f64, v: f64) -> [DVec3; 3] {
+        let [du, dv] = self.degree;
+        if du > STACK_DEGREE || dv > STACK_DEGREE {
+            let p = self.derivatives(u, v, 1);
+            return [p.get(0, 0), p.get(1, 0), p.get(0, 1)];
+        }
+        let [su, sv] = self.find_spans(u, v);
+        let [(u0, u1), (v0, v1)] = self.domain();
+        let (bu, dbu) = basis_and_derivative(self.knots[0].as_slice(), du, su, u.clamp(u0, u1));
+        let (bv, dbv) = basis_and_derivative(self.knots[1].as_slice(), dv, sv, v.clamp(v0, v1));
+        let nv = self.count[1];
+        let (mut s, mut s_u, mut s_v) = (DVec4::ZERO, DVec4::ZERO, DVec4::ZERO);
+        for k in 0..=du {
+            let row = (su - du + k) * nv + sv - dv;
+            let (mut inner, mut inner_v) = (DVec4::ZERO, DVec4::ZERO);
+            for l in 0..=dv {
+                let idx = row + l;
+                let w = self.weights.as_ref().map_or(1.0, |w| w[idx]);
+                let h = to_homogeneous(self.points[idx], w);
+                inner += h * bv[l];
+                inner_v += h * dbv[l];
+            }
+            s += inner * bu[k];
+            s_u += inner * dbu[k];
+            s_v += inner_v * bu[k];
+        }
+        let p = s.truncate() / s.w;
+        [
+            p,
+            (s_u.truncate() - p * s_u.w) / s.w,
+            (s_v.truncate() - p * s_v.w) / s.w,
+        ]
+    }
+
     /// S(u, v) by de Boor's algorithm as a curve of curves (independent of the Hermite path).
     #[must_use]
     pub fn eval(&self, u: f64, v: f64) -> DVec3 {
@@ -494,6 +534,45 @@ impl TensorSurface {
         let p = self.derivatives(u, v, 2);
         curvatures_from_partials(&p)
     }
+}
+
+/// Degrees up to which [`TensorSurface::first_partials`] works in stack arrays.
+const STACK_DEGREE: usize = 15;
+
+/// The d + 1 basis functions non-zero on `span` at `t` and their first derivatives.
+fn basis_and_derivative(
+    knots: &[f64],
+    d: usize,
+    span: usize,
+    t: f64,
+) -> ([f64; STACK_DEGREE + 1], [f64; STACK_DEGREE + 1]) {
+    let mut n = [0.0; STACK_DEGREE + 1];
+    super::basis::basis_funs_into(knots, d, span, t, &mut n);
+    let mut dn = [0.0; STACK_DEGREE + 1];
+    if d == 0 {
+        return (n, dn);
+    }
+    // The d basis functions of degree d − 1 on the span: N_{span−d+1 ..= span, d−1}.
+    let mut low = [0.0; STACK_DEGREE + 1];
+    super::basis::basis_funs_into(knots, d - 1, span, t, &mut low);
+    let df = d as f64;
+    for j in 0..=d {
+        let i = span - d + j;
+        let left = if j >= 1 {
+            let den = knots[i + d] - knots[i];
+            if den > 0.0 { low[j - 1] / den } else { 0.0 }
+        } else {
+            0.0
+        };
+        let right = if j < d {
+            let den = knots[i + d + 1] - knots[i + 1];
+            if den > 0.0 { low[j] / den } else { 0.0 }
+        } else {
+            0.0
+        };
+        dn[j] = df * (left - right);
+    }
+    (n, dn)
 }
 
 /// Gaussian and mean curvature from partials up to order (2, 2) (only Su, Sv, Suu, Suv, Svv
@@ -756,5 +835,58 @@ mod tests {
         )
         .unwrap_err();
         assert!(e.message.starts_with("u direction"), "{e}");
+    }
+}
+
+#[cfg(test)]
+mod first_partials_tests {
+    use super::*;
+
+    /// A bicubic × biquadratic net with uneven knots, rational or not.
+    fn surface(rational: bool) -> TensorSurface {
+        let (nu, nv) = (6, 5);
+        let points = (0..nu * nv)
+            .map(|k| {
+                let (i, j) = ((k / nv) as f64, (k % nv) as f64);
+                DVec3::new(i, j, (1.3 * i).sin() * (0.7 * j).cos())
+            })
+            .collect();
+        let weights = rational.then(|| (0..nu * nv).map(|k| 0.5 + (k % 7) as f64 * 0.25).collect());
+        TensorSurface::bspline(
+            [3, 2],
+            [
+                vec![0.0, 0.0, 0.0, 0.0, 0.3, 1.1, 2.0, 2.0, 2.0, 2.0],
+                vec![0.0, 0.0, 0.0, 0.2, 0.6, 1.0, 1.0, 1.0],
+            ],
+            [nu, nv],
+            points,
+            weights,
+        )
+        .unwrap()
+    }
+
+    /// The allocation-free S, S_u, S_v agree with the Hermite path to rounding, at knots
+    /// and ends too; a perturbed weight does not (the comparison can fail).
+    #[test]
+    fn first_partials_agree_with_the_hermite_path() {
+        let close = |a: DVec3, b: DVec3| (a - b).length() <= 1e-12 * (1.0 + b.length());
+        for rational in [false, true] {
+            let s = surface(rational);
+            for k in 0..=40 {
+                let (u, v) = (2.0 * k as f64 / 40.0, (k * 7 % 41) as f64 / 40.0);
+                let fast = s.first_partials(u, v);
+                let p = s.derivatives(u, v, 1);
+                for (f, h) in fast
+                    .into_iter()
+                    .zip([p.get(0, 0), p.get(1, 0), p.get(0, 1)])
+                {
+                    assert!(close(f, h), "rational {rational} at ({u}, {v}): {f} vs {h}");
+                }
+            }
+        }
+        let (mut a, b) = (surface(true), surface(true));
+        a.set_weight(2, 2, 1.3);
+        let (pa, pb) = (a.first_partials(0.9, 0.5), b.first_partials(0.9, 0.5));
+        assert!(!close(pa[1], pb[1]), "a changed weight must change S_u");
     }
 }

@@ -60,6 +60,13 @@ pub trait Kind: Clone + Debug + PartialEq + Sized + 'static {
     /// Parameter domain per direction (one entry for curves).
     fn domain(&self) -> Vec<(f64, f64)>;
 
+    /// S, S_u and S_v at `uv` from an evaluator that does not allocate, where the kind has
+    /// one (tensor-product surfaces): what measures a surface evaluates it thousands of times.
+    /// `None`: [`Kind::derivatives_at`] serves.
+    fn first_partials(&self, _uv: [f64; 2]) -> Option<[DVec3; 3]> {
+        None
+    }
+
     /// The polynomial degree per direction, where the kind has one (B-spline and Bézier
     /// curves and surfaces); empty otherwise. For `info` and messages.
     fn degrees(&self) -> Vec<usize> {

@@ -226,6 +226,8 @@ pub trait DynKind {
     fn type_name(&self) -> &'static str;
     fn is_surface(&self) -> bool;
     fn sample_dims(&self) -> [usize; 2];
+    /// S, S_u, S_v by a fast evaluator, where the kind has one ([`Kind::first_partials`]).
+    fn first_partials(&self, uv: [f64; 2]) -> Option<[DVec3; 3]>;
     /// The degree per direction, where the kind has one ([`Kind::degrees`]).
     fn degrees(&self) -> Vec<usize>;
     /// Where the geometry's pieces meet, per direction ([`Kind::breakpoints`]).
@@ -295,6 +297,10 @@ where
 
     fn degrees(&self) -> Vec<usize> {
         Kind::degrees(self)
+    }
+
+    fn first_partials(&self, uv: [f64; 2]) -> Option<[DVec3; 3]> {
+        Kind::first_partials(self, uv)
     }
 
     fn with_samples(&self, samples: [usize; 2]) -> Result<Model, EditError> {

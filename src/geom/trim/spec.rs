@@ -91,27 +91,6 @@ impl TrimCurve {
         }
     }
 
-    /// The derivative dc/dt at `t` (clamped to the domain; a polyline's on the segment `t`
-    /// falls in, the last one at its end).
-    #[must_use]
-    pub fn tangent(&self, t: f64) -> DVec2 {
-        match self {
-            Self::Polyline(p) => {
-                let last = p.len().saturating_sub(1);
-                let k = (t.clamp(0.0, last as f64).floor() as usize).min(last.saturating_sub(1));
-                p.get(k + 1)
-                    .zip(p.get(k))
-                    .map_or(DVec2::ZERO, |(b, a)| *b - *a)
-            }
-            Self::Spline(c) => {
-                let (a, b) = c.domain();
-                c.derivatives(t.clamp(a, b), 1)
-                    .get(1)
-                    .map_or(DVec2::ZERO, |d| d.truncate())
-            }
-        }
-    }
-
     /// Whether evaluation is exact on straight pieces (no flattening needed).
     #[must_use]
     pub fn is_straight(&self) -> bool {

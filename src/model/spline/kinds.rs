@@ -175,6 +175,10 @@ impl Kind for SurfaceModel {
         self.surface().degree().to_vec()
     }
 
+    fn first_partials(&self, [u, v]: [f64; 2]) -> Option<[DVec3; 3]> {
+        Some(self.surface().first_partials(u, v))
+    }
+
     fn breakpoints(&self) -> Vec<Vec<f64>> {
         let s = self.surface();
         (0..2)

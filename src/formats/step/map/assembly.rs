@@ -15,8 +15,8 @@
 
 use std::collections::{HashMap, HashSet};
 
-use glam::{DAffine3, DMat3, DVec3};
 use crate::formats::step::{EntityRef, StepFile};
+use glam::{DAffine3, DMat3, DVec3};
 
 use super::attrs::{P, Res, bad, direction, frame, is, part, point3};
 use super::products::Products;

@@ -11,9 +11,9 @@
 //!
 //! Every error is one line naming the line, `#id` and entity (the reader's `StepError` text).
 
+use crate::formats::step::{EntityRef, ParamRef, RecordRef, StepError};
 use crate::geom::analytic::Frame;
 use glam::{DVec2, DVec3};
-use crate::formats::step::{EntityRef, ParamRef, RecordRef, StepError};
 
 /// Results of the mapping.
 pub(crate) type Res<T> = Result<T, Error>;

@@ -9,9 +9,9 @@
 //! lines, sampling plus golden-section refinement for splines), and gives its exact rational
 //! B-spline form over a range where one exists.
 
+use crate::formats::step::{EntityRef, Value};
 use crate::geom::analytic::{ArcMap, AxisMap, Frame, NurbsCurve, ellipse_arc, line_segment};
 use glam::DVec3;
-use crate::formats::step::{EntityRef, Value};
 
 use super::attrs::{P, Res, bad, frame, frame2, is, part, point3, unsupported, vector};
 use super::nurbs::{FastCurve, read_bspline_curve};

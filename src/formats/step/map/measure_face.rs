@@ -11,8 +11,8 @@
 //! coordinate's extreme sample then refined by a pattern search inside the trim.
 
 use crate::geom::analytic::NurbsCurve;
-use glam::{DVec2, DVec3};
 use crate::geom::trim::{Coverage, Curve2, LoopInput, Piece, Tolerances, TrimRegions, integrate};
+use glam::{DVec2, DVec3};
 
 use super::nurbs::FastSurface;
 use super::{CadCurve2, CadFace};

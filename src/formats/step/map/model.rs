@@ -10,8 +10,8 @@
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use glam::DAffine3;
 use crate::formats::step::StepFile;
+use glam::DAffine3;
 
 use super::assembly::{self, Instance};
 use super::attrs::{Error, Kind, is};

@@ -7,10 +7,10 @@
 //! the file before it is checked against the lists actually present: the multiplicities must
 //! add up to `points + degree + 1` before the knot vector is expanded.
 
+use crate::formats::step::EntityRef;
 use crate::formats::step::map::attrs::{at, at_mut};
 use crate::geom::analytic::{NurbsCurve, NurbsSurface};
 use glam::{DVec3, DVec4};
-use crate::formats::step::EntityRef;
 
 use super::attrs::{P, Part, Res, bad, is, msg, part, point3};
 

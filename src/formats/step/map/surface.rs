@@ -14,9 +14,11 @@
 //! (same `(u, v)` in each case, so its PCURVEs still apply). Offsets of other surfaces have no
 //! exact NURBS form and are reported as not drawn.
 
-use crate::geom::analytic::{AnalyticSurface, ArcMap, Frame, NurbsCurve, SurfaceKind, line_segment};
-use glam::{DVec2, DVec3};
 use crate::formats::step::EntityRef;
+use crate::geom::analytic::{
+    AnalyticSurface, ArcMap, Frame, NurbsCurve, SurfaceKind, line_segment,
+};
+use glam::{DVec2, DVec3};
 
 use super::attrs::{P, Res, axis1, bad, frame, is, part, unsupported, vector};
 use super::curves::{self, Curve, full_arc};
@@ -114,10 +116,11 @@ fn read_inner(e: EntityRef<'_>, rad: f64, extent: (DVec3, DVec3), depth: usize) 
     if depth > MAX_NESTING {
         return Err(bad(&e, "surfaces nested too deeply"));
     }
-    let analytic = |a: crate::geom::analytic::Result<AnalyticSurface>, pre: [Pre; 2]| -> Res<Surface> {
-        let a = a.map_err(|x| bad(&e, x.to_string()))?;
-        Ok(plain(e.id(), Geometry::Analytic(a), pre))
-    };
+    let analytic =
+        |a: crate::geom::analytic::Result<AnalyticSurface>, pre: [Pre; 2]| -> Res<Surface> {
+            let a = a.map_err(|x| bad(&e, x.to_string()))?;
+            Ok(plain(e.id(), Geometry::Analytic(a), pre))
+        };
     let angular = [Pre::Scale(rad), Pre::Identity];
     let both = [Pre::Scale(rad), Pre::Scale(rad)];
     if is(&e, "B_SPLINE_SURFACE") {

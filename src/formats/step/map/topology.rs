@@ -6,8 +6,8 @@
 //!
 //! Nothing here needs the surface: parameter ranges are worked out by the trims, which know it.
 
-use glam::DVec3;
 use crate::formats::step::EntityRef;
+use glam::DVec3;
 
 use super::attrs::{P, Res, bad, is, part, point3, unsupported};
 use super::curves::{self, Read};

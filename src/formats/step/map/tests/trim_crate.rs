@@ -1,7 +1,7 @@
 //! A limitation of the trim crate found on real data, kept as a reproduction for its owner.
 
-use glam::DVec2;
 use crate::geom::trim::{LoopInput, Tolerances, TrimRegions};
+use glam::DVec2;
 
 /// Two curves leaving one vertex 0.009 rad apart (a cusp, trj5_k1-ug-214 #119 before the
 /// mapping spread vertex offsets along its polylines): no two segments cross (checked exactly
