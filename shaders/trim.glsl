@@ -3,8 +3,11 @@
 // per structure on the CPU (src/geom/trim/coverage.rs, which has this test in f32 operation for
 // operation). Words from the object's record start:
 //   [0] cells offset, [1] records offset, [2] segments offset, [3] level table offset (words,
-//   from the record start), [4] cell rows (mu - 1), [5] cell columns (mv - 1);
-//   cells:    one word per cell (row-major): 0 outside, 1 inside, 2 | (record << 2) boundary;
+//   from the record start), [4] sample cell rows (mu - 1), [5] sample cell columns (mv - 1),
+//   [6] mask cells per sample cell and direction (k: the mask's cells cut each sample cell in
+//   k x k, so that a cell holds few boundary segments however coarse the samples);
+//   cells:    one word per mask cell (row-major): 0 outside, 1 inside, 2 | (record << 2)
+//             boundary;
 //   records:  4 words per boundary cell: first segment, (count << 1) | reference inside,
 //             reference point x, y (float bits, cell-local);
 //   segments: 4 words each, (a.x, a.y, b.x, b.y) in cell-local coordinates (float bits);
@@ -59,11 +62,15 @@ mat2 trim_reach() {
 // where their two tessellations of the edge part); `reach` from trim_reach().
 bool trim_inside(mat2 reach) {
     TrimWords t = TrimWords(v_trim.xy);
-    int ncu = int(t.w[4]);
-    int ncv = int(t.w[5]);
-    int cx = clamp(int(floor(v_grid.x)), 0, ncu - 1);
-    int cy = clamp(int(floor(v_grid.y)), 0, ncv - 1);
-    vec2 p = v_grid - vec2(float(cx), float(cy));
+    uint k = t.w[6];
+    int ncu = int(t.w[4] * k);
+    int ncv = int(t.w[5] * k);
+    vec2 g = v_grid * float(k);
+    int cx = clamp(int(floor(g.x)), 0, ncu - 1);
+    int cy = clamp(int(floor(g.y)), 0, ncv - 1);
+    vec2 p = g - vec2(float(cx), float(cy));
+    // Pixels per mask cell.
+    reach = reach / float(k);
     uint word = t.w[t.w[0] + uint(cx * ncv + cy)];
     uint tag = word & 3u;
     if (tag != 2u) {

@@ -14,9 +14,12 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 /// Threads set by `--threads` (0: not set, use every core).
 static THREADS: AtomicUsize = AtomicUsize::new(0);
 
-/// Items a worker takes at once: large enough that the shared counter is not contended, small
-/// enough that the last chunks balance.
+/// Most items a worker takes at once: large enough that the shared counter is not contended,
+/// small enough that the last chunks balance. Lists of fewer than [`CHUNKS_PER_THREAD`] such
+/// chunks per thread are taken in smaller chunks, down to one item: a CAD model's dozens of
+/// faces each take milliseconds, and one chunk of 16 would leave the other threads idle.
 const CHUNK: usize = 16;
+const CHUNKS_PER_THREAD: usize = 4;
 
 /// Sets the number of threads [`map`] uses (`--threads N`); 0 means every core.
 pub fn set_threads(n: usize) {
@@ -60,7 +63,8 @@ pub fn map_with<T: Sync, R: Send>(
     items: &[T],
     f: impl Fn(&T) -> R + Sync,
 ) -> Vec<R> {
-    let workers = threads.min(items.len().div_ceil(CHUNK));
+    let chunk = (items.len() / (threads.max(1) * CHUNKS_PER_THREAD)).clamp(1, CHUNK);
+    let workers = threads.min(items.len().div_ceil(chunk));
     if workers <= 1 {
         return items.iter().map(f).collect();
     }
@@ -70,11 +74,11 @@ pub fn map_with<T: Sync, R: Send>(
         for _ in 0..workers {
             s.spawn(|| {
                 loop {
-                    let start = next.fetch_add(CHUNK, Ordering::Relaxed);
+                    let start = next.fetch_add(chunk, Ordering::Relaxed);
                     if start >= items.len() {
                         break;
                     }
-                    let end = (start + CHUNK).min(items.len());
+                    let end = (start + chunk).min(items.len());
                     // Each worker is one thread: work inside an item stays on it
                     // (for_each_mut), rather than spawning threads per item on a full machine.
                     let out: Vec<R> = on_one_thread(|| items[start..end].iter().map(&f).collect());

@@ -54,11 +54,32 @@ pub struct RenderArgs {
     /// what it made resident (peak resident size less the program and the Vulkan driver).
     #[arg(long)]
     pub memory_report: bool,
+    /// Print how long each phase took: load (parse, trims, pre-evaluation), the Vulkan device
+    /// (started beside the load, so only its wait counts), drawing and reading back, writing
+    /// the image.
+    #[arg(long)]
+    pub timings: bool,
 }
 
 /// Loads, edits and renders; prints the closing line (and the memory report).
+///
+/// The Vulkan device starts on a second thread while the scene loads (instance, device, the
+/// driver's start and the surface pipelines' compilation take tens of milliseconds on
+/// lavapipe), except with `--memory-report`,
+/// which measures what the driver adds apart from what the scene does.
 pub fn run(args: RenderArgs) -> Result<(), CliError> {
+    let start = Instant::now();
     let before = Resident::read();
+    ImageFormat::of(&args.out).map_err(CliError)?;
+    let msaa = args.msaa;
+    let early = (!args.memory_report).then(|| {
+        std::thread::spawn(move || {
+            let mut r = start_renderer()?;
+            r.warm_offscreen(msaa)
+                .map_err(|e| CliError(e.to_string()))?;
+            Ok(r)
+        })
+    });
     let (doc, estimate) = load_document(
         &args.scene,
         args.edits.as_deref(),
@@ -67,6 +88,7 @@ pub fn run(args: RenderArgs) -> Result<(), CliError> {
         args.display.analysis,
         args.display.net,
     )?;
+    let loaded = start.elapsed();
     let mut options = args.display.options();
     if let Some((name, t)) = &args.osculating {
         options.osculating_at = Some(osculating_at(&doc, name, *t)?);
@@ -82,18 +104,58 @@ pub fn run(args: RenderArgs) -> Result<(), CliError> {
         options,
         msaa: args.msaa,
     };
-    let lines = render_image(&doc, &args.out, shot, probe);
+    let renderer = match early.map(std::thread::JoinHandle::join) {
+        Some(Ok(r)) => Some(r?),
+        Some(Err(_)) => return Err(CliError("the Vulkan device's start failed".into())),
+        None => None,
+    };
+    let lines = render_image(&doc, &args.out, shot, probe, renderer);
     // The process ends with this command: freeing a large scene's allocations one by one
     // (two per object and more) would only delay the exit.
     std::mem::forget(doc);
-    let (line, report) = lines?;
+    let (line, report, phases) = lines?;
     eprintln!("{}", escape_controls(&line));
     if let Some(r) = report {
         eprintln!("{r}");
     } else if args.memory_report {
         eprintln!("memory: the resident size is not readable here (/proc/self/status)");
     }
+    if args.timings {
+        eprintln!(
+            "timings: load {:.1} ms, device wait {:.1} ms, draw and read back {:.1} ms, write {:.1} ms, total {:.1} ms",
+            ms(loaded),
+            ms(phases.device),
+            ms(phases.draw),
+            ms(phases.write),
+            ms(start.elapsed())
+        );
+    }
     Ok(())
+}
+
+fn ms(d: std::time::Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}
+
+/// A headless renderer with the validation layer as `PRESPLINE_VALIDATION` says.
+fn start_renderer() -> Result<Renderer, CliError> {
+    Renderer::new(&RendererDesc {
+        app_name: "prespline render".into(),
+        validation: validation_mode(),
+        ..RendererDesc::default()
+    })
+    .map_err(|e| CliError(e.to_string()))
+}
+
+/// How long [`render_image`]'s phases took.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Phases {
+    /// Starting the renderer, or waiting for it.
+    pub device: std::time::Duration,
+    /// Uploading, drawing and reading the pixels back.
+    pub draw: std::time::Duration,
+    /// Encoding and writing the image.
+    pub write: std::time::Duration,
 }
 
 /// `NAME@T` of `--osculating`.
@@ -204,31 +266,41 @@ pub struct MemoryProbe {
     pub before: Resident,
 }
 
-/// Renders `doc` headless and writes `out` (PNG or JPEG, by its extension); returns a
-/// one-line summary, and with `probe` the `--memory-report` line.
+/// Renders `doc` headless with `renderer` (one is started when `None`) and writes `out` (PNG
+/// or JPEG, by its extension); returns a one-line summary, with `probe` the
+/// `--memory-report` line, and the phases' times.
 pub fn render_image(
     doc: &Document,
     out: &Path,
     shot: Shot,
     probe: Option<MemoryProbe>,
-) -> Result<(String, Option<String>), CliError> {
+    renderer: Option<Renderer>,
+) -> Result<(String, Option<String>, Phases), CliError> {
     let (width, height) = (shot.width, shot.height);
     let start = Instant::now();
     // An image name that names no format the renderer writes is refused before anything runs.
     ImageFormat::of(out).map_err(CliError)?;
     let before_driver = Resident::read();
-    let mut renderer = Renderer::new(&RendererDesc {
-        app_name: "prespline render".into(),
-        validation: validation_mode(),
-        ..RendererDesc::default()
-    })
-    .map_err(|e| CliError(e.to_string()))?;
+    let mut renderer = match renderer {
+        Some(r) => r,
+        None => start_renderer()?,
+    };
     let after_driver = Resident::read();
+    let mut phases = Phases {
+        device: start.elapsed(),
+        ..Phases::default()
+    };
     let pixels = render_document(&mut renderer, doc, &shot).map_err(|e| CliError(e.to_string()))?;
     let sink = renderer.validation_sink();
     let device = renderer.caps().name.clone();
-    // Teardown first: the layer reports leaked objects when the device is destroyed.
-    drop(renderer);
+    if sink.is_some() {
+        // Teardown first: the layer reports leaked objects when the device is destroyed.
+        drop(renderer);
+    } else {
+        // The process ends with this command, and the driver's teardown (every pipeline's
+        // machine code, the device's memory) would only delay the exit.
+        std::mem::forget(renderer);
+    }
     if let Some(errors) = sink.map(|s| s.errors()).filter(|e| !e.is_empty()) {
         let first = errors[0].to_string();
         return Err(CliError(format!(
@@ -237,7 +309,9 @@ pub fn render_image(
             first.lines().next().unwrap_or("")
         )));
     }
+    phases.draw = start.elapsed() - phases.device;
     write_image(&pixels, out).map_err(CliError)?;
+    phases.write = start.elapsed() - phases.device - phases.draw;
     let summary = format!(
         "wrote {} ({width}x{height}, {} objects, {device}, {:.0} ms)",
         out.display(),
@@ -254,5 +328,5 @@ pub fn render_image(
         .line(),
         _ => "memory: the resident size is not readable here (/proc/self/status)".into(),
     });
-    Ok((summary, report))
+    Ok((summary, report, phases))
 }

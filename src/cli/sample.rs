@@ -153,7 +153,7 @@ fn write_object(
                     if j > 0 {
                         out.push_str(", ");
                     }
-                    out.push_str(if t.coverage.sample_inside(i, j) {
+                    out.push_str(if t.sample_inside(i, j) {
                         "true"
                     } else {
                         "false"

@@ -33,28 +33,93 @@ pub struct DocObject {
 /// The most boundary vertices of a trimmed surface [`DocObject::drawn_points`] evaluates.
 pub const BOUNDARY_POINTS: usize = 256;
 
-/// A trim with its coverage of an object's sample grid.
+/// A trim with its coverage of an object's sample grid, each sample cell cut into `refine`²
+/// mask cells (see [`TrimCoverage::of`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrimCoverage {
     pub trimmed: Trimmed,
+    /// The coverage of the mask grid: the sample grid with every cell cut `refine` times per
+    /// direction (its sample `(i·refine, j·refine)` is sample `(i, j)`).
     pub coverage: Coverage,
+    /// Mask cells per sample cell and direction, a power of two.
+    pub refine: usize,
 }
+
+/// The mask's target of boundary segments per mask cell, on average over its cells: what the
+/// fragment shader tests per fragment. A plane drawn from 2 × 2 samples with a hole flattened
+/// into thousands of segments would otherwise test all of them at every fragment (seconds a
+/// frame on lavapipe).
+const MASK_SEGMENTS_PER_CELL: f64 = 0.5;
+/// The most mask cells per sample cell and direction, and the most mask cells in all.
+const MAX_REFINE: usize = 64;
+const MAX_MASK_CELLS: usize = 1 << 21;
 
 impl TrimCoverage {
     /// The coverage of a sampled surface's grid by `trimmed`; `None` for a curve or a grid
     /// the coverage cannot take (over 32,768 samples a side, which no sample limit allows).
+    /// The mask cells: the sample cells cut in 2, 4, … per direction until the boundary's
+    /// segments per cell fall to [`MASK_SEGMENTS_PER_CELL`] on average (each cut quarters it:
+    /// a flattened curve's segments spread over twice the cells, each a quarter of the area).
     #[must_use]
     pub fn of(trimmed: &Trimmed, sampled: &SampledObject) -> Option<Self> {
         let params = sampled.params();
         let [u, v] = params.as_slice() else {
             return None;
         };
-        let coverage = Coverage::new(trimmed.regions(), u, v).ok()?;
+        let coarse = Coverage::new(trimmed.regions(), u, v).ok()?;
+        let (mu, mv) = coarse.samples();
+        let cells = (mu - 1) * (mv - 1);
+        let refs: usize = coarse
+            .gpu_records()
+            .iter()
+            .map(|r| (r[1] >> 1) as usize)
+            .sum();
+        let mut refine = 1;
+        let mut cost = refs as f64 / cells.max(1) as f64;
+        while cost > MASK_SEGMENTS_PER_CELL
+            && refine < MAX_REFINE
+            && 2 * refine * (mu - 1) < 32_768
+            && 2 * refine * (mv - 1) < 32_768
+            && cells * 4 * refine * refine <= MAX_MASK_CELLS
+        {
+            refine *= 2;
+            cost /= 4.0;
+        }
+        let coverage = if refine == 1 {
+            coarse
+        } else {
+            Coverage::new(trimmed.regions(), &cut(u, refine), &cut(v, refine)).ok()?
+        };
         Some(Self {
             trimmed: trimmed.clone(),
             coverage,
+            refine,
         })
     }
+
+    /// Whether sample `(i, j)` lies inside the trim.
+    #[must_use]
+    pub fn sample_inside(&self, i: usize, j: usize) -> bool {
+        self.coverage
+            .sample_inside(i * self.refine, j * self.refine)
+    }
+}
+
+/// The uniform parameters `s` with every interval cut into `k`.
+fn cut(s: &[f64], k: usize) -> Vec<f64> {
+    let (Some(&a), Some(&b)) = (s.first(), s.last()) else {
+        return Vec::new();
+    };
+    let n = (s.len() - 1) * k;
+    (0..=n)
+        .map(|m| {
+            if m == n {
+                b
+            } else {
+                a + (b - a) * m as f64 / n as f64
+            }
+        })
+        .collect()
 }
 
 impl DocObject {
@@ -81,17 +146,15 @@ impl DocObject {
     /// Whether sample (i, j) is drawn: inside the trim of a trimmed surface, always otherwise.
     #[must_use]
     pub fn drawn(&self, i: usize, j: usize) -> bool {
-        self.trim
-            .as_ref()
-            .is_none_or(|t| t.coverage.sample_inside(i, j))
+        self.trim.as_ref().is_none_or(|t| t.sample_inside(i, j))
     }
 
     /// Points of what is drawn, for framing and bounds: every `every`-th sample (a trimmed
-    /// surface's inside ones), and a trimmed surface's boundary, at most [`BOUNDARY_POINTS`]
-    /// of its vertices evaluated on the exact surface (a coarse grid of a large face, a plane's
-    /// 2 × 2, can have no sample inside its trim).
+    /// surface's inside ones), and a trimmed surface's boundary, at most `boundary` (at most
+    /// [`BOUNDARY_POINTS`]) of its vertices evaluated on the exact surface (a coarse grid of a
+    /// large face, a plane's 2 × 2, can have no sample inside its trim).
     #[must_use]
-    pub fn drawn_points(&self, every: usize) -> Vec<DVec3> {
+    pub fn drawn_points(&self, every: usize, boundary: usize) -> Vec<DVec3> {
         let g = self.sampled.grid();
         let [rows, cols] = g.dims;
         let every = every.max(1);
@@ -100,20 +163,24 @@ impl DocObject {
         };
         let mut out: Vec<DVec3> = (0..rows * cols)
             .step_by(every)
-            .filter(|k| t.coverage.sample_inside(k / cols, k % cols))
+            .filter(|k| t.sample_inside(k / cols, k % cols))
             .map(|k| g.position(k / cols, k % cols))
             .collect();
         let loops = t.trimmed.regions().loops();
         let vertices: usize = loops.iter().map(|l| l.points().len()).sum();
-        let step = vertices.div_ceil(BOUNDARY_POINTS).max(1);
-        let model = self.sampled.model();
+        let step = vertices.div_ceil(boundary.clamp(1, BOUNDARY_POINTS)).max(1);
+        let kind = self.sampled.model().kind();
         for p in loops.iter().flat_map(|l| l.points()).step_by(step) {
-            let mut d = [DVec3::ZERO];
-            model
-                .kind()
-                .derivatives_at([p.x, p.y], 0, &[(0, 0)], &mut d);
-            if d[0].is_finite() {
-                out.push(d[0]);
+            let q = match kind.tensor() {
+                Some(t) => t.first_partials(p.x, p.y)[0],
+                None => {
+                    let mut d = [DVec3::ZERO];
+                    kind.derivatives_at([p.x, p.y], 0, &[(0, 0)], &mut d);
+                    d[0]
+                }
+            };
+            if q.is_finite() {
+                out.push(q);
             }
         }
         out
@@ -291,7 +358,7 @@ impl Document {
         // minimum and a maximum, so the order does not matter).
         let each = crate::parallel::map(&self.objects, |o| {
             let mut b = Bounds::EMPTY;
-            for p in o.drawn_points(1) {
+            for p in o.drawn_points(1, BOUNDARY_POINTS) {
                 b.include(p);
             }
             for p in o.controls.grip_points() {

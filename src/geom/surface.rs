@@ -496,6 +496,84 @@ impl TensorSurface {
         ]
     }
 
+    /// [`TensorSurface::first_partials`] at every point of the grid `us` × `vs` (at most
+    /// [`GRID_NODES`] each), `out[a * vs.len() + b]` at `(us[a], vs[b])`, the same bits. Where
+    /// every node of the grid lies in one knot span per direction (the Gauss nodes of a cell
+    /// between breakpoints), the basis functions are found once per row and column and the
+    /// control net is contracted with the v basis once per column: 12 basis evaluations and
+    /// about a fifth of the multiplications of 36 separate points.
+    pub fn first_partials_grid(&self, us: &[f64], vs: &[f64], out: &mut [[DVec3; 3]]) {
+        let [du, dv] = self.degree;
+        let fallback = |out: &mut [[DVec3; 3]]| {
+            for (a, &u) in us.iter().enumerate() {
+                for (b, &v) in vs.iter().enumerate() {
+                    if let Some(o) = out.get_mut(a * vs.len() + b) {
+                        *o = self.first_partials(u, v);
+                    }
+                }
+            }
+        };
+        if du > STACK_DEGREE
+            || dv > STACK_DEGREE
+            || us.len() > GRID_NODES
+            || vs.len() > GRID_NODES
+            || out.len() < us.len() * vs.len()
+            || us.is_empty()
+            || vs.is_empty()
+        {
+            return fallback(out);
+        }
+        let [(u0, u1), (v0, v1)] = self.domain();
+        let su = self.knots[0].find_span(du, self.count[0], us[0]);
+        let sv = self.knots[1].find_span(dv, self.count[1], vs[0]);
+        let same_u = us
+            .iter()
+            .all(|&u| self.knots[0].find_span(du, self.count[0], u) == su);
+        let same_v = vs
+            .iter()
+            .all(|&v| self.knots[1].find_span(dv, self.count[1], v) == sv);
+        if !(same_u && same_v) {
+            return fallback(out);
+        }
+        let nv = self.count[1];
+        // Per v node, per row k of the span: Σ_l H_{k,l} N_l(v) and Σ_l H_{k,l} N_l′(v).
+        let mut col = [[DVec4::ZERO; STACK_DEGREE + 1]; GRID_NODES];
+        let mut col_v = [[DVec4::ZERO; STACK_DEGREE + 1]; GRID_NODES];
+        for (b, &v) in vs.iter().enumerate() {
+            let (bv, dbv) = basis_and_derivative(self.knots[1].as_slice(), dv, sv, v.clamp(v0, v1));
+            for k in 0..=du {
+                let row = (su - du + k) * nv + sv - dv;
+                let (mut inner, mut inner_v) = (DVec4::ZERO, DVec4::ZERO);
+                for l in 0..=dv {
+                    let idx = row + l;
+                    let w = self.weights.as_ref().map_or(1.0, |w| w[idx]);
+                    let h = to_homogeneous(self.points[idx], w);
+                    inner += h * bv[l];
+                    inner_v += h * dbv[l];
+                }
+                col[b][k] = inner;
+                col_v[b][k] = inner_v;
+            }
+        }
+        for (a, &u) in us.iter().enumerate() {
+            let (bu, dbu) = basis_and_derivative(self.knots[0].as_slice(), du, su, u.clamp(u0, u1));
+            for b in 0..vs.len() {
+                let (mut s, mut s_u, mut s_v) = (DVec4::ZERO, DVec4::ZERO, DVec4::ZERO);
+                for k in 0..=du {
+                    s += col[b][k] * bu[k];
+                    s_u += col[b][k] * dbu[k];
+                    s_v += col_v[b][k] * bu[k];
+                }
+                let p = s.truncate() / s.w;
+                out[a * vs.len() + b] = [
+                    p,
+                    (s_u.truncate() - p * s_u.w) / s.w,
+                    (s_v.truncate() - p * s_v.w) / s.w,
+                ];
+            }
+        }
+    }
+
     /// S(u, v) by de Boor's algorithm as a curve of curves (independent of the Hermite path).
     #[must_use]
     pub fn eval(&self, u: f64, v: f64) -> DVec3 {
@@ -539,6 +617,9 @@ impl TensorSurface {
 /// Degrees up to which [`TensorSurface::first_partials`] works in stack arrays.
 const STACK_DEGREE: usize = 15;
 
+/// The most nodes per direction [`TensorSurface::first_partials_grid`] takes at once.
+pub const GRID_NODES: usize = 8;
+
 /// The d + 1 basis functions non-zero on `span` at `t` and their first derivatives.
 fn basis_and_derivative(
     knots: &[f64],
@@ -547,14 +628,28 @@ fn basis_and_derivative(
     t: f64,
 ) -> ([f64; STACK_DEGREE + 1], [f64; STACK_DEGREE + 1]) {
     let mut n = [0.0; STACK_DEGREE + 1];
-    super::basis::basis_funs_into(knots, d, span, t, &mut n);
     let mut dn = [0.0; STACK_DEGREE + 1];
+    // The d basis functions of degree d − 1 on the span, N_{span−d+1 ..= span, d−1}: BasisFuns
+    // (A2.2) one step short of degree d, kept on the way.
+    let mut low = [0.0; STACK_DEGREE + 1];
+    n[0] = 1.0;
+    for j in 1..=d {
+        if j == d {
+            low[..d].copy_from_slice(&n[..d]);
+        }
+        let mut saved = 0.0;
+        for r in 0..j {
+            let right = knots[span + r + 1] - t;
+            let left = t - knots[span + 1 + r - j];
+            let temp = n[r] / (right + left);
+            n[r] = saved + right * temp;
+            saved = left * temp;
+        }
+        n[j] = saved;
+    }
     if d == 0 {
         return (n, dn);
     }
-    // The d basis functions of degree d − 1 on the span: N_{span−d+1 ..= span, d−1}.
-    let mut low = [0.0; STACK_DEGREE + 1];
-    super::basis::basis_funs_into(knots, d - 1, span, t, &mut low);
     let df = d as f64;
     for j in 0..=d {
         let i = span - d + j;

@@ -11,7 +11,7 @@ use super::grid::GridStride;
 use super::mirror::Mirror;
 use super::pipeline::{
     Lines3dPush, MASK_BINDING, MapPush, OverlayPush, PUSH_STAGES, PointsPush, PolylinePush,
-    SurfacePush, WirePush,
+    SurfacePush, Which, WirePush,
 };
 use super::pod::{Pod, bytes_of};
 use super::region::{PointRun, SurfaceBatch, SurfaceGrid};
@@ -20,11 +20,7 @@ use super::transient::TransientAlloc;
 use super::vertex::{LineVertex, OverlayVertex};
 
 /// The pipeline for a batch: `trimmed` when it has a coverage mask (checked against it).
-fn masked(
-    batch: &SurfaceBatch,
-    whole: vk::Pipeline,
-    trimmed: vk::Pipeline,
-) -> GpuResult<vk::Pipeline> {
+fn masked(batch: &SurfaceBatch, whole: Which, trimmed: Which) -> GpuResult<Which> {
     match batch.mask {
         Some(mask) => mask.check(batch.offsets.len()).map(|()| trimmed),
         None => Ok(whole),
@@ -184,8 +180,9 @@ impl Frame<'_> {
             back: style.back,
         };
         let cells = check_cells(cells, count, &runs)?;
-        let pipelines = &self.ctx.pipelines;
-        let pipeline = masked(batch, pipelines.surface, pipelines.surface_trim)?;
+        let pipeline = self
+            .ctx
+            .pipeline(masked(batch, Which::Surface, Which::SurfaceTrim)?)?;
         self.bind_and_push(pipeline, &push);
         let instance = self.bind_mask(batch);
         let indices = self.draw_indexed(mirror, base, index_buffer, count, &runs, cells, instance);
@@ -272,8 +269,9 @@ impl Frame<'_> {
             params,
         };
         let cells = check_cells(cells, count, &runs)?;
-        let pipelines = &self.ctx.pipelines;
-        let pipeline = masked(batch, pipelines.surface_map, pipelines.surface_map_trim)?;
+        let pipeline =
+            self.ctx
+                .pipeline(masked(batch, Which::SurfaceMap, Which::SurfaceMapTrim)?)?;
         self.bind_and_push(pipeline, &push);
         let scalar_buffer = scalars.slot(self.slot).raw();
         // SAFETY: recording inside a rendering scope; the scalar mirror has VERTEX_BUFFER
@@ -350,8 +348,9 @@ impl Frame<'_> {
             view_proj: self.view_proj(),
             color,
         };
-        let pipelines = &self.ctx.pipelines;
-        let pipeline = masked(batch, pipelines.wire, pipelines.wire_trim)?;
+        let pipeline = self
+            .ctx
+            .pipeline(masked(batch, Which::Wire, Which::WireTrim)?)?;
         self.bind_and_push(pipeline, &push);
         let instance = self.bind_mask(batch);
         self.draw_indexed(mirror, base, index_buffer, count, &runs, None, instance);
@@ -514,9 +513,9 @@ impl Frame<'_> {
             thin: u32::from(thin),
         };
         let (pipeline, per_segment) = if thin {
-            (self.ctx.pipelines.thin_lines, 2)
+            (self.ctx.eager(Which::ThinLines), 2)
         } else {
-            (self.ctx.pipelines.polyline, 6)
+            (self.ctx.eager(Which::Polyline), 6)
         };
         self.bind_and_push(pipeline, &push);
         self.set_depth_test(style.depth_test);
@@ -555,7 +554,7 @@ impl Frame<'_> {
             quads: u32::from(!large_points),
             _pad: 0,
         };
-        self.bind_and_push(self.ctx.pipelines.points, &push);
+        self.bind_and_push(self.ctx.eager(Which::Points), &push);
         self.set_depth_test(style.depth_test);
         self.draw_vertices(vertex_count(run.count, if large_points { 1 } else { 6 }));
         Ok(())
@@ -576,7 +575,7 @@ impl Frame<'_> {
         let push = Lines3dPush {
             view_proj: self.view_proj(),
         };
-        self.bind_and_push(self.ctx.pipelines.lines3d, &push);
+        self.bind_and_push(self.ctx.eager(Which::Lines3d), &push);
         self.draw_transient(alloc, (vertices.len() & !1) as u32);
         Ok(())
     }
@@ -596,7 +595,7 @@ impl Frame<'_> {
             atlas_width: self.ctx.text.atlas_size()[0],
             _pad: 0,
         };
-        self.bind_and_push(self.ctx.pipelines.overlay, &push);
+        self.bind_and_push(self.ctx.eager(Which::Overlay), &push);
         self.draw_transient(alloc, count as u32);
         Ok(())
     }

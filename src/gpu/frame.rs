@@ -11,7 +11,8 @@ use super::font::Font;
 use super::grid::GridCache;
 use super::mirror::{Mirror, MirrorWriter};
 use super::offscreen::OffscreenTarget;
-use super::pipeline::PipelineSet;
+use super::pipeline::{PipelineKey, Pipelines, Which};
+use super::shader::Shaders;
 use super::slot::{FrameRing, FrameSlot};
 use super::style::Camera;
 use super::swapchain::Swapchain;
@@ -60,13 +61,30 @@ pub(crate) struct FrameContext<'a> {
     pub grids: &'a mut GridCache,
     pub uploader: &'a mut Uploader,
     pub layout: vk::PipelineLayout,
-    pub pipelines: PipelineSet,
+    /// The pipelines, built for the target's key on first use ([`FrameContext::pipeline`]).
+    pub pipelines: &'a mut Pipelines,
+    pub shaders: &'a Shaders,
+    pub key: PipelineKey,
     /// Device address of the overlay font's glyph atlas (0: none).
     pub font: vk::DeviceAddress,
     /// The overlay font the atlas was built from (metrics and layout).
     pub text: &'a Font,
     /// Flush host writes even to coherent memory (see `RendererDesc::always_flush`).
     pub always_flush: bool,
+}
+
+impl FrameContext<'_> {
+    /// Pipeline `which` for this frame's target, built on first use (creating a pipeline
+    /// while a command buffer records is allowed: pipelines are not command-buffer state).
+    pub(crate) fn pipeline(&mut self, which: Which) -> GpuResult<vk::Pipeline> {
+        self.pipelines
+            .get(self.device, self.shaders, self.key, which)
+    }
+
+    /// A pipeline built with the set when the frame began (lines, points, overlays).
+    pub(crate) fn eager(&self, which: Which) -> vk::Pipeline {
+        self.pipelines.eager(self.key, which)
+    }
 }
 
 /// One frame being recorded. Obtained from [`super::Renderer::begin_offscreen`] or

@@ -289,6 +289,9 @@ impl Pixels {
         encoder.set_color(png::ColorType::Rgba);
         encoder.set_depth(png::BitDepth::Eight);
         encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+        // fdeflate's PNG-tuned mode: a 1280 × 720 render in a few milliseconds instead of tens,
+        // for files about a fifth larger (renders are flat colours and smooth shading).
+        encoder.set_compression(png::Compression::Fast);
         let mut writer = encoder.write_header().map_err(|e| err(e.to_string()))?;
         writer
             .write_image_data(&self.rgba)

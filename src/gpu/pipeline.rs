@@ -5,7 +5,6 @@
 //! for polylines/points from buffer device addresses in the push constants.
 
 use std::collections::HashMap;
-use std::collections::hash_map::Entry;
 use std::mem::offset_of;
 
 use ash::vk;
@@ -158,27 +157,62 @@ pub(crate) struct PipelineKey {
     pub samples: vk::SampleCountFlags,
 }
 
-/// One pipeline per primitive kind, for one [`PipelineKey`].
-#[derive(Clone, Copy)]
-pub(crate) struct PipelineSet {
-    pub surface: vk::Pipeline,
-    pub wire: vk::Pipeline,
-    pub polyline: vk::Pipeline,
+/// The pipelines of a set, one per primitive kind. Those the infallible draws use (lines,
+/// points, overlays) are built with the set; the others on first use, so that a scene of
+/// curves compiles no surface pipeline and one of trimmed faces no untrimmed one (lavapipe
+/// compiles each to machine code: milliseconds and megabytes apiece).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Which {
+    Surface,
+    Wire,
+    Polyline,
     /// `polyline.vert` as a line list: one-pixel lines and nets, 2 vertices per segment.
-    pub thin_lines: vk::Pipeline,
-    pub points: vk::Pipeline,
-    pub lines3d: vk::Pipeline,
-    pub overlay: vk::Pipeline,
+    ThinLines,
+    Points,
+    Lines3d,
+    Overlay,
     /// Surfaces coloured by an analysis map (a second vertex stream of one scalar each).
-    pub surface_map: vk::Pipeline,
+    SurfaceMap,
     /// The surface, map and wire pipelines of trimmed surfaces: a third, instance-rate
     /// stream names the object's coverage mask, which every fragment is tested against.
-    pub surface_trim: vk::Pipeline,
-    pub surface_map_trim: vk::Pipeline,
-    pub wire_trim: vk::Pipeline,
+    SurfaceTrim,
+    SurfaceMapTrim,
+    WireTrim,
 }
 
-/// The shared layout and the pipeline sets built so far.
+impl Which {
+    /// Every pipeline, in the order of [`set_specs`].
+    const ALL: [Which; SET_SIZE] = [
+        Which::Surface,
+        Which::Wire,
+        Which::Polyline,
+        Which::Points,
+        Which::ThinLines,
+        Which::Lines3d,
+        Which::Overlay,
+        Which::SurfaceMap,
+        Which::SurfaceTrim,
+        Which::SurfaceMapTrim,
+        Which::WireTrim,
+    ];
+
+    /// Built with the set: the pipelines of draws that cannot fail.
+    fn eager(self) -> bool {
+        matches!(
+            self,
+            Which::Polyline | Which::ThinLines | Which::Points | Which::Lines3d | Which::Overlay
+        )
+    }
+
+    fn index(self) -> usize {
+        Self::ALL.iter().position(|&w| w == self).unwrap_or(0)
+    }
+}
+
+/// The pipelines built so far for one [`PipelineKey`] (null: not yet).
+type PipelineSet = [vk::Pipeline; SET_SIZE];
+
+/// The shared layout and the pipelines built so far, per target.
 #[derive(Default)]
 pub(crate) struct Pipelines {
     pub layout: vk::PipelineLayout,
@@ -244,17 +278,48 @@ impl Pipelines {
         })
     }
 
-    /// The pipeline set for `key`, built on first use (a new swapchain format, say).
+    /// Builds the eager pipelines of `key`'s set if they are not there (a new swapchain
+    /// format, say): a frame's infallible draws use them.
+    pub(crate) fn prepare(
+        &mut self,
+        device: &Device,
+        shaders: &Shaders,
+        key: PipelineKey,
+    ) -> GpuResult<()> {
+        for w in Which::ALL.into_iter().filter(|w| w.eager()) {
+            self.get(device, shaders, key, w)?;
+        }
+        Ok(())
+    }
+
+    /// Pipeline `which` for `key`, built on first use.
     pub(crate) fn get(
         &mut self,
         device: &Device,
         shaders: &Shaders,
         key: PipelineKey,
-    ) -> GpuResult<&PipelineSet> {
-        Ok(match self.sets.entry(key) {
-            Entry::Occupied(e) => e.into_mut(),
-            Entry::Vacant(e) => e.insert(build_set(device, shaders, self.layout, key)?),
-        })
+        which: Which,
+    ) -> GpuResult<vk::Pipeline> {
+        let set = self
+            .sets
+            .entry(key)
+            .or_insert([vk::Pipeline::null(); SET_SIZE]);
+        let slot = &mut set[which.index()];
+        if *slot == vk::Pipeline::null() {
+            let inputs = VertexInputs::new();
+            let specs = set_specs(&inputs, device.caps.large_points);
+            *slot = build_one(device, shaders, self.layout, key, &specs[which.index()])?;
+        }
+        Ok(*slot)
+    }
+
+    /// A pipeline [`Pipelines::prepare`] built for `key`; null if it was not called.
+    #[must_use]
+    pub(crate) fn eager(&self, key: PipelineKey, which: Which) -> vk::Pipeline {
+        debug_assert!(which.eager());
+        self.sets
+            .get(&key)
+            .map_or(vk::Pipeline::null(), |s| s[which.index()])
     }
 
     /// Destroys every pipeline and the layout.
@@ -263,20 +328,8 @@ impl Pipelines {
     /// No submitted GPU work that uses these objects may still be pending (the device is idle
     /// or lost, or they were never used).
     pub(crate) unsafe fn destroy(self, device: &Device) {
-        for set in self.sets.into_values() {
-            for p in [
-                set.surface,
-                set.wire,
-                set.polyline,
-                set.thin_lines,
-                set.points,
-                set.lines3d,
-                set.overlay,
-                set.surface_map,
-                set.surface_trim,
-                set.surface_map_trim,
-                set.wire_trim,
-            ] {
+        for p in self.sets.into_values().flatten() {
+            if p != vk::Pipeline::null() {
                 // SAFETY: the renderer waited for the GPU before destroying pipelines.
                 unsafe { device.raw.destroy_pipeline(p, None) };
             }
@@ -371,7 +424,7 @@ pub(crate) const MASK_BINDING: u32 = 2;
 /// The pipelines of a set, in the order of [`set_specs`].
 const SET_SIZE: usize = 11;
 
-/// What each pipeline of a set is made of, in the order [`PipelineSet::from_built`] reads:
+/// What each pipeline of a set is made of, in the order of [`Which::ALL`]:
 /// surface, wire, polyline, points, thin lines, 3D lines, overlay, surface map, and the
 /// trimmed surface, surface map and wire.
 fn set_specs(inputs: &VertexInputs, large_points: bool) -> [Spec<'_>; SET_SIZE] {
@@ -473,75 +526,6 @@ fn set_specs(inputs: &VertexInputs, large_points: bool) -> [Spec<'_>; SET_SIZE] 
             blend: false,
         },
     ]
-}
-
-impl PipelineSet {
-    /// Names the pipelines built from [`set_specs`], in its order.
-    fn from_built(p: [vk::Pipeline; SET_SIZE]) -> Self {
-        let [
-            surface,
-            wire,
-            polyline,
-            points,
-            thin_lines,
-            lines3d,
-            overlay,
-            surface_map,
-            surface_trim,
-            surface_map_trim,
-            wire_trim,
-        ] = p;
-        Self {
-            surface,
-            wire,
-            polyline,
-            thin_lines,
-            points,
-            lines3d,
-            overlay,
-            surface_map,
-            surface_trim,
-            surface_map_trim,
-            wire_trim,
-        }
-    }
-}
-
-/// Every pipeline of the set for `key`.
-fn build_set(
-    device: &Device,
-    shaders: &Shaders,
-    layout: vk::PipelineLayout,
-    key: PipelineKey,
-) -> GpuResult<PipelineSet> {
-    let inputs = VertexInputs::new();
-    let specs = set_specs(&inputs, device.caps.large_points);
-    let built = build_all(device, shaders, layout, key, &specs)?;
-    Ok(PipelineSet::from_built(built))
-}
-
-/// One pipeline per spec; on failure, those built so far are destroyed.
-fn build_all(
-    device: &Device,
-    shaders: &Shaders,
-    layout: vk::PipelineLayout,
-    key: PipelineKey,
-    specs: &[Spec<'_>; SET_SIZE],
-) -> GpuResult<[vk::Pipeline; SET_SIZE]> {
-    let mut built = [vk::Pipeline::null(); SET_SIZE];
-    for (i, spec) in specs.iter().enumerate() {
-        match build_one(device, shaders, layout, key, spec) {
-            Ok(p) => built[i] = p,
-            Err(e) => {
-                for &p in &built[..i] {
-                    // SAFETY: freshly created, never used.
-                    unsafe { device.raw.destroy_pipeline(p, None) };
-                }
-                return Err(e);
-            }
-        }
-    }
-    Ok(built)
 }
 
 fn build_one(

@@ -18,8 +18,9 @@ use super::grid::GridCache;
 use super::instance::{Instance, InstanceDesc, ValidationMode};
 use super::memory::Buffer;
 use super::mirror::Mirror;
+use super::offscreen::OFFSCREEN_FORMAT;
 use super::offscreen::{OffscreenDesc, OffscreenTarget, Pixels};
-use super::pipeline::{PipelineKey, PipelineSet, Pipelines};
+use super::pipeline::{PipelineKey, Pipelines, Which};
 use super::shader::Shaders;
 use super::slot::{FrameRing, FrameSlot};
 use super::swapchain::{Swapchain, SwapchainDesc};
@@ -266,6 +267,23 @@ impl Renderer {
         OffscreenTarget::new(&self.device, desc, samples)
     }
 
+    /// Builds ahead the pipelines an offscreen frame of `samples` MSAA samples draws shaded
+    /// surfaces with (untrimmed and trimmed) and those every frame needs, so that a caller
+    /// can compile them on a second thread while it loads a scene (lavapipe compiles each
+    /// pipeline to machine code: milliseconds apiece).
+    pub fn warm_offscreen(&mut self, samples: u32) -> GpuResult<()> {
+        let key = PipelineKey {
+            color_format: OFFSCREEN_FORMAT,
+            samples: self.device.caps.resolve_samples(samples)?,
+        };
+        self.pipelines.prepare(&self.device, &self.shaders, key)?;
+        for which in [Which::Surface, Which::SurfaceTrim] {
+            self.pipelines
+                .get(&self.device, &self.shaders, key, which)?;
+        }
+        Ok(())
+    }
+
     /// Waits for the last frame rendered into `target` and returns its pixels. That frame
     /// must have been captured ([`Frame::capture`]).
     pub fn read_pixels(&mut self, target: &OffscreenTarget) -> GpuResult<Pixels> {
@@ -337,9 +355,9 @@ impl Renderer {
     ) -> GpuResult<Frame<'a>> {
         let slot = self.frames.next_slot(&self.device)?;
         let view = target.view();
-        let pipelines = self.prepare(view, slot, false)?;
+        let key = self.prepare(view, slot, false)?;
         Ok(Frame::new(
-            self.frame_context(pipelines),
+            self.frame_context(key),
             FrameTarget::Offscreen(target),
             view,
             slot,
@@ -363,7 +381,7 @@ impl Renderer {
         // submitted, or the slot's acquire semaphore stays signalled.
         if let Some(view) = swapchain.view(0) {
             self.pipelines
-                .get(&self.device, &self.shaders, pipeline_key(&view))?;
+                .prepare(&self.device, &self.shaders, pipeline_key(&view))?;
         }
         let slot = self.frames.next_slot(&self.device)?;
         let acquire = self.frames.slots[slot].acquire;
@@ -377,7 +395,7 @@ impl Renderer {
                 "acquired image {image_index} does not exist"
             ))),
         };
-        let (view, pipelines) = match prepared {
+        let (view, key) = match prepared {
             Ok(p) => p,
             Err(e) => {
                 swapchain.stale = true;
@@ -390,7 +408,7 @@ impl Renderer {
             image_index,
         };
         Ok(Some(Frame::new(
-            self.frame_context(pipelines),
+            self.frame_context(key),
             target,
             view,
             slot,
@@ -404,28 +422,29 @@ impl Renderer {
         view: TargetView,
         slot: usize,
         swapchain: bool,
-    ) -> GpuResult<PipelineSet> {
-        let pipelines = *self
-            .pipelines
-            .get(&self.device, &self.shaders, pipeline_key(&view))?;
+    ) -> GpuResult<PipelineKey> {
+        let key = pipeline_key(&view);
+        self.pipelines.prepare(&self.device, &self.shaders, key)?;
         let frame_slot: &mut FrameSlot = &mut self.frames.slots[slot];
         frame_slot.begin_commands(&self.device)?;
         let barriers = barrier::begin_barriers(&view, swapchain);
         // SAFETY: the slot's command buffer is recording (begun above, outside rendering);
         // the images are live and owned by the target.
         unsafe { barrier::record(&self.device.raw, frame_slot.cmd, &barriers) };
-        Ok(pipelines)
+        Ok(key)
     }
 
     /// What a frame borrows from the renderer while it records.
-    fn frame_context(&mut self, pipelines: PipelineSet) -> FrameContext<'_> {
+    fn frame_context(&mut self, key: PipelineKey) -> FrameContext<'_> {
         FrameContext {
             device: &self.device,
             ring: &mut self.frames,
             grids: &mut self.grids,
             uploader: &mut self.uploader,
             layout: self.pipelines.layout,
-            pipelines,
+            pipelines: &mut self.pipelines,
+            shaders: &self.shaders,
+            key,
             font: self.font.as_ref().map_or(0, |f| f.address()),
             text: &self.text,
             always_flush: self.always_flush,

@@ -8,6 +8,7 @@ use super::erbs::LocalPath;
 use super::index::Index2;
 use super::spline::curve::CurveModel;
 use crate::fields::{At, ReadCtx, SceneError};
+use crate::geom::surface::TensorSurface;
 use crate::sampling::budget::Extent;
 use crate::sampling::{DirtyRegion, SampleMode, Sampler, Tracked};
 use glam::DVec3;
@@ -60,10 +61,10 @@ pub trait Kind: Clone + Debug + PartialEq + Sized + 'static {
     /// Parameter domain per direction (one entry for curves).
     fn domain(&self) -> Vec<(f64, f64)>;
 
-    /// S, S_u and S_v at `uv` from an evaluator that does not allocate, where the kind has
-    /// one (tensor-product surfaces): what measures a surface evaluates it thousands of times.
-    /// `None`: [`Kind::derivatives_at`] serves.
-    fn first_partials(&self, _uv: [f64; 2]) -> Option<[DVec3; 3]> {
+    /// The kind's geometry as a tensor-product (rational) B-spline surface, where it is one:
+    /// what measures a surface evaluates it thousands of times, through evaluators that do not
+    /// allocate ([`TensorSurface::first_partials`]). `None`: [`Kind::derivatives_at`] serves.
+    fn tensor(&self) -> Option<&TensorSurface> {
         None
     }
 

@@ -10,6 +10,7 @@ use super::erbs::LocalPath;
 use super::index::Index2;
 use super::kind::{Kind, Support};
 use crate::fields::{At, SceneError};
+use crate::geom::surface::TensorSurface;
 use crate::sampling::budget::Extent;
 use crate::sampling::{DirtyRegion, SampleGrid, SampleMode, Sampler, Tracked};
 use glam::DVec3;
@@ -226,8 +227,8 @@ pub trait DynKind {
     fn type_name(&self) -> &'static str;
     fn is_surface(&self) -> bool;
     fn sample_dims(&self) -> [usize; 2];
-    /// S, S_u, S_v by a fast evaluator, where the kind has one ([`Kind::first_partials`]).
-    fn first_partials(&self, uv: [f64; 2]) -> Option<[DVec3; 3]>;
+    /// The tensor-product B-spline surface, where the kind is one ([`Kind::tensor`]).
+    fn tensor(&self) -> Option<&TensorSurface>;
     /// The degree per direction, where the kind has one ([`Kind::degrees`]).
     fn degrees(&self) -> Vec<usize>;
     /// Where the geometry's pieces meet, per direction ([`Kind::breakpoints`]).
@@ -299,8 +300,8 @@ where
         Kind::degrees(self)
     }
 
-    fn first_partials(&self, uv: [f64; 2]) -> Option<[DVec3; 3]> {
-        Kind::first_partials(self, uv)
+    fn tensor(&self) -> Option<&TensorSurface> {
+        Kind::tensor(self)
     }
 
     fn with_samples(&self, samples: [usize; 2]) -> Result<Model, EditError> {

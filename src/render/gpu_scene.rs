@@ -579,7 +579,7 @@ impl GpuScene {
             .filter_map(|g| {
                 let i = g.members[0];
                 let trim = doc.objects[i].trim.as_ref()?;
-                Some((i, mask_words(&trim.coverage)))
+                Some((i, mask_words(&trim.coverage, trim.refine)))
             })
             .collect();
         let words: Vec<MaskWords<'_>> = masked

@@ -62,8 +62,12 @@ pub fn framing_points(doc: &Document, nets: impl Fn(usize) -> bool) -> Vec<DVec3
         .collect();
     let every = (samples + handles.len()).div_ceil(MAX).max(1);
     let mut points: Vec<DVec3> = handles.into_iter().step_by(every).collect();
+    // The trimmed surfaces' boundary points share the same allowance (a CAD model has
+    // hundreds of faces, each with thousands of boundary vertices).
+    let trimmed = doc.objects.iter().filter(|o| o.trim.is_some()).count();
+    let boundary = (MAX / trimmed.max(1)).max(16);
     for o in &doc.objects {
-        points.extend(o.drawn_points(every));
+        points.extend(o.drawn_points(every, boundary));
     }
     points
 }

@@ -7,8 +7,8 @@
 use crate::geom::trim::{CellClass, Coverage};
 
 /// Words before the cell words: the offsets of the cells, records, segments and level table,
-/// and the cell rows and columns.
-const HEADER: usize = 6;
+/// the sample cell rows and columns, and the mask cells per sample cell and direction.
+const HEADER: usize = 7;
 
 /// Strides 1, 2, 4, 8, 16 per direction: the display level of detail's (`lod::MAX_STRIDE`).
 pub const STRIDE_LEVELS: u32 = 5;
@@ -19,9 +19,11 @@ const OUTSIDE: u8 = 0;
 const INSIDE: u8 = 1;
 const MIXED: u8 = 2;
 
-/// The mask words of `c`.
+/// The mask words of `c`, a coverage of the sample grid with every cell cut `refine` times
+/// per direction (a power of two; see `editor::TrimCoverage`).
 #[must_use]
-pub fn mask_words(c: &Coverage) -> Vec<u32> {
+pub fn mask_words(c: &Coverage, refine: usize) -> Vec<u32> {
+    let refine = refine.max(1);
     let (mu, mv) = c.samples();
     let (cells, records, segments) = (c.gpu_cells(), c.gpu_records(), c.gpu_segments());
     let at_records = HEADER + cells.len();
@@ -34,28 +36,36 @@ pub fn mask_words(c: &Coverage) -> Vec<u32> {
         word(at_records),
         word(at_segments),
         word(at_levels),
-        word(mu.saturating_sub(1)),
-        word(mv.saturating_sub(1)),
+        word(mu.saturating_sub(1) / refine),
+        word(mv.saturating_sub(1) / refine),
+        word(refine),
     ]);
     out.extend_from_slice(cells);
     out.extend(records.iter().flatten());
     out.extend(segments.iter().flatten().map(|x| x.to_bits()));
-    append_levels(c, &mut out);
+    append_levels(c, refine, &mut out);
     out
 }
 
 /// The level table (one word per (row level, column level): the offset of its packed
-/// classes) and the packed classes of every level, 16 blocks a word, row-major.
-fn append_levels(c: &Coverage, out: &mut Vec<u32>) {
+/// classes) and the packed classes of every level, 16 blocks a word, row-major: blocks of
+/// sample cells, each a merge of its `refine`² mask cells.
+fn append_levels(c: &Coverage, refine: usize, out: &mut Vec<u32>) {
     let (mu, mv) = c.samples();
-    let (ncu, ncv) = (mu.saturating_sub(1), mv.saturating_sub(1));
-    let fine: Vec<u8> = (0..ncu * ncv)
+    let (mut ncu, mut ncv) = (mu.saturating_sub(1), mv.saturating_sub(1));
+    let mut fine: Vec<u8> = (0..ncu * ncv)
         .map(|k| match c.cell_class(k / ncv.max(1), k % ncv.max(1)) {
             CellClass::Outside => OUTSIDE,
             CellClass::Inside => INSIDE,
             CellClass::Boundary => MIXED,
         })
         .collect();
+    let mut k = refine;
+    while k > 1 {
+        (fine, ncu) = halve_rows(&fine, ncu, ncv);
+        (fine, ncv) = halve_cols(&fine, ncu, ncv);
+        k /= 2;
+    }
     let table = out.len();
     let n = STRIDE_LEVELS as usize;
     out.extend(std::iter::repeat_n(0, n * n));
@@ -187,22 +197,28 @@ mod tests {
     }
 
     /// Every block of every level says what its cells are: inside only if all are, outside
-    /// only if all are, mixed otherwise; the shader's fast path relies on it.
+    /// only if all are, mixed otherwise; the shader's fast path relies on it. Also for masks
+    /// whose cells cut each sample cell in 2 × 2 and 4 × 4 (a block of sample cells then
+    /// merges all the mask cells under it).
     #[test]
     fn block_classes_of_every_level_agree_with_their_cells() {
-        for (n, m) in [(33, 29), (40, 17), (9, 9)] {
-            let c = coverage(n, m);
-            let words = mask_words(&c);
+        for (n, m, refine) in [(33, 29, 1), (40, 17, 1), (9, 9, 1), (9, 8, 2), (9, 9, 4)] {
             let (ncu, ncv) = (n - 1, m - 1);
+            let c = coverage(ncu * refine + 1, ncv * refine + 1);
+            let words = mask_words(&c, refine);
+            assert_eq!(
+                (words[4], words[5], words[6]),
+                (ncu as u32, ncv as u32, refine as u32)
+            );
             for lr in 0..5 {
                 for lc in 0..5 {
                     let (sr, sc) = (1usize << lr, 1usize << lc);
                     for br in 0..ncu.div_ceil(sr) {
                         for bc in 0..ncv.div_ceil(sc) {
-                            let cells: Vec<CellClass> = (br * sr..((br + 1) * sr).min(ncu))
-                                .flat_map(|i| {
-                                    (bc * sc..((bc + 1) * sc).min(ncv)).map(move |j| (i, j))
-                                })
+                            let rows = br * sr * refine..((br + 1) * sr).min(ncu) * refine;
+                            let cols = bc * sc * refine..((bc + 1) * sc).min(ncv) * refine;
+                            let cells: Vec<CellClass> = rows
+                                .flat_map(|i| cols.clone().map(move |j| (i, j)))
                                 .map(|(i, j)| c.cell_class(i, j))
                                 .collect();
                             let want = if cells.iter().all(|&x| x == CellClass::Inside) {
@@ -215,7 +231,7 @@ mod tests {
                             assert_eq!(
                                 packed(&words, lr, lc, br, bc),
                                 want,
-                                "{n}x{m} level ({lr}, {lc}) block ({br}, {bc})"
+                                "{n}x{m}/{refine} level ({lr}, {lc}) block ({br}, {bc})"
                             );
                         }
                     }
@@ -228,7 +244,7 @@ mod tests {
     #[test]
     fn a_wrong_block_class_is_seen() {
         let c = coverage(33, 29);
-        let mut words = mask_words(&c);
+        let mut words = mask_words(&c, 1);
         let level = words[words[3] as usize + 5 + 1] as usize;
         let before = packed(&words, 1, 1, 3, 3);
         words[level + (3 * 14 + 3) / 16] ^= 1 << (2 * ((3 * 14 + 3) % 16));

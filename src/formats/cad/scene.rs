@@ -178,10 +178,11 @@ pub fn face_samples(surface: &TensorSurface, tol: f64) -> [usize; 2] {
             for probe in 0..5 {
                 let o = oa + (ob - oa) * f64::from(probe) / 4.0;
                 let at = |s: f64| {
+                    // The allocation-free evaluator (this runs for every span of every face).
                     if dir == 0 {
-                        surface.eval(s, o)
+                        surface.first_partials(s, o)[0]
                     } else {
-                        surface.eval(o, s)
+                        surface.first_partials(o, s)[0]
                     }
                 };
                 let mid = at(0.5 * (s0 + s1));

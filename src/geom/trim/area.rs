@@ -56,6 +56,30 @@ const GL_W: [f64; N] = [
 ];
 /// Nodes per axis; the interpolant has degree `N - 1`.
 const N: usize = 6;
+/// Gauss nodes per axis of a cell ([`Integrand::grid`]).
+pub const CELL_NODES: usize = N;
+
+/// What [`integrate`] integrates: any `Fn(u, v) -> f64`, or an integrand that evaluates the
+/// 6 × 6 Gauss nodes of a cell together (a tensor-product surface finds its basis functions
+/// once per row and column of them).
+pub trait Integrand: Sync {
+    /// The value at `(u, v)`.
+    fn at(&self, u: f64, v: f64) -> f64;
+    /// `out[a][b]` = the value at `(us[a], vs[b])`.
+    fn grid(&self, us: &[f64; N], vs: &[f64; N], out: &mut [[f64; N]; N]) {
+        for (a, &u) in us.iter().enumerate() {
+            for (b, &v) in vs.iter().enumerate() {
+                out[a][b] = self.at(u, v);
+            }
+        }
+    }
+}
+
+impl<F: Fn(f64, f64) -> f64 + Sync> Integrand for F {
+    fn at(&self, u: f64, v: f64) -> f64 {
+        self(u, v)
+    }
+}
 
 /// Rows of cells per unit of work handed to a thread.
 const ROWS_PER_CHUNK: usize = 4;
@@ -104,7 +128,7 @@ pub fn integrate(
     u: &[f64],
     v: &[f64],
     coverage: &Coverage,
-    f: impl Fn(f64, f64) -> f64 + Sync,
+    f: impl Integrand,
 ) -> Result<f64, TrimError> {
     if !coverage.matches(regions, u, v) {
         return Err(TrimError::BadGrid {
@@ -186,7 +210,7 @@ impl Neumaier {
     }
 }
 
-impl<F: Fn(f64, f64) -> f64> Ctx<'_, F> {
+impl<F: Integrand> Ctx<'_, F> {
     /// The integral over the inside part of cell `(i, j)`.
     #[must_use]
     fn cell(&self, i: usize, j: usize) -> f64 {
@@ -202,11 +226,9 @@ impl<F: Fn(f64, f64) -> f64> Ctx<'_, F> {
             0.5 * (v1 - v0),
         );
         let mut fv = [[0.0; N]; N];
-        for a in 0..N {
-            for b in 0..N {
-                fv[a][b] = (self.f)(um + hu * GL_X[a], vm + hv * GL_X[b]);
-            }
-        }
+        let us = GL_X.map(|x| um + hu * x);
+        let vs = GL_X.map(|x| vm + hv * x);
+        self.f.grid(&us, &vs, &mut fv);
         let jacobian = hu * hv;
         if class == CellClass::Inside {
             let mut s = 0.0;

@@ -23,14 +23,14 @@ pub mod regions;
 pub mod spec;
 mod trimmed;
 
-pub use area::integrate;
+pub use area::{CELL_NODES, Integrand, integrate};
 pub use coverage::{CellClass, Coverage};
 pub use curve::{Curve2, Piece, flatten, flatten_piece, flatten_tracked};
 pub use error::TrimError;
 pub use loops::{LoopInput, Role, Tolerances};
 pub use regions::{TrimLoop, TrimRegions};
 pub use spec::{LoopSpec, Trim, TrimCurve, TrimPiece};
-pub use trimmed::{FLATTEN_TOLERANCE, Trimmed, flatten_tolerance};
+pub use trimmed::{FLATTEN_TOLERANCE, Trimmed, flatten_tolerance, regions_at};
 
 #[cfg(test)]
 mod tests;

@@ -7,7 +7,8 @@ use super::error::TrimError;
 use super::loops::{LoopInput, Tolerances};
 use super::regions::TrimRegions;
 use super::spec::{Trim, TrimCurve};
-use glam::DVec2;
+use crate::geom::bspline::BSplineCurve;
+use glam::{DVec2, DVec3};
 use std::sync::Arc;
 
 /// The flattening tolerance, as a fraction of the parameter domain's diagonal: every point of
@@ -34,13 +35,20 @@ impl Curve2 for TrimCurve {
         TrimCurve::point(self, t)
     }
 
-    /// For splines: the largest |c''| of 33 evenly spaced points of the span, plus a fifth (a
-    /// span's second derivative varies smoothly; flattening checks every piece's midpoint
-    /// besides, and bisects where the bound fell short).
+    /// For polynomial splines, exact: c'' is a B-spline of degree p − 2 whose control points
+    /// are the second differences of the curve's (The NURBS Book eq. 3.8 twice), and on a span
+    /// |c''| is at most the largest of the p − 1 that act there (convex hull; on cubics the
+    /// bound is attained, c'' being linear). For rational splines: the largest |c''| of 33
+    /// evenly spaced points of the span, plus a fifth (a span's second derivative varies
+    /// smoothly; flattening checks every piece's midpoint besides, and bisects where the bound
+    /// fell short).
     fn second_derivative_bound(&self, t0: f64, t1: f64) -> Option<f64> {
         let TrimCurve::Spline(c) = self else {
             return None;
         };
+        if !c.is_rational() {
+            return polynomial_second_derivative_bound(c, t0, t1);
+        }
         let mut m: f64 = 0.0;
         for k in 0..=32 {
             let t = t0 + (t1 - t0) * f64::from(k) / 32.0;
@@ -60,6 +68,44 @@ impl Curve2 for TrimCurve {
             }
         }
     }
+}
+
+/// The hull bound of |c''| over `[t0, t1]` of a polynomial B-spline (see
+/// [`Curve2::second_derivative_bound`] for [`TrimCurve`]).
+fn polynomial_second_derivative_bound(c: &BSplineCurve, t0: f64, t1: f64) -> Option<f64> {
+    let p = c.degree();
+    if p < 2 {
+        return Some(0.0);
+    }
+    let u = c.knots().as_slice();
+    let pts = c.points();
+    let n = pts.len();
+    let first = |i: usize| -> Option<DVec3> {
+        let den = u.get(i + p + 1)? - u.get(i + 1)?;
+        Some(if den > 0.0 {
+            (*pts.get(i + 1)? - *pts.get(i)?) * (p as f64 / den)
+        } else {
+            DVec3::ZERO
+        })
+    };
+    let second = |i: usize| -> Option<f64> {
+        let den = u.get(i + p + 1)? - u.get(i + 2)?;
+        Some(if den > 0.0 {
+            ((first(i + 1)? - first(i)?) * ((p - 1) as f64 / den)).length()
+        } else {
+            0.0
+        })
+    };
+    let lo = c.find_span(t0.min(t1));
+    let mut hi = c.find_span(t0.max(t1));
+    if hi > lo && u.get(hi).copied() == Some(t0.max(t1)) {
+        hi -= 1;
+    }
+    let mut m: f64 = 0.0;
+    for i in lo.saturating_sub(p)..=hi.saturating_sub(2).min(n.saturating_sub(3)) {
+        m = m.max(second(i)?);
+    }
+    m.is_finite().then_some(m)
 }
 
 /// The vertices of the polyline `v` (vertex k at parameter k) over `range`, in its direction:
@@ -96,40 +142,49 @@ impl PartialEq for Trimmed {
     }
 }
 
+/// The regions of `spec` on `domain` with its curves flattened within `tol` (polylines are
+/// taken as they are): [`Trimmed::new`] at [`flatten_tolerance`], measures at a coarser one.
+pub fn regions_at(
+    spec: &Trim,
+    domain: [(f64, f64); 2],
+    tol: f64,
+) -> Result<TrimRegions, TrimError> {
+    if spec.loops.is_empty() {
+        return Err(TrimError::NoLoops);
+    }
+    let mut inputs = Vec::with_capacity(spec.loops.len());
+    for (k, l) in spec.loops.iter().enumerate() {
+        if l.pieces.is_empty() {
+            return Err(TrimError::EmptyLoop { loop_index: k });
+        }
+        // Polylines as their vertices over the range (exact, no flattening).
+        let straight: Vec<Option<Vec<DVec2>>> = l
+            .pieces
+            .iter()
+            .map(|p| match &p.curve {
+                TrimCurve::Polyline(v) => Some(polyline_part(v, p.range)),
+                TrimCurve::Spline(_) => None,
+            })
+            .collect();
+        let pieces: Vec<Piece<'_>> = l
+            .pieces
+            .iter()
+            .zip(&straight)
+            .map(|(p, s)| match s {
+                Some(points) => Piece::Points(points),
+                None => Piece::Curve(&p.curve as &dyn Curve2, p.range),
+            })
+            .collect();
+        inputs.push(LoopInput::from_pieces(k, &pieces, l.role, tol)?);
+    }
+    TrimRegions::new(&inputs, domain, &Tolerances::default())
+}
+
 impl Trimmed {
     /// Validates `spec` against the surface's parameter `domain` and classifies its loops (see
     /// `loops` and `regions` for the rules); an error names the loop and curve.
     pub fn new(spec: Trim, domain: [(f64, f64); 2]) -> Result<Self, TrimError> {
-        if spec.loops.is_empty() {
-            return Err(TrimError::NoLoops);
-        }
-        let tol = flatten_tolerance(domain);
-        let mut inputs = Vec::with_capacity(spec.loops.len());
-        for (k, l) in spec.loops.iter().enumerate() {
-            if l.pieces.is_empty() {
-                return Err(TrimError::EmptyLoop { loop_index: k });
-            }
-            // Polylines as their vertices over the range (exact, no flattening).
-            let straight: Vec<Option<Vec<DVec2>>> = l
-                .pieces
-                .iter()
-                .map(|p| match &p.curve {
-                    TrimCurve::Polyline(v) => Some(polyline_part(v, p.range)),
-                    TrimCurve::Spline(_) => None,
-                })
-                .collect();
-            let pieces: Vec<Piece<'_>> = l
-                .pieces
-                .iter()
-                .zip(&straight)
-                .map(|(p, s)| match s {
-                    Some(points) => Piece::Points(points),
-                    None => Piece::Curve(&p.curve as &dyn Curve2, p.range),
-                })
-                .collect();
-            inputs.push(LoopInput::from_pieces(k, &pieces, l.role, tol)?);
-        }
-        let regions = TrimRegions::new(&inputs, domain, &Tolerances::default())?;
+        let regions = regions_at(&spec, domain, flatten_tolerance(domain))?;
         Ok(Self {
             spec,
             regions: Arc::new(regions),

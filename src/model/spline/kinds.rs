@@ -8,6 +8,7 @@ use super::form::SplineForm;
 use super::surface::{SurfaceEdit, SurfaceModel};
 use super::surface_sampler::SplineSurfaceSampler;
 use crate::fields::{At, ReadCtx, SceneError};
+use crate::geom::surface::TensorSurface;
 use crate::model::controls::{ControlDisplay, Grip};
 use crate::model::edit::EditError;
 use crate::model::index::Index2;
@@ -175,8 +176,8 @@ impl Kind for SurfaceModel {
         self.surface().degree().to_vec()
     }
 
-    fn first_partials(&self, [u, v]: [f64; 2]) -> Option<[DVec3; 3]> {
-        Some(self.surface().first_partials(u, v))
+    fn tensor(&self) -> Option<&TensorSurface> {
+        Some(self.surface())
     }
 
     fn breakpoints(&self) -> Vec<Vec<f64>> {
