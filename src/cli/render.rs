@@ -80,15 +80,25 @@ pub fn run(args: RenderArgs) -> Result<(), CliError> {
             Ok(r)
         })
     });
-    let (doc, estimate) = load_document(
+    let loaded_doc = load_document(
         &args.scene,
         args.edits.as_deref(),
         &args.samples.counts(),
         &args.memory.budget(),
         args.display.analysis,
         args.display.net,
-    )?;
+    );
     let loaded = start.elapsed();
+    let renderer = match early.map(std::thread::JoinHandle::join) {
+        Some(Ok(r)) => Some(r),
+        Some(Err(_)) => Some(Err(CliError("the Vulkan device's start failed".into()))),
+        None => None,
+    };
+    // The device thread has finished either way: a process must not exit while the driver
+    // starts on another thread (its exit handlers would free what that thread still uses).
+    let (doc, estimate) = loaded_doc?;
+    let renderer = renderer.transpose()?;
+    let waited = start.elapsed() - loaded;
     let mut options = args.display.options();
     if let Some((name, t)) = &args.osculating {
         options.osculating_at = Some(osculating_at(&doc, name, *t)?);
@@ -103,11 +113,6 @@ pub fn run(args: RenderArgs) -> Result<(), CliError> {
         camera: args.camera,
         options,
         msaa: args.msaa,
-    };
-    let renderer = match early.map(std::thread::JoinHandle::join) {
-        Some(Ok(r)) => Some(r?),
-        Some(Err(_)) => return Err(CliError("the Vulkan device's start failed".into())),
-        None => None,
     };
     let lines = render_image(&doc, &args.out, shot, probe, renderer);
     // The process ends with this command: freeing a large scene's allocations one by one
@@ -124,7 +129,7 @@ pub fn run(args: RenderArgs) -> Result<(), CliError> {
         eprintln!(
             "timings: load {:.1} ms, device wait {:.1} ms, draw and read back {:.1} ms, write {:.1} ms, total {:.1} ms",
             ms(loaded),
-            ms(phases.device),
+            ms(waited + phases.device),
             ms(phases.draw),
             ms(phases.write),
             ms(start.elapsed())
@@ -293,14 +298,8 @@ pub fn render_image(
     let pixels = render_document(&mut renderer, doc, &shot).map_err(|e| CliError(e.to_string()))?;
     let sink = renderer.validation_sink();
     let device = renderer.caps().name.clone();
-    if sink.is_some() {
-        // Teardown first: the layer reports leaked objects when the device is destroyed.
-        drop(renderer);
-    } else {
-        // The process ends with this command, and the driver's teardown (every pipeline's
-        // machine code, the device's memory) would only delay the exit.
-        std::mem::forget(renderer);
-    }
+    // Teardown first: the layer reports leaked objects when the device is destroyed.
+    drop(renderer);
     if let Some(errors) = sink.map(|s| s.errors()).filter(|e| !e.is_empty()) {
         let first = errors[0].to_string();
         return Err(CliError(format!(

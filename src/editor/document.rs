@@ -45,11 +45,12 @@ pub struct TrimCoverage {
     pub refine: usize,
 }
 
-/// The mask's target of boundary segments per mask cell, on average over its cells: what the
-/// fragment shader tests per fragment. A plane drawn from 2 × 2 samples with a hole flattened
-/// into thousands of segments would otherwise test all of them at every fragment (seconds a
-/// frame on lavapipe).
-const MASK_SEGMENTS_PER_CELL: f64 = 0.5;
+/// The mask's target of segments per boundary cell, on average over the boundary cells: what the
+/// fragment shader tests per boundary fragment. A plane drawn from 2 × 2 samples with a hole
+/// flattened into thousands of segments would otherwise test all of them at every fragment
+/// (seconds a frame on lavapipe). Cells no finer than needed: the half-pixel growth reaches only
+/// the segments of the fragment's own cell, so a mask cell smaller than a pixel grows less.
+const MASK_SEGMENTS_PER_CELL: f64 = 32.0;
 /// The most mask cells per sample cell and direction, and the most mask cells in all.
 const MAX_REFINE: usize = 64;
 const MAX_MASK_CELLS: usize = 1 << 21;
@@ -57,9 +58,9 @@ const MAX_MASK_CELLS: usize = 1 << 21;
 impl TrimCoverage {
     /// The coverage of a sampled surface's grid by `trimmed`; `None` for a curve or a grid
     /// the coverage cannot take (over 32,768 samples a side, which no sample limit allows).
-    /// The mask cells: the sample cells cut in 2, 4, … per direction until the boundary's
-    /// segments per cell fall to [`MASK_SEGMENTS_PER_CELL`] on average (each cut quarters it:
-    /// a flattened curve's segments spread over twice the cells, each a quarter of the area).
+    /// The mask cells: the sample cells cut in 2, 4, … per direction until the segments per
+    /// boundary cell fall to [`MASK_SEGMENTS_PER_CELL`] on average (each cut about halves it: a
+    /// flattened curve crosses twice the cells, each holding half its segments).
     #[must_use]
     pub fn of(trimmed: &Trimmed, sampled: &SampledObject) -> Option<Self> {
         let params = sampled.params();
@@ -69,13 +70,10 @@ impl TrimCoverage {
         let coarse = Coverage::new(trimmed.regions(), u, v).ok()?;
         let (mu, mv) = coarse.samples();
         let cells = (mu - 1) * (mv - 1);
-        let refs: usize = coarse
-            .gpu_records()
-            .iter()
-            .map(|r| (r[1] >> 1) as usize)
-            .sum();
+        let records = coarse.gpu_records();
+        let refs: usize = records.iter().map(|r| (r[1] >> 1) as usize).sum();
         let mut refine = 1;
-        let mut cost = refs as f64 / cells.max(1) as f64;
+        let mut cost = refs as f64 / records.len().max(1) as f64;
         while cost > MASK_SEGMENTS_PER_CELL
             && refine < MAX_REFINE
             && 2 * refine * (mu - 1) < 32_768
@@ -83,7 +81,7 @@ impl TrimCoverage {
             && cells * 4 * refine * refine <= MAX_MASK_CELLS
         {
             refine *= 2;
-            cost /= 4.0;
+            cost /= 2.0;
         }
         let coverage = if refine == 1 {
             coarse

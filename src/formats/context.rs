@@ -56,6 +56,9 @@ pub struct LoadContext<'a> {
     pub samples: SampleDefaults,
     /// Every registered format, for the JSON scene's kept fields.
     pub formats: &'a [&'a dyn FileFormat],
+    /// The file's name without directory and extension, where it came from a file: names
+    /// objects when the file names nothing (an IGES file without a product id).
+    pub stem: Option<&'a str>,
 }
 
 /// Sample counts for the objects of a file that give none (`--samples` on the command line):

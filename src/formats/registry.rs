@@ -75,11 +75,13 @@ fn load_as(
     options: LoadOptions<'_>,
 ) -> Result<Import, String> {
     let bytes = std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let stem = path.file_stem().and_then(|s| s.to_str());
     let ctx = LoadContext {
         budget: options.budget,
         progress: options.progress,
         samples: options.samples,
         formats: FORMATS,
+        stem,
     };
     format.read(&bytes, &ctx).map_err(|e| e.in_file(path))
 }
@@ -91,6 +93,7 @@ pub fn parse_scene(text: &str) -> Result<Scene, SceneError> {
         progress: &crate::progress::Silent,
         samples: SampleDefaults::default(),
         formats: FORMATS,
+        stem: None,
     };
     json::parse_scene(text, &ctx)
 }

@@ -8,6 +8,8 @@ mod common;
 mod oracle;
 
 mod budget_counts;
+mod cad_errors;
+mod cad_reference;
 mod cli_errors;
 mod cli_help;
 mod cli_spline_errors;

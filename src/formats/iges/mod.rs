@@ -170,9 +170,10 @@ impl super::FileFormat for Iges {
     fn read(
         &self,
         bytes: &[u8],
-        _ctx: &super::LoadContext<'_>,
+        ctx: &super::LoadContext<'_>,
     ) -> Result<super::Import, super::FormatError> {
-        map::read_iges(bytes)
+        super::cad::check_read(bytes, ctx)?;
+        map::read_iges_with_stem(bytes, ctx.stem)
             .map(super::cad::to_import)
             .map_err(super::FormatError::new)
     }

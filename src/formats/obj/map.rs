@@ -274,12 +274,11 @@ fn surface_element(s: &TensorSurface, basis: Basis) -> FreeForm {
     }
 }
 
-/// A name survives an OBJ `o` statement when it has no comment sign, no control characters, no
-/// trailing backslash and single spaces between words (the reader joins words with one space).
+/// A name survives an OBJ `o` statement when it has no control characters, no trailing
+/// backslash and single spaces between words (the reader joins words with one space). A `#`
+/// would start a comment, so names are written through [`encode_name`].
 fn check_name(name: &str) -> Result<(), String> {
-    let why = if name.contains('#') {
-        Some("'#' would start a comment")
-    } else if name.chars().any(char::is_control) {
+    let why = if name.chars().any(char::is_control) {
         Some("it contains a control character")
     } else if name.ends_with('\\') {
         Some("a trailing '\\' would continue the line")
@@ -292,4 +291,36 @@ fn check_name(name: &str) -> Result<(), String> {
         Some(why) => Err(format!("the name cannot be written to OBJ: {why}")),
         None => Ok(()),
     }
+}
+
+/// A name as an `o` statement writes it: `#` (which would start a comment) as `%23` and `%` as
+/// `%25`, so that CAD face names such as `bracket#1234` survive and [`decode_name`] restores
+/// every name exactly. Other programs show the encoded name, which stays legible.
+#[must_use]
+pub(crate) fn encode_name(name: &str) -> String {
+    name.replace('%', "%25").replace('#', "%23")
+}
+
+/// The name an `o` or `g` statement gives: [`encode_name`] undone (`%23` is `#`, `%25` is `%`;
+/// any other `%` stays as written).
+#[must_use]
+pub(crate) fn decode_name(written: &str) -> String {
+    let mut out = String::with_capacity(written.len());
+    let mut rest = written;
+    while let Some(at) = rest.find('%') {
+        out.push_str(&rest[..at]);
+        let tail = &rest[at..];
+        if let Some(t) = tail.strip_prefix("%23") {
+            out.push('#');
+            rest = t;
+        } else if let Some(t) = tail.strip_prefix("%25") {
+            out.push('%');
+            rest = t;
+        } else {
+            out.push('%');
+            rest = &tail[1..];
+        }
+    }
+    out.push_str(rest);
+    out
 }

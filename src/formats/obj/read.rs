@@ -231,7 +231,7 @@ impl Reader {
             "trim" | "hole" | "scrv" | "sp" => self.body(s),
             "end" => self.end(s),
             "o" | "g" => {
-                let name = join(&s.args);
+                let name = super::map::decode_name(&join(&s.args));
                 self.name = (!name.is_empty()).then_some(name);
                 Ok(())
             }

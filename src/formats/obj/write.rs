@@ -96,7 +96,7 @@ impl<'a> Writer<'a> {
         let s = &mut self.s;
         s.push('\n');
         if let Some(name) = &e.name {
-            let _ = writeln!(s, "o {name}");
+            let _ = writeln!(s, "o {}", super::map::encode_name(name));
         }
         if let Some(m) = &e.samples {
             let counts: Vec<String> = m.iter().map(ToString::to_string).collect();

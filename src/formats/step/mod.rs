@@ -58,8 +58,9 @@ impl super::FileFormat for Step {
     fn read(
         &self,
         bytes: &[u8],
-        _ctx: &super::LoadContext<'_>,
+        ctx: &super::LoadContext<'_>,
     ) -> Result<super::Import, super::FormatError> {
+        super::cad::check_read(bytes, ctx)?;
         map::read_step(bytes)
             .map(super::cad::to_import)
             .map_err(super::FormatError::new)

@@ -49,13 +49,28 @@ pub fn read_iges(bytes: &[u8]) -> Result<CadModel, String> {
     read_iges_named(bytes, None)
 }
 
+/// [`read_iges`] for a file named `stem` (its name without directory and extension): faces
+/// are named after the Global section's product id, else after `stem` (`hammer#341`), else
+/// the receiving system's id or the file name the Global section gives.
+pub fn read_iges_with_stem(bytes: &[u8], stem: Option<&str>) -> Result<CadModel, String> {
+    let file = IgesFile::parse(bytes).map_err(|e| e.to_string())?;
+    let own = file.global.product_id.trim();
+    let name = if own.is_empty() { stem } else { Some(own) };
+    read_parsed(&file, name.map(str::to_owned))
+}
+
 /// [`read_iges`] with the face-name stem given by the caller (normally the file stem:
 /// `hammer#341`).
 pub fn read_iges_named(bytes: &[u8], stem: Option<&str>) -> Result<CadModel, String> {
     let file = IgesFile::parse(bytes).map_err(|e| e.to_string())?;
-    let stem = stem.map_or_else(|| default_stem(&file), str::to_owned);
-    let refs = roots::referenced(&file).map_err(|e| e.to_string())?;
-    let mut reader = Reader::new(&file, stem);
+    read_parsed(&file, stem.map(str::to_owned))
+}
+
+/// Maps a parsed file, faces named after `stem` or [`default_stem`].
+fn read_parsed(file: &IgesFile, stem: Option<String>) -> Result<CadModel, String> {
+    let stem = stem.unwrap_or_else(|| default_stem(file));
+    let refs = roots::referenced(file).map_err(|e| e.to_string())?;
+    let mut reader = Reader::new(file, stem);
     let unit = reader.unit();
     let mut outcomes = Vec::new();
     for e in file.entities() {
