@@ -638,3 +638,23 @@ fn spec_trimming_example_reads_with_warnings_and_an_exact_cut() {
     let w = s.weights().unwrap();
     assert_eq!(w, [1.0, 1.0, 2.3, 7.6, 0.5, 6.1, 2.3, 1.5, 3.3]);
 }
+
+/// Names with `#` (CAD faces such as `bracket#1234`) and `%` survive OBJ: written as `%23` and
+/// `%25`, read back as they were; a `%` that starts neither stays as written.
+#[test]
+fn names_with_comment_and_percent_signs_round_trip() {
+    let mut scene = parse_scene(&example("bezier_curve.json")).unwrap();
+    scene.objects[0].name = "bracket#1234 50% %23".into();
+    let obj = scene_to_obj(&scene).unwrap();
+    assert!(obj.contains("o bracket%231234 50%25 %2523\n"), "{obj}");
+    assert_json_obj_json(&scene);
+    // A hand-written name with a lone '%' reads as written.
+    let text = obj.replace("o bracket%231234 50%25 %2523", "o 100%x");
+    assert_eq!(parse_obj(&text).unwrap().scene.objects[0].name, "100%x");
+    // Negative control: the encoded name read without decoding would differ.
+    let raw = obj.replace("o bracket%231234 50%25 %2523", "o bracket%231234");
+    assert_ne!(
+        parse_obj(&raw).unwrap().scene.objects[0].name,
+        "bracket%231234"
+    );
+}
