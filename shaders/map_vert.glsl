@@ -20,7 +20,7 @@ layout(location = 2) out float v_value;
 // first vertex in the bound buffer (one instance-rate attribute per draw).
 layout(location = 4) in uvec4 in_trim;
 layout(location = 5) out vec2 v_grid;
-layout(location = 6) flat out uvec4 v_trim;
+layout(location = 6) flat out uvec2 v_trim;
 #ifdef TRIM_FAST
 #include "trim_fast.glsl"
 #endif
@@ -37,7 +37,7 @@ void main() {
     uint cols = in_trim.z & 0xFFFFFFu;
     uint k = uint(gl_VertexIndex) - in_trim.w;
     v_grid = vec2(float(k / cols), float(k % cols));
-    v_trim = in_trim;
+    v_trim = in_trim.xy;
 #ifdef TRIM_FAST
     v_fast = trim_vertex_class(TrimWords(in_trim.xy), k / cols, k % cols, (in_trim.z >> 24) & 15u, in_trim.z >> 28);
 #endif

@@ -19,7 +19,7 @@
 #include "trim_words.glsl"
 
 layout(location = 5) in vec2 v_grid;
-layout(location = 6) flat in uvec4 v_trim;
+layout(location = 6) flat in uvec2 v_trim;
 
 vec4 trim_vec4(TrimWords t, uint at) {
     return uintBitsToFloat(uvec4(t.w[at], t.w[at + 1u], t.w[at + 2u], t.w[at + 3u]));
@@ -48,20 +48,20 @@ vec2 trim_segment_offset(vec2 p, vec4 s) {
     return q - e * t;
 }
 
-// Pixels per grid unit as a matrix: the inverse of the screen-space derivatives of the grid
-// coordinate, so a grid-space vector's length on screen is |reach * v| (zero where the
-// triangle is seen edge-on: no growth). Call it where control flow is uniform.
+// The screen-space derivatives of the grid coordinate. Derivatives need uniform control flow, so
+// every fragment takes them; their inverse (pixels per grid unit, below) is formed only by the
+// few fragments that test the growth.
 mat2 trim_reach() {
-    mat2 j = mat2(dFdx(v_grid), dFdy(v_grid));
-    float det = determinant(j);
-    return abs(det) > 1e-30 ? inverse(j) : mat2(0.0);
+    return mat2(dFdx(v_grid), dFdy(v_grid));
 }
 
 // Whether the fragment is inside the trim, the drawn region grown by half a pixel at the
 // boundary (faces that share an edge overlap by a sub-pixel sliver instead of leaving pinholes
-// where their two tessellations of the edge part); `reach` from trim_reach().
-bool trim_inside(mat2 reach) {
-    TrimWords t = TrimWords(v_trim.xy);
+// where their two tessellations of the edge part); `j` from trim_reach(). Pixels per grid unit
+// are the inverse of `j`, so a grid-space vector's length on screen is |inverse(j) * v| (zero
+// where the triangle is seen edge-on: no growth).
+bool trim_inside(mat2 j) {
+    TrimWords t = TrimWords(v_trim);
     uint k = t.w[6];
     int ncu = int(t.w[4] * k);
     int ncv = int(t.w[5] * k);
@@ -69,8 +69,6 @@ bool trim_inside(mat2 reach) {
     int cx = clamp(int(floor(g.x)), 0, ncu - 1);
     int cy = clamp(int(floor(g.y)), 0, ncv - 1);
     vec2 p = g - vec2(float(cx), float(cy));
-    // Pixels per mask cell.
-    reach = reach / float(k);
     uint word = t.w[t.w[0] + uint(cx * ncv + cy)];
     uint tag = word & 3u;
     if (tag != 2u) {
@@ -87,6 +85,12 @@ bool trim_inside(mat2 reach) {
             inside = !inside;
         }
     }
+    if (inside) {
+        return true;
+    }
+    float det = determinant(j);
+    // Pixels per mask cell.
+    mat2 reach = abs(det) > 1e-30 ? inverse(j) / float(k) : mat2(0.0);
     bool grows = reach != mat2(0.0);
     for (uint k = 0u; k < count && !inside && grows; ++k) {
         vec2 v = trim_segment_offset(p, trim_vec4(t, t.w[2] + (first + k) * 4u));

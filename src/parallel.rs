@@ -40,6 +40,9 @@ pub fn on_one_thread<R>(f: impl FnOnce() -> R) -> R {
     r
 }
 
+/// The cores available to the process, once known.
+static CORES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+
 /// Threads [`map`] uses: `--threads N`, else the cores available to the process.
 #[must_use]
 pub fn threads() -> usize {
@@ -47,7 +50,11 @@ pub fn threads() -> usize {
         return n;
     }
     match THREADS.load(Ordering::Relaxed) {
-        0 => std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get),
+        // Asked once: the standard library reads the cgroup quota files on every call (a few
+        // milliseconds of a 60 ms `info`).
+        0 => *CORES.get_or_init(|| {
+            std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
+        }),
         n => n,
     }
 }

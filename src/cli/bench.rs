@@ -30,7 +30,7 @@ use std::path::{Path, PathBuf};
 /// Run a scripted, reproducible editing session and report where every millisecond goes.
 #[derive(Args, Debug, Clone)]
 pub struct BenchArgs {
-    /// Scene file (JSON or OBJ); the demo scene without it.
+    /// Scene file (JSON, OBJ, STEP or IGES); the demo scene without it.
     pub scene: Option<PathBuf>,
     /// What the scripted user does.
     #[arg(long, default_value = "drag", value_parser = Scenario::parse, value_name = "drag|erbs-rotate|orbit|idle")]

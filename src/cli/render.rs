@@ -21,7 +21,7 @@ use std::time::Instant;
 /// Render a scene headless (no display needed) into a PNG or JPEG image (by the extension).
 #[derive(Args, Debug, Clone)]
 pub struct RenderArgs {
-    /// Scene file (JSON, or Wavefront OBJ by its .obj extension).
+    /// Scene file: JSON, Wavefront OBJ (.obj), STEP (.stp, .step) or IGES (.igs, .iges), by extension.
     pub scene: PathBuf,
     /// Output image: PNG for .png, JPEG for .jpg or .jpeg; other extensions are refused.
     #[arg(long, short = 'o', value_name = "IMAGE.png|IMAGE.jpg")]
@@ -187,7 +187,7 @@ pub fn check_drawable(scene: &Scene, path: &Path, budget: &MemoryBudget) -> Resu
         .map_err(|e| CliError::in_file(path, e))
 }
 
-/// Loads a scene (JSON or OBJ) into an editor held to the memory budget and applies an edits
+/// Loads a scene (any format the registry reads) into an editor held to the memory budget and applies an edits
 /// file through it (the delta path; edits that grow an object are budgeted as they come), with
 /// `map` shown on the surfaces (a curvature map is budgeted first) and, with `nets`, every
 /// object's control display drawn.

@@ -19,7 +19,7 @@ pub const MAX_DERIVATIVES: usize = 20;
 /// Sample every object of a scene and print positions and derivatives as JSON on stdout.
 #[derive(Args, Debug, Clone)]
 pub struct SampleArgs {
-    /// Scene file (JSON, see docs/scene-format.md; or Wavefront OBJ, see docs/obj.md).
+    /// Scene file: JSON (docs/scene-format.md), Wavefront OBJ (docs/obj.md), STEP or IGES (docs/cad.md).
     pub scene: PathBuf,
     /// Highest derivative order N: curves get c..c^(N), surfaces every ∂^{a+b}S with a, b ≤ N.
     #[arg(long, short = 'd', default_value_t = 1, value_name = "N")]

@@ -23,7 +23,7 @@ const DEMO_SAVE: &str = "prespline-demo.json";
 /// format; H or F1 in the viewer lists the keys.
 #[derive(Args, Debug, Clone)]
 pub struct ViewArgs {
-    /// Scene file (JSON, or Wavefront OBJ by its .obj extension); without it, the demo:
+    /// Scene file (JSON, OBJ, STEP or IGES, by extension); without it, the demo:
     /// B-spline surface, ERBS surface and curve, NURBS circle, closed ERBS torus, Utah
     /// teapot.
     pub scene: Option<PathBuf>,

@@ -910,7 +910,8 @@ impl GpuScene {
                 split_cells(shape, order[bi].stride, &support, self.drop_chunk)
             });
             let [w, h] = key.extent.map(u64::from);
-            if !self.layer_always && !worth_a_layer(cells.as_ref(), triangles, w * h) {
+            let trimmed = order.iter().any(|b| self.groups[b.group].mask.is_some());
+            if !self.layer_always && !worth_a_layer(cells.as_ref(), triangles, w * h, trimmed) {
                 self.unworthy = Some(key);
                 return Ok(false);
             }
@@ -1600,13 +1601,17 @@ fn arena_layout(doc: &Document) -> (Vec<Place>, Vec<usize>) {
 /// lavapipe, as much as drawing a few thousand surface triangles: docs/performance.md), so
 /// what stays in it must be a surface triangle per [`PIXELS_PER_KEPT_TRIANGLE`] pixels at
 /// least, and a quarter of the frame's triangles. Otherwise the frame is drawn in full: a
-/// scene of curves only, or an ERBS local patch whose support is the whole surface.
-fn worth_a_layer(cells: Option<&SplitCells>, all: u64, pixels: u64) -> bool {
+/// scene of curves only, or an ERBS local patch whose support is the whole surface. With
+/// `trimmed` surfaces in the frame triangles do not measure the cost: a trimmed face's
+/// fragments test its mask (and discard, so depth is tested late), and a CAD plane of two
+/// triangles can fill the screen (a 160-face assembly: 32 ms a frame in full), so there the
+/// quarter alone decides.
+fn worth_a_layer(cells: Option<&SplitCells>, all: u64, pixels: u64, trimmed: bool) -> bool {
     let dynamic: u64 = cells.map_or(0, |c| {
         c.dynamic.iter().map(|&(_, n)| u64::from(n) / 3).sum()
     });
     let kept = all.saturating_sub(dynamic);
-    kept * PIXELS_PER_KEPT_TRIANGLE >= pixels && 4 * dynamic < 3 * all
+    (trimmed || kept * PIXELS_PER_KEPT_TRIANGLE >= pixels) && 4 * dynamic < 3 * all
 }
 
 /// A static layer must keep a surface triangle per this many pixels of its target to pay for
@@ -1792,16 +1797,36 @@ mod tests {
     fn a_layer_pays_only_for_enough_kept_triangles_and_a_small_dynamic_set() {
         let pixels = 1280 * 720;
         // Plenty kept, a tenth dynamic: a layer.
-        assert!(worth_a_layer(Some(&dynamic(10_000)), 100_000, pixels));
+        assert!(worth_a_layer(
+            Some(&dynamic(10_000)),
+            100_000,
+            pixels,
+            false
+        ));
         // A curve moving over many surface triangles: a layer.
-        assert!(worth_a_layer(None, 100_000, pixels));
+        assert!(worth_a_layer(None, 100_000, pixels, false));
         // Curves only: nothing would stay in the layer.
-        assert!(!worth_a_layer(None, 0, pixels));
+        assert!(!worth_a_layer(None, 0, pixels, false));
         // A small dynamic set, but too few triangles kept for the copy.
-        assert!(!worth_a_layer(Some(&dynamic(100)), 1_000, pixels));
+        assert!(!worth_a_layer(Some(&dynamic(100)), 1_000, pixels, false));
         // Enough kept, but the dynamic set is most of the frame.
-        assert!(!worth_a_layer(Some(&dynamic(80_000)), 100_000, pixels));
-        assert!(!worth_a_layer(Some(&dynamic(100_000)), 100_000, pixels));
+        assert!(!worth_a_layer(
+            Some(&dynamic(80_000)),
+            100_000,
+            pixels,
+            false
+        ));
+        assert!(!worth_a_layer(
+            Some(&dynamic(100_000)),
+            100_000,
+            pixels,
+            false
+        ));
+        // Trimmed faces: few triangles, costly fragments; the quarter still holds.
+        assert!(!worth_a_layer(Some(&dynamic(100)), 1_000, pixels, false));
+        assert!(worth_a_layer(Some(&dynamic(100)), 1_000, pixels, true));
+        assert!(!worth_a_layer(Some(&dynamic(800)), 1_000, pixels, true));
+        assert!(!worth_a_layer(None, 0, pixels, true));
     }
 
     #[test]

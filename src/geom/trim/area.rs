@@ -163,10 +163,7 @@ pub fn integrate(
             parts.push((k, sum.total()));
         }
     };
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
-        .min(chunks)
-        .min(16);
+    let threads = crate::parallel::threads().min(chunks).min(16);
     let mut parts = std::thread::scope(|s| {
         let helpers: Vec<_> = (1..threads)
             .filter_map(|_| std::thread::Builder::new().spawn_scoped(s, work).ok())

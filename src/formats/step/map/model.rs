@@ -116,8 +116,7 @@ fn map_all(file: &StepFile, instances: &[Instance]) -> HashMap<u64, Result<Done,
         }
         out
     };
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
+    let threads = crate::parallel::threads()
         .min(MAX_THREADS)
         .min(firsts.len());
     std::thread::scope(|s| {
