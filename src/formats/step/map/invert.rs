@@ -15,7 +15,7 @@ use crate::formats::step::map::attrs::at;
 use crate::geom::analytic::{InvertOptions, NewtonOptions, ParamBox, SurfaceKind, invert_nurbs};
 use glam::{DVec2, DVec3};
 
-use super::nurbs::FastSurface;
+use super::nurbs::{D1, FastSurface};
 use super::surface::{Geometry, Inv, NurbsSurface2, Surface};
 
 /// A line of the parameter plane where one parameter is arbitrary: `param[dir] == at`.
@@ -229,17 +229,24 @@ fn invert_bspline(
     let size = n.size;
     let local = hint.and_then(|h| newton(&n.fast, p, h, periods));
     let best = match local {
-        Some(r) if r.1 <= 1e-3 * size || (r.2 && !on_edge(&n.fast, r.0, periods)) => (r.0, r.1),
+        Some(r) if r.1 <= 1e-3 * size || (r.2 && !on_edge(&n.fast, r.0, periods)) => {
+            (r.0, r.1, Some(r.3))
+        }
         _ => {
             let global = global(n, p, periods)?;
             match local {
-                Some(l) if l.1 <= global.1 => (l.0, l.1),
+                Some(l) if l.1 <= global.1 => (l.0, l.1, Some(l.3)),
                 _ => global,
             }
         }
     };
-    let w = wrap(&n.fast, best.0, periods);
-    let d = n.fast.d1(w.x, w.y)?;
+    let d = match best.2 {
+        Some(d) => d,
+        None => {
+            let w = wrap(&n.fast, best.0, periods);
+            n.fast.d1(w.x, w.y)?
+        }
+    };
     let scale = d.su.length().max(d.sv.length()).max(f64::MIN_POSITIVE);
     Some(Inv {
         uv: best.0,
@@ -259,7 +266,11 @@ const GRID_MAX: usize = 64;
 /// (made once per surface), and the analytic crate's inversion (a finer search) when none of
 /// them lands on the surface.
 #[must_use]
-fn global(n: &NurbsSurface2, p: DVec3, periods: [Option<f64>; 2]) -> Option<(DVec2, f64)> {
+fn global(
+    n: &NurbsSurface2,
+    p: DVec3,
+    periods: [Option<f64>; 2],
+) -> Option<(DVec2, f64, Option<D1>)> {
     let grid = n.grid.get_or_init(|| start_grid(&n.fast, &n.surface.knots));
     let mut near: Vec<(f64, DVec2)> = grid
         .iter()
@@ -269,12 +280,12 @@ fn global(n: &NurbsSurface2, p: DVec3, periods: [Option<f64>; 2]) -> Option<(DVe
     if k > 0 {
         near.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0));
     }
-    let mut best: Option<(DVec2, f64)> = None;
+    let mut best: Option<(DVec2, f64, Option<D1>)> = None;
     for &(_, start) in near.iter().take(k) {
         if let Some(r) = newton(&n.fast, p, start, periods)
             && best.is_none_or(|b| r.1 < b.1)
         {
-            best = Some((r.0, r.1));
+            best = Some((r.0, r.1, Some(r.3)));
         }
     }
     if best.is_some_and(|b| b.1 <= 1e-6 * n.size) {
@@ -282,7 +293,9 @@ fn global(n: &NurbsSurface2, p: DVec3, periods: [Option<f64>; 2]) -> Option<(DVe
     }
     let g = invert_nurbs(&n.surface, p, &NewtonOptions::default()).ok()?;
     let refined = newton(&n.fast, p, DVec2::from(g.uv), periods)
-        .map_or((DVec2::from(g.uv), g.distance), |r| (r.0, r.1));
+        .map_or((DVec2::from(g.uv), g.distance, None), |r| {
+            (r.0, r.1, Some(r.3))
+        });
     Some(match best {
         Some(b) if b.1 <= refined.1 => b,
         _ => refined,
@@ -328,14 +341,16 @@ fn start_grid(s: &FastSurface, knots: &[Vec<f64>; 2]) -> Vec<(DVec2, DVec3)> {
 
 /// Gauss–Newton on `|S(u, v) − p|²` from `start`, steps halved while they do not reduce the
 /// distance, iterates clamped to the domain; a singular normal matrix (a pole) falls back to
-/// steps along the non-degenerate direction.
+/// steps along the non-degenerate direction. Returns the foot, its distance, whether it
+/// converged, and the point and partials there (callers need them, and evaluating them again
+/// was a fifth of a STEP part's load).
 #[must_use]
 fn newton(
     s: &FastSurface,
     p: DVec3,
     start: DVec2,
     periods: [Option<f64>; 2],
-) -> Option<(DVec2, f64, bool)> {
+) -> Option<(DVec2, f64, bool, D1)> {
     let [du, dv] = s.domain();
     // Closed directions run on across the seam (evaluated one period back); others clamp.
     let clamp = |q: DVec2| {
@@ -412,7 +427,7 @@ fn newton(
             break;
         }
     }
-    Some((uv, dist, converged))
+    Some((uv, dist, converged, d))
 }
 
 /// `q` moved by whole periods into the domain in the closed directions.
