@@ -215,7 +215,7 @@ fn sign(k: usize) -> f64 {
 /// improves and stays inside. Interior extremes (a torus's top) lie between grid samples.
 #[must_use]
 fn climb(s: &FastSurface, regions: &TrimRegions, k: usize, mut q: DVec2, cell: DVec2) -> DVec3 {
-    let value = |q: DVec2| s.d1(q.x, q.y).map(|d| (sign(k) * coord(d.p, k), d.p));
+    let value = |q: DVec2| s.point(q.x, q.y).map(|p| (sign(k) * coord(p, k), p));
     let Some((mut best, mut point)) = value(q) else {
         return DVec3::NAN;
     };

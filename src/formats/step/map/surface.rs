@@ -389,7 +389,7 @@ impl Surface {
     pub(crate) fn point(&self, uv: DVec2) -> Option<DVec3> {
         match &self.geom {
             Geometry::Analytic(a) => a.point(uv.x, uv.y).ok(),
-            Geometry::Nurbs(n) => n.fast.d1(uv.x, uv.y).map(|d| d.p),
+            Geometry::Nurbs(n) => n.fast.point(uv.x, uv.y),
         }
     }
 

@@ -130,6 +130,12 @@ fn fast_surface_matches_the_reference_evaluator() {
         let a = s.derivs(u, v).expect("reference");
         let b = fast.d1(u, v).expect("fast");
         assert!((a.p - b.p).length() < 1e-13, "{u} {v}");
+        // The point-only path is the same arithmetic: the same bits.
+        let q = fast.point(u, v).expect("point");
+        assert_eq!(
+            q.to_array().map(f64::to_bits),
+            b.p.to_array().map(f64::to_bits)
+        );
         assert!(
             (a.su - b.su).length() < 1e-11 && (a.sv - b.sv).length() < 1e-11,
             "{u} {v}"
@@ -139,6 +145,10 @@ fn fast_surface_matches_the_reference_evaluator() {
         fast.d1(f64::NAN, 0.5).is_none(),
         "a NaN parameter is refused, not clamped"
     );
+    assert!(fast.point(0.5, f64::NAN).is_none());
+    // Negative control for the bit comparison: a nearby parameter gives other bits.
+    let (p, q) = (fast.point(0.3, 0.6), fast.point(0.3 + 1e-9, 0.6));
+    assert_ne!(p.map(|p| p.x.to_bits()), q.map(|q| q.x.to_bits()));
     let curve = NurbsCurve {
         degree: 2,
         knots: vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0],

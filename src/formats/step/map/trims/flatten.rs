@@ -28,7 +28,7 @@ pub(crate) fn flatten(
     to_st: &dyn Fn(DVec2) -> DVec2,
     m: &super::output::Maps<'_>,
 ) -> Result<Vec<DVec2>, String> {
-    let in_space = |st: DVec2| m.surface.d1(st.x, st.y).map_or(glam::DVec3::NAN, |d| d.p);
+    let in_space = |st: DVec2| m.surface.point(st.x, st.y).unwrap_or(glam::DVec3::NAN);
     let mut coarse: Vec<(f64, DVec2)> = p.samples.iter().map(|s| (s.t, s.uv + p.shift)).collect();
     // The curve's own ends (a 3D edge's coarse ends are its vertices, which may lie off the
     // curve by the file's tolerance: the caller blends that difference in).
