@@ -37,8 +37,11 @@ lint: deps
 # Xvfb runs with -noreset: by default an X server resets when its last client leaves, and a
 # viewer connecting during the reset fails with "Failed to open connection to X server" (six
 # clients connecting in turn on a loaded 2-core host: 60 of 2,400 refused, none with -noreset).
+# The import graph first: a circle between the top-level modules fails the run
+# (docs/architecture.md).
 test: export PRESPLINE_STRICT = 1
 test: lint
+	python3 scripts/import-graph.py src
 	xvfb-run -a -s "-screen 0 1280x1024x24 -noreset" $(CARGO) test --lib --bins --tests
 	$(CARGO) test --doc
 	$(CARGO) build --benches

@@ -2,13 +2,13 @@
 # Installs what prespline needs on Debian/Ubuntu when it is missing: a C++ compiler (glslang is
 # built from source by build.rs), the Vulkan loader, Mesa's lavapipe (software Vulkan), the
 # Khronos validation layers, Xvfb for the windowed tests, strace (for the test that saves are
-# fsynced), and the X11 client libraries winit loads at run time. Does nothing when everything
-# is present.
+# fsynced), the X11 client libraries winit loads at run time, and Python 3 (make test runs the
+# import-graph check, scripts/import-graph.py). Does nothing when everything is present.
 set -euo pipefail
 
 packages=(
   g++ libvulkan1 mesa-vulkan-drivers vulkan-validationlayers
-  xvfb xauth strace libx11-6 libx11-xcb1 libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0
+  xvfb xauth strace python3 libx11-6 libx11-xcb1 libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0
 )
 
 missing=()
