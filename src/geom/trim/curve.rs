@@ -209,9 +209,9 @@ fn eval(c: &dyn Curve2, t: f64) -> Result<DVec2, TrimError> {
     }
 }
 
-/// Distance from `q` to the segment `a`–`b`.
+/// The point of the segment `a`–`b` nearest to `q`.
 #[must_use]
-pub(crate) fn point_segment_distance(q: DVec2, a: DVec2, b: DVec2) -> f64 {
+pub(crate) fn segment_foot(q: DVec2, a: DVec2, b: DVec2) -> DVec2 {
     let e = b - a;
     let len2 = e.length_squared();
     let s = if len2 > 0.0 {
@@ -219,7 +219,13 @@ pub(crate) fn point_segment_distance(q: DVec2, a: DVec2, b: DVec2) -> f64 {
     } else {
         0.0
     };
-    q.distance(a + e * s)
+    a + e * s
+}
+
+/// Distance from `q` to the segment `a`–`b`.
+#[must_use]
+pub(crate) fn point_segment_distance(q: DVec2, a: DVec2, b: DVec2) -> f64 {
+    q.distance(segment_foot(q, a, b))
 }
 
 /// Adaptive bisection of `[t0, t1]` (whose start point is already the last of `out`), with an

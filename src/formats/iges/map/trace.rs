@@ -14,6 +14,7 @@
 //! surfaces (planes, cylinders, cones), how large the parameter box must be.
 
 use crate::geom::analytic::{NurbsCurve, NurbsSurface, ParamBox, ParamMap, SurfaceKind};
+use crate::geom::trim::curve::point_segment_distance;
 use glam::{DVec2, DVec3};
 
 use super::boundary::{LoopSource, Piece, Source};
@@ -255,10 +256,10 @@ impl Tracer<'_> {
             while let Some(&(tb, (gb, fb))) = stack.last() {
                 let tm = 0.5 * (ta + tb);
                 let (gm, fm) = self.eval(&piece.source, tm, Some(ga))?;
-                let mut deviates = distance_to_chord(fm, fa, fb) > self.tol;
+                let mut deviates = point_segment_distance(fm, fa, fb) > self.tol;
                 for f in [0.25, 0.75] {
                     let probe = self.eval(&piece.source, ta + (tb - ta) * f, Some(ga))?.1;
-                    deviates |= distance_to_chord(probe, fa, fb) > self.tol;
+                    deviates |= point_segment_distance(probe, fa, fb) > self.tol;
                 }
                 if deviates && tm != ta && tm != tb {
                     stack.push((tm, (gm, fm)));
@@ -294,17 +295,6 @@ fn extent(points: &[DVec3]) -> f64 {
     let lo = points.iter().fold(DVec3::INFINITY, |a, &b| a.min(b));
     let hi = points.iter().fold(DVec3::NEG_INFINITY, |a, &b| a.max(b));
     (hi - lo).length()
-}
-
-fn distance_to_chord(q: DVec2, a: DVec2, b: DVec2) -> f64 {
-    let e = b - a;
-    let len2 = e.length_squared();
-    let s = if len2 > 0.0 {
-        ((q - a).dot(e) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    q.distance(a + e * s)
 }
 
 /// Where a loop's coarse points sit against the fixed range of each angular parameter: the

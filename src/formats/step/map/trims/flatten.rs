@@ -15,6 +15,7 @@
 use glam::DVec2;
 
 use super::piece::{Ctx, Piece};
+use crate::geom::trim::curve::segment_foot;
 
 /// Most halvings of one coarse interval.
 const MAX_DEPTH: u32 = 24;
@@ -58,7 +59,7 @@ pub(crate) fn flatten(
             let tm = 0.5 * (a.0 + t);
             let uvm = p.uv_near(ctx, tm, 0.5 * (a.1 + uv));
             let sm = to_st(uvm);
-            let foot = foot_on_chord(sm, sa, sb);
+            let foot = segment_foot(sm, sa, sb);
             let far = (in_space(foot) - in_space(sm)).length() > m.tol3d
                 || foot.distance(sm) > m.tol_param;
             if far && depth < MAX_DEPTH && tm != a.0 && tm != t {
@@ -119,17 +120,4 @@ pub(crate) fn blend_ends(pts: &mut [DVec2], a: Option<DVec2>, b: Option<DVec2>) 
     if let Some(last) = pts.last_mut() {
         *last = l + db;
     }
-}
-
-/// The point of the segment `a`–`b` nearest to `q`.
-#[must_use]
-fn foot_on_chord(q: DVec2, a: DVec2, b: DVec2) -> DVec2 {
-    let e = b - a;
-    let len2 = e.length_squared();
-    let s = if len2 > 0.0 {
-        ((q - a).dot(e) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    a + e * s
 }
