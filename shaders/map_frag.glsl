@@ -16,7 +16,6 @@ layout(location = 0) out vec4 out_color;
 
 #ifdef TRIMMED
 #include "trim.glsl"
-layout(location = 7) flat in uint v_fast;
 #endif
 
 // The diverging scale of src/render/maps.rs (SCALE): blue below zero, white at zero, red
@@ -41,9 +40,9 @@ vec3 scale_color(float s) {
 
 void main() {
 #ifdef TRIMMED
-    // Triangles wholly inside skip the test, wholly outside ones are dropped at once.
-    mat2 reach = trim_reach();
-    if (v_fast == 0u || (v_fast != 1u && !trim_inside(reach))) {
+    // Only the blocks the trim's boundary crosses come here: those wholly inside draw through
+    // the untrimmed pipeline, those wholly outside not at all (src/render/trim_mask.rs).
+    if (!trim_inside(trim_reach())) {
         discard;
     }
 #endif

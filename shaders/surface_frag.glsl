@@ -15,7 +15,6 @@ layout(location = 0) out vec4 out_color;
 
 #ifdef TRIMMED
 #include "trim.glsl"
-layout(location = 7) flat in uint v_fast;
 #endif
 
 // x^e: by repeated squaring for whole exponents up to 255 (the usual Blinn-Phong exponents),
@@ -39,9 +38,9 @@ float specular_power(float x, float e) {
 
 void main() {
 #ifdef TRIMMED
-    // Triangles wholly inside skip the test, wholly outside ones are dropped at once.
-    mat2 reach = trim_reach();
-    if (v_fast == 0u || (v_fast != 1u && !trim_inside(reach))) {
+    // Only the blocks the trim's boundary crosses come here: those wholly inside draw through
+    // the untrimmed pipeline, those wholly outside not at all (src/render/trim_mask.rs).
+    if (!trim_inside(trim_reach())) {
         discard;
     }
 #endif

@@ -2,18 +2,15 @@
 // spacing, from the vertex shader) is tested against the object's coverage mask, built once
 // per structure on the CPU (src/geom/trim/coverage.rs, which has this test in f32 operation for
 // operation). Words from the object's record start:
-//   [0] cells offset, [1] records offset, [2] segments offset, [3] level table offset (words,
-//   from the record start), [4] sample cell rows (mu - 1), [5] sample cell columns (mv - 1),
-//   [6] mask cells per sample cell and direction (k: the mask's cells cut each sample cell in
-//   k x k, so that a cell holds few boundary segments however coarse the samples);
+//   [0] cells offset, [1] records offset, [2] segments offset (words, from the record start),
+//   [3] sample cell rows (mu - 1), [4] sample cell columns (mv - 1), [5] mask cells per sample
+//   cell and direction (k: the mask's cells cut each sample cell in k x k, so that a cell
+//   holds few boundary segments however coarse the samples);
 //   cells:    one word per mask cell (row-major): 0 outside, 1 inside, 2 | (record << 2)
 //             boundary;
 //   records:  4 words per boundary cell: first segment, (count << 1) | reference inside,
 //             reference point x, y (float bits, cell-local);
-//   segments: 4 words each, (a.x, a.y, b.x, b.y) in cell-local coordinates (float bits);
-//   level table: 25 words, the offset of the block classes of each (row, column) level of
-//   detail (strides 1 .. 16), 2 bits a block (0 outside, 1 inside, 2 mixed), 16 a word
-//   (shaders/trim_fast.glsl reads them).
+//   segments: 4 words each, (a.x, a.y, b.x, b.y) in cell-local coordinates (float bits).
 // A boundary cell's fragment is inside iff the reference point's flag XOR the parity of the
 // crossings of the path fragment -> reference with the cell's segments.
 #include "trim_words.glsl"
@@ -62,9 +59,9 @@ mat2 trim_reach() {
 // where the triangle is seen edge-on: no growth).
 bool trim_inside(mat2 j) {
     TrimWords t = TrimWords(v_trim);
-    uint k = t.w[6];
-    int ncu = int(t.w[4] * k);
-    int ncv = int(t.w[5] * k);
+    uint k = t.w[5];
+    int ncu = int(t.w[3] * k);
+    int ncv = int(t.w[4] * k);
     vec2 g = v_grid * float(k);
     int cx = clamp(int(floor(g.x)), 0, ncu - 1);
     int cy = clamp(int(floor(g.y)), 0, ncv - 1);

@@ -7,15 +7,11 @@ layout(push_constant) uniform Push {
 } pc;
 
 #ifdef TRIMMED
-// The object's coverage mask: device address of its words (lo, hi), vertices per grid row
-// (bits 0-23) with the level of detail drawn (row and column levels in bits 24 and 28), and its
-// first vertex in the bound buffer (one instance-rate attribute per draw).
+// The object's coverage mask: device address of its words (lo, hi), vertices per grid row,
+// and its first vertex in the bound buffer (one instance-rate attribute per draw).
 layout(location = 4) in uvec4 in_trim;
 layout(location = 5) out vec2 v_grid;
 layout(location = 6) flat out uvec2 v_trim;
-#ifdef TRIM_FAST
-#include "trim_fast.glsl"
-#endif
 #endif
 
 void main() {
@@ -23,12 +19,9 @@ void main() {
 #ifdef TRIMMED
     // Grid coordinates (row, column) of this vertex, interpolated across the triangle: the
     // fragment's parameter position in units of the sample spacing.
-    uint cols = in_trim.z & 0xFFFFFFu;
+    uint cols = in_trim.z;
     uint k = uint(gl_VertexIndex) - in_trim.w;
     v_grid = vec2(float(k / cols), float(k % cols));
     v_trim = in_trim.xy;
-#ifdef TRIM_FAST
-    v_fast = trim_vertex_class(TrimWords(in_trim.xy), k / cols, k % cols, (in_trim.z >> 24) & 15u, in_trim.z >> 28);
-#endif
 #endif
 }

@@ -1,8 +1,8 @@
 //! Coverage masks: per-fragment inside tests in grid coordinates for surfaces drawn from a
 //! grid of vertices (trimmed surfaces). The words of every mask of a scene sit in one mirror;
 //! a table mirror holds `uvec4` entries — the device address of a mask's words in that slot
-//! and two words the caller chooses (the shaders read the vertices per grid row, the level of
-//! detail drawn and the surface's first vertex there) — which the trimmed pipelines read as
+//! and two words the caller chooses (the shaders read the vertices per grid row and the
+//! surface's first vertex there) — which the trimmed pipelines read as
 //! an instance-rate attribute, so a masked draw needs no descriptor set and no push constants
 //! beyond the untrimmed one's (`shaders/trim.glsl` reads the words).
 

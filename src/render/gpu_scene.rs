@@ -10,7 +10,7 @@ use super::retained::{
     screen_rect, screen_rect_with, split_cells, touched_vertices, union_rect, vertex_bounds,
 };
 use super::style::{Highlight, NetMode, Palette, ViewOptions, Wire};
-use super::trim_mask::{level_entry, mask_entries, mask_words};
+use super::trim_mask::{BlockRanges, TrimBlocks, mask_entry, mask_parts};
 use crate::editor::{
     Applied, ControlLayout, ControlsChange, Document, Handle, LOCAL_CURVE_SAMPLES,
     LOCAL_PATCH_SAMPLES, LocalEntry,
@@ -144,6 +144,8 @@ pub struct GpuScene {
     controls_complete: bool,
     /// The trimmed surfaces' coverage masks, made by the first frame that draws.
     masks: Option<MaskSet>,
+    /// Per mask, its blocks by class at every level of detail (made with the masks).
+    blocks: Vec<TrimBlocks>,
 }
 
 /// A static layer in the target and what it was built for.
@@ -202,6 +204,7 @@ impl GpuScene {
                 .collect(),
             controls_complete: doc.objects.is_empty(),
             masks: None,
+            blocks: Vec::new(),
         };
         // On failure, give back what was created.
         match scene.fill(renderer, doc, &places, &sizes) {
@@ -572,16 +575,17 @@ impl GpuScene {
         if self.masks.is_some() || self.groups.iter().all(|g| g.mask.is_none()) {
             return Ok(());
         }
-        let masked: Vec<(usize, Vec<u32>)> = self
-            .groups
-            .iter()
-            .filter(|g| g.mask.is_some())
-            .filter_map(|g| {
-                let i = g.members[0];
-                let trim = doc.objects[i].trim.as_ref()?;
-                Some((i, mask_words(&trim.coverage, trim.refine)))
-            })
-            .collect();
+        let mut masked: Vec<(usize, Vec<u32>)> = Vec::new();
+        let mut blocks = Vec::new();
+        for g in self.groups.iter().filter(|g| g.mask.is_some()) {
+            let i = g.members[0];
+            let Some(trim) = doc.objects[i].trim.as_ref() else {
+                continue;
+            };
+            let (words, b) = mask_parts(&trim.coverage, trim.refine);
+            masked.push((i, words));
+            blocks.push(b);
+        }
         let words: Vec<MaskWords<'_>> = masked
             .iter()
             .map(|(i, w)| {
@@ -590,19 +594,27 @@ impl GpuScene {
                     (self.objects[*i].samples.offset / SurfaceGrid::FLOATS_PER_VERTEX) as u32;
                 MaskWords {
                     words: w,
-                    entries: mask_entries(cols, first),
+                    entries: vec![mask_entry(cols, first)],
                 }
             })
             .collect();
         self.masks = Some(frame.create_mask_set(&words)?);
+        self.blocks = blocks;
         Ok(())
     }
 
-    /// The coverage mask group `g` is drawn through at `stride`.
-    fn group_mask(&self, g: usize, stride: GridStride) -> Option<MaskRef<'_>> {
+    /// The blocks of group `g`'s trim at `stride`: what its draws cut by class.
+    fn group_blocks(&self, g: usize, stride: GridStride) -> Option<&BlockRanges> {
         let mask = self.groups[g].mask?;
-        let entry = level_entry(mask, [stride.rows, stride.cols]);
-        Some(self.masks.as_ref()?.entry(entry))
+        self.blocks
+            .get(mask as usize)?
+            .at([stride.rows, stride.cols])
+    }
+
+    /// The coverage mask group `g` is drawn through.
+    fn group_mask(&self, g: usize) -> Option<MaskRef<'_>> {
+        let mask = self.groups[g].mask?;
+        Some(self.masks.as_ref()?.entry(mask))
     }
 
     /// Makes the control mirrors a frame drawn with `opts` and `hl` needs and does not have
@@ -796,13 +808,14 @@ impl GpuScene {
             shape: group.shape,
             stride: b.stride,
             offsets: &offsets,
-            mask: self.group_mask(b.group, b.stride),
+            mask: self.group_mask(b.group),
         };
         self.draw_surfaces(
             frame,
             group.arena,
             &batch,
             None,
+            self.group_blocks(b.group, b.stride),
             &self.group_style(doc, b.group),
         )?;
         let every = match opts.wire {
@@ -831,10 +844,11 @@ impl GpuScene {
             shape: group.shape,
             stride: b.stride,
             offsets: &offsets,
-            mask: self.group_mask(b.group, b.stride),
+            mask: self.group_mask(b.group),
         };
         let style = self.group_style(doc, b.group);
-        self.draw_surfaces(frame, group.arena, &batch, Some(cells), &style)
+        let blocks = self.group_blocks(b.group, b.stride);
+        self.draw_surfaces(frame, group.arena, &batch, Some(cells), blocks, &style)
     }
 
     fn group_style(&self, doc: &Document, g: usize) -> SurfaceStyle {
@@ -1122,9 +1136,37 @@ impl GpuScene {
     }
 
     /// A batch of surfaces (with `cells`, those cells of its one surface), shaded or coloured
-    /// by the map. Until the first upload after a map change has built its scalars,
-    /// curvature maps draw plain shading.
+    /// by the map. A trimmed surface (`blocks`, its blocks at the batch's stride) draws its
+    /// blocks wholly inside the trim as an untrimmed surface and only the boundary blocks
+    /// through its mask.
     fn draw_surfaces(
+        &self,
+        frame: &mut Frame<'_>,
+        arena: usize,
+        batch: &SurfaceBatch,
+        cells: Option<&[(u32, u32)]>,
+        blocks: Option<&BlockRanges>,
+        style: &SurfaceStyle,
+    ) -> GpuResult<()> {
+        let Some(blocks) = blocks else {
+            return self.draw_surfaces_as(frame, arena, batch, cells, style);
+        };
+        let [inside, mixed] = blocks.split(cells);
+        let whole = SurfaceBatch {
+            mask: None,
+            ..*batch
+        };
+        for (batch, cells) in [(&whole, inside), (batch, mixed)] {
+            if !cells.is_empty() {
+                self.draw_surfaces_as(frame, arena, batch, Some(&cells), style)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// [`GpuScene::draw_surfaces`] through the batch's own pipeline. Until the first upload
+    /// after a map change has built its scalars, curvature maps draw plain shading.
+    fn draw_surfaces_as(
         &self,
         frame: &mut Frame<'_>,
         arena: usize,
