@@ -62,8 +62,8 @@ pub struct DisplayArgs {
     /// Hide ERBS local curves and patches.
     #[arg(long)]
     pub no_local: bool,
-    /// Isoparametric lines every N samples on surfaces (1 = full wireframe).
-    #[arg(long, value_name = "N")]
+    /// Isoparametric lines every N samples on surfaces (1 = full wireframe; N ≥ 1).
+    #[arg(long, value_name = "N", value_parser = parse_wire)]
     pub wire: Option<u32>,
     /// Draw surface normals.
     #[arg(long)]
@@ -87,6 +87,17 @@ pub struct DisplayArgs {
     /// Draw every sample of every surface (no display level of detail).
     #[arg(long)]
     pub no_lod: bool,
+}
+
+/// `--wire N`: a whole number of samples between isolines, at least 1.
+fn parse_wire(s: &str) -> Result<u32, String> {
+    match s.trim().parse::<u32>() {
+        Ok(0) => {
+            Err("0 draws no isolines: give N ≥ 1 (1 = full wireframe), or leave --wire out".into())
+        }
+        Ok(n) => Ok(n),
+        Err(_) => Err(format!("'{s}' is not a whole number of samples ≥ 1")),
+    }
 }
 
 impl DisplayArgs {

@@ -32,7 +32,13 @@ use std::path::{Path, PathBuf};
 pub struct BenchArgs {
     /// Scene file (JSON, OBJ, STEP or IGES); the demo scene without it.
     pub scene: Option<PathBuf>,
-    /// What the scripted user does.
+    /// What the scripted user does. drag: the middle control point of the surface with the
+    /// most control points (else of any object) is grabbed and moved in a circle of 40 pixels,
+    /// one edit per frame. erbs-rotate: the middle local patch (or local curve) of the first
+    /// ERBS object is turned a little every frame. orbit: the camera turns around the scene,
+    /// 4 pixels of middle-button drag a frame, no edits. idle: nothing changes, yet every frame
+    /// is drawn in full: it measures one full redraw (the viewer itself draws nothing while
+    /// idle).
     #[arg(long, default_value = "drag", value_parser = Scenario::parse, value_name = "drag|erbs-rotate|orbit|idle")]
     pub scenario: Scenario,
     /// Measured frames.
@@ -47,9 +53,12 @@ pub struct BenchArgs {
     /// Run in a window (no vsync) instead of headless.
     #[arg(long)]
     pub window: bool,
-    /// Also run the same session the way tools without pre-evaluation work (full re-sampling
-    /// and full upload of edited objects every frame) and compare: reports in DIR/incremental
-    /// and DIR/naive, the comparison printed and saved as DIR/comparison.txt.
+    /// Also run the same session the way tools without pre-evaluation work and compare. The
+    /// naive run turns off the delta path only: every edit re-samples its whole object and
+    /// uploads all of it, so the retained redraw (still on) must draw the whole object again
+    /// each frame instead of the touched cells. Reports in DIR/incremental and DIR/naive; the
+    /// comparison, with the samples and bytes each run rewrote per frame, is printed and saved
+    /// as DIR/comparison.txt.
     #[arg(long)]
     pub naive: bool,
     /// Output directory for the reports.

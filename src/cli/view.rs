@@ -115,6 +115,10 @@ pub fn run(opts: ViewArgs) -> Result<(), CliError> {
     }
     super::render::check_drawable(&scene, Path::new(&title), &budget)?;
     super::render::check_analysis(&scene, opts.analysis, &budget)?;
+    if let Some(p) = &opts.save_as {
+        formats::check_save(&scene, p)
+            .map_err(|e| CliError(format!("--save-as {}: {e}", p.display())))?;
+    }
     if !app::display_available() {
         return Err(CliError(
             "no display: DISPLAY is not set (prespline view needs X11 or XWayland; headless: `prespline render` or `prespline bench`, or `make run` which falls back to a headless demo)".into(),

@@ -18,6 +18,6 @@ pub use context::{
     FileFormat, FormatError, Import, LoadContext, Located, SampleDefaults, Skipped, Written,
 };
 pub use registry::{
-    FORMATS, LoadOptions, format_of, known_extensions, load, load_json, parse_scene, read_json,
-    save, save_json,
+    FORMATS, LoadOptions, check_save, format_of, known_extensions, load, load_json, parse_scene,
+    read_json, save, save_json,
 };

@@ -98,6 +98,14 @@ pub fn parse_scene(text: &str) -> Result<Scene, SceneError> {
     json::parse_scene(text, &ctx)
 }
 
+/// Whether [`save`] could write `scene` to `path`: the format's whole text is made and
+/// dropped, so a save that can only fail is refused when the path is given, not when the user
+/// saves.
+pub fn check_save(scene: &Scene, path: &Path) -> Result<(), String> {
+    let format = format_of(path).unwrap_or(FORMATS[0]);
+    format.write(scene).map(|_| ()).map_err(|e| e.to_string())
+}
+
 /// Writes the scene in the format the path names (the JSON scene format for any other
 /// extension) atomically and durably ([`write_durably`]), so a failed save never destroys the
 /// previous file; nothing is written when an object has no form in that format. Returns what

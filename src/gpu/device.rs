@@ -50,6 +50,21 @@ impl DeviceCaps {
                 .contains(vk::SampleCountFlags::from_raw(samples))
     }
 
+    /// The sample counts this device renders with, for messages: `1, 2 or 4`.
+    #[must_use]
+    pub fn sample_count_list(&self) -> String {
+        let counts: Vec<String> = (0..7)
+            .map(|k| 1u32 << k)
+            .filter(|&n| self.supports_samples(n))
+            .map(|n| n.to_string())
+            .collect();
+        match counts.as_slice() {
+            [] => "1".into(),
+            [one] => one.clone(),
+            [rest @ .., last] => format!("{} or {last}", rest.join(", ")),
+        }
+    }
+
     /// The MSAA sample count used when a target asks for 0, chosen per device type by
     /// measurement (docs/performance.md, "Frames"): 1 on CPU rasterisers (lavapipe), where 4×
     /// multisampling multiplies the cost of every triangle's rasterisation and of the resolve,
@@ -76,8 +91,9 @@ impl DeviceCaps {
         };
         if !n.is_power_of_two() || !self.supports_samples(n) {
             return Err(GpuError::InvalidArgument(format!(
-                "{n}x MSAA is not supported by {}",
-                self.name
+                "{n}x MSAA is not supported by {}, which renders with {} samples",
+                self.name,
+                self.sample_count_list()
             )));
         }
         Ok(vk::SampleCountFlags::from_raw(n))

@@ -131,6 +131,12 @@ mod escape_tests {
             escape_controls("a\nb\u{1b}[31m\t\u{7f}c"),
             r"a\nb\u{1b}[31m\t\u{7f}c"
         );
+        // C1 controls alone (the 8-bit CSI, NEL, the first and last of the block).
+        assert_eq!(
+            escape_controls("a\u{9b}31mb\u{85}\u{80}\u{9f}"),
+            r"a\u{9b}31mb\u{85}\u{80}\u{9f}"
+        );
+        assert!(matches!(escape_controls("\u{a0}\u{7e}"), Cow::Borrowed(_)));
         // Negative control: a line that still holds a control character fails the check.
         assert!(escape_controls("x\ry").chars().all(|c| !c.is_control()));
         assert!("x\ry".chars().any(char::is_control));

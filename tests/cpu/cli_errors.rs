@@ -190,6 +190,23 @@ fn fields_and_names() {
         None,
         &["field 'type'", "unknown type 'spline'"],
     );
+    // Other programs' names for NURBS point to the B-spline kinds with weights.
+    expect_error(
+        &scene(&[&CURVE.replace("bspline_curve", "nurbs_curve")]),
+        None,
+        &[
+            "unknown type 'nurbs_curve'",
+            "bspline_curve with \"weights\"",
+        ],
+    );
+    expect_error(
+        &scene(&[&CURVE.replace("bspline_curve", "nurbs_surface")]),
+        None,
+        &[
+            "unknown type 'nurbs_surface'",
+            "bspline_surface with \"weights\"",
+        ],
+    );
     expect_error(
         &scene(&[&ERBS.replace("\"samples\"", "\"bfunction\": \"gauss\", \"samples\"")]),
         None,
@@ -508,7 +525,7 @@ fn erbs_surface_fields() {
             at,
             "field 'knots'",
             "v direction",
-            "expected 5 knots",
+            "expected 5 knots (local patches + 2 = 3 + 2)",
             "got 4",
         ],
     );
@@ -662,7 +679,13 @@ fn control_characters_in_user_text_are_escaped() {
         r#""name": "c", "x\u001b]0;pwned\u0007": 1,"#,
     );
     expect_error(&scene(&[&bad_field]), None, &[r"x\u{1b}]0;pwned\u{7}"]);
-    for text in [&bad_name, &bad_field] {
+    // C1 controls alone: the 8-bit CSI (U+009B) and NEL (U+0085).
+    let c1_name = CURVE.replace(
+        r#""name": "c""#,
+        r#""name": "c\u009b31md\u0085", "oops": 1"#,
+    );
+    expect_error(&scene(&[&c1_name]), None, &[r"c\u{9b}31md\u{85}", "'oops'"]);
+    for text in [&bad_name, &bad_field, &c1_name] {
         let (_, _, stderr) = sample(&scene(&[text]), None);
         assert!(
             !stderr.trim_end_matches('\n').chars().any(char::is_control),
@@ -865,4 +888,36 @@ fn command_line_errors_are_one_line() {
     let (code, stdout, _) = run(&["render", "--help"]);
     assert_eq!(code, Some(0));
     assert!(stdout.lines().count() > 5, "{stdout}");
+}
+
+/// `view --save-as x.obj` on a scene OBJ cannot hold (an ERBS curve with the exponential
+/// B-function has no B-spline form) is refused when the viewer starts, in one line, instead of
+/// at the first Ctrl+S; the same scene with `--save-as x.json` gets past that check (to the
+/// missing display here).
+#[test]
+fn view_refuses_a_save_path_that_cannot_hold_the_scene() {
+    let dir = Scratch::new("cli-errors");
+    let scene = dir.file("scene.json", &scene(&[ERBS]));
+    let view = |save: &str| {
+        let out = Command::new(env!("CARGO_BIN_EXE_prespline"))
+            .arg("view")
+            .arg(&scene)
+            .arg("--save-as")
+            .arg(dir.path().join(save))
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY")
+            .output()
+            .unwrap();
+        assert!(!out.status.success());
+        String::from_utf8(out.stderr).unwrap()
+    };
+    let err = view("x.obj");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("--save-as") && err.contains("x.obj") && err.contains("object 'e'"),
+        "{err}"
+    );
+    assert!(!dir.path().join("x.obj").exists());
+    let err = view("x.json");
+    assert!(err.contains("no display"), "{err}");
 }

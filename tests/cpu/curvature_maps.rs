@@ -390,3 +390,79 @@ fn surface_families_are_numbered_names_that_touch() {
         assert_eq!(got, want);
     }
 }
+
+/// Families that do not start at object 0: a curve and a lone patch come first, then the
+/// teapot's 32 touching patches, then the teapot scaled up four times (its curvature a
+/// sixteenth) under other names. Every member's per-object range is its own family's, computed
+/// here from the members' values, so mixing family and object indices cannot pass; the
+/// negative control is the shared scale, which gives the big teapot the small one's range.
+#[test]
+fn families_after_other_objects_take_their_own_ranges() {
+    use prespline::render::maps::{MapRange, SurfaceMap, map_scales, surface_families};
+    use prespline::render::maps::{MapScale, symmetric_range};
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/teapot.json");
+    let teapot: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    let mut objects = vec![serde_json::json!({
+        "name": "rail", "type": "bezier_curve",
+        "points": [[0, 0, 0], [1, 2, 0], [2, 0, 0]], "samples": 20
+    })];
+    let lone = serde_json::json!({ "objects": [&teapot["objects"][5]] });
+    objects.extend(moved(&lone, 30.0, |_| "lone".to_string()));
+    objects.extend(moved(&teapot, 0.0, str::to_string));
+    let mut big = moved(&teapot, 0.0, |n| n.replace("teapot", "big"));
+    for o in &mut big {
+        scale(&mut o["points"], 4.0);
+    }
+    let big = serde_json::json!({ "objects": big });
+    objects.extend(moved(&big, 60.0, str::to_string));
+    let text = serde_json::json!({ "objects": objects }).to_string();
+    let scene = prespline::formats::parse_scene(&text).unwrap();
+    let doc = common::editor(&scene, Some(SurfaceMap::Gaussian)).into_document();
+
+    let families = surface_families(&doc);
+    let want: Vec<(String, Vec<usize>)> = vec![
+        ("lone".into(), vec![1]),
+        ("teapot".into(), (2..34).collect()),
+        ("big".into(), (34..66).collect()),
+    ];
+    assert_eq!(families, want);
+
+    let values = |members: &[usize]| -> Vec<f64> {
+        members
+            .iter()
+            .flat_map(|&i| doc.objects[i].sampled.grid().curvatures.clone().unwrap())
+            .map(|kh| SurfaceMap::Gaussian.value(kh))
+            .collect()
+    };
+    let own = map_scales(&doc, SurfaceMap::Gaussian, MapRange::PerObject);
+    let shared = map_scales(&doc, SurfaceMap::Gaussian, MapRange::Shared);
+    let mismatches = |scales: &[MapScale]| -> usize {
+        want.iter()
+            .map(|(_, members)| {
+                let r = MapScale::symmetric(symmetric_range(values(members).into_iter()));
+                members.iter().filter(|&&i| scales[i] != r).count()
+            })
+            .sum()
+    };
+    assert_eq!(mismatches(&own), 0, "{own:?}");
+    let (small, large) = (own[2].high, own[34].high);
+    assert!(small > 8.0 * large, "teapot {small}, big teapot {large}");
+    assert!(
+        mismatches(&shared) >= 32,
+        "the shared scale is seen as wrong"
+    );
+}
+
+/// Every point of a scene object's `points` scaled by `k` about the origin.
+fn scale(v: &mut serde_json::Value, k: f64) {
+    match v {
+        serde_json::Value::Array(a) if a.len() == 3 && a.iter().all(|c| c.is_number()) => {
+            for c in a.iter_mut() {
+                *c = serde_json::json!(c.as_f64().unwrap() * k);
+            }
+        }
+        serde_json::Value::Array(a) => a.iter_mut().for_each(|x| scale(x, k)),
+        _ => {}
+    }
+}

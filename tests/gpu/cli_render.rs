@@ -69,6 +69,7 @@ fn bad_input_is_one_line() {
     for (flag, value, msg) in [
         ("--size", "0x10", "within 1..16384"),
         ("--camera", "1,2,3", "EX,EY,EZ,TX,TY,TZ"),
+        ("--wire", "0", "0 draws no isolines: give N ≥ 1"),
     ] {
         let r = prespline()
             .arg("render")
@@ -82,6 +83,25 @@ fn bad_input_is_one_line() {
         let err = String::from_utf8_lossy(&r.stderr);
         assert!(err.contains(msg), "{flag} {value}: {err}");
     }
+    // A sample count the device lacks names the ones it has (lavapipe: 1 or 4).
+    let r = prespline()
+        .arg("render")
+        .arg(&scene)
+        .arg("--out")
+        .arg(dir.join("x.png"))
+        .args(["--size", "64x64", "--msaa", "8"])
+        .output()
+        .unwrap();
+    assert!(!r.status.success());
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("8x MSAA is not supported by")
+            && err.contains("renders with 1")
+            && err.contains(" or 4 samples"),
+        "{err}"
+    );
+    assert!(!dir.join("x.png").exists());
 }
 
 /// `PRESPLINE_VALIDATION=required` (what every test run uses) fails with one line when the

@@ -253,8 +253,9 @@ fn parse_object(i: usize, v: &Value, fields: &ObjectFields<'_>) -> Result<SceneO
         Err(at.err(
             "type",
             format!(
-                "unknown type '{ty}' (expected one of: {})",
-                Model::types().join(", ")
+                "unknown type '{ty}' (expected one of: {}){}",
+                Model::types().join(", "),
+                type_hint(ty)
             ),
         ))
     })?;
@@ -308,4 +309,20 @@ fn parse_color(at: &At, v: &Value) -> Result<[f64; 3], SceneError> {
         ));
     }
     Ok(p.to_array())
+}
+
+/// What a user who wrote another program's type name meant: NURBS are the B-spline kinds with
+/// `weights`, and rational Béziers the Bézier kinds with them.
+fn type_hint(ty: &str) -> &'static str {
+    let t = ty.to_ascii_lowercase();
+    let surface = t.contains("surf") || t.contains("patch");
+    if t.contains("nurbs") || t.contains("rational") {
+        if surface {
+            "; a NURBS surface is a bspline_surface with \"weights\""
+        } else {
+            "; a NURBS curve is a bspline_curve with \"weights\""
+        }
+    } else {
+        ""
+    }
 }

@@ -14,6 +14,22 @@
 
 use super::super::error::{GeomError, GeomResult};
 
+/// What the locals of a direction are, for messages: a surface's are patches.
+#[derive(Debug, Clone, Copy)]
+enum Locals {
+    Curves,
+    Patches,
+}
+
+impl Locals {
+    fn noun(self) -> &'static str {
+        match self {
+            Locals::Curves => "local curves",
+            Locals::Patches => "local patches",
+        }
+    }
+}
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct ErbsKnots {
     knots: Vec<f64>,
@@ -24,17 +40,32 @@ pub struct ErbsKnots {
 impl ErbsKnots {
     /// Open knots for `n` local curves.
     pub fn open(knots: Vec<f64>, n: usize) -> GeomResult<Self> {
+        Self::open_of(knots, n, Locals::Curves)
+    }
+
+    /// Open knots for one direction of `n` local patches (errors say patches).
+    pub fn open_patches(knots: Vec<f64>, n: usize) -> GeomResult<Self> {
+        Self::open_of(knots, n, Locals::Patches)
+    }
+
+    /// Closed knots for one direction of `n` local patches (errors say patches).
+    pub fn closed_patches(knots: Vec<f64>, n: usize) -> GeomResult<Self> {
+        Self::closed_of(knots, n, Locals::Patches)
+    }
+
+    fn open_of(knots: Vec<f64>, n: usize, locals: Locals) -> GeomResult<Self> {
+        let locals = locals.noun();
         if n < 2 {
             return Err(GeomError::new(
                 "local",
-                format!("an ERBS needs at least 2 local curves, got {n}"),
+                format!("an ERBS needs at least 2 {locals}, got {n}"),
             ));
         }
         if knots.len() != n + 2 {
             return Err(GeomError::new(
                 "knots",
                 format!(
-                    "expected {} knots (local curves + 2 = {n} + 2), got {}",
+                    "expected {} knots ({locals} + 2 = {n} + 2), got {}",
                     n + 2,
                     knots.len()
                 ),
@@ -69,17 +100,22 @@ impl ErbsKnots {
 
     /// Closed (periodic) knots for `n` local curves: n + 1 strictly increasing values.
     pub fn closed(knots: Vec<f64>, n: usize) -> GeomResult<Self> {
+        Self::closed_of(knots, n, Locals::Curves)
+    }
+
+    fn closed_of(knots: Vec<f64>, n: usize, locals: Locals) -> GeomResult<Self> {
+        let locals = locals.noun();
         if n < 2 {
             return Err(GeomError::new(
                 "local",
-                format!("a closed ERBS needs at least 2 local curves, got {n}"),
+                format!("a closed ERBS needs at least 2 {locals}, got {n}"),
             ));
         }
         if knots.len() != n + 1 {
             return Err(GeomError::new(
                 "knots",
                 format!(
-                    "expected {} knots for a closed ERBS (local curves + 1 = {n} + 1, the last closing the period), got {}",
+                    "expected {} knots for a closed ERBS ({locals} + 1 = {n} + 1, the last closing the period), got {}",
                     n + 1,
                     knots.len()
                 ),
@@ -97,6 +133,15 @@ impl ErbsKnots {
 
     /// Uniform knots over [a, b] for `n` locals: open t_1 = a … t_n = b, closed k_0 = a … k_n = b.
     pub fn uniform(a: f64, b: f64, n: usize, closed: bool) -> GeomResult<Self> {
+        Self::uniform_of(a, b, n, closed, Locals::Curves)
+    }
+
+    /// [`ErbsKnots::uniform`] for one direction of `n` local patches (errors say patches).
+    pub fn uniform_patches(a: f64, b: f64, n: usize, closed: bool) -> GeomResult<Self> {
+        Self::uniform_of(a, b, n, closed, Locals::Patches)
+    }
+
+    fn uniform_of(a: f64, b: f64, n: usize, closed: bool, locals: Locals) -> GeomResult<Self> {
         if !(a.is_finite() && b.is_finite() && a < b) {
             return Err(GeomError::new(
                 "from",
@@ -116,12 +161,12 @@ impl ErbsKnots {
             }
         };
         if closed {
-            Self::closed((0..=n).map(at).collect(), n)
+            Self::closed_of((0..=n).map(at).collect(), n, locals)
         } else {
             let mut k: Vec<f64> = (0..n).map(at).collect();
             k.insert(0, a);
             k.push(b);
-            Self::open(k, n)
+            Self::open_of(k, n, locals)
         }
     }
 

@@ -186,8 +186,8 @@ impl ErbsSurface {
     ) -> GeomResult<Self> {
         let [ku, kv] = knots;
         let knots = [
-            ErbsKnots::open(ku, count[0]).map_err(|e| direction(e, "u"))?,
-            ErbsKnots::open(kv, count[1]).map_err(|e| direction(e, "v"))?,
+            ErbsKnots::open_patches(ku, count[0]).map_err(|e| direction(e, "u"))?,
+            ErbsKnots::open_patches(kv, count[1]).map_err(|e| direction(e, "v"))?,
         ];
         let local = local
             .into_iter()
@@ -261,9 +261,9 @@ impl ErbsSurface {
     ) -> GeomResult<Self> {
         let dom = source.domain();
         let knots = [
-            ErbsKnots::uniform(dom[0].0, dom[0].1, count[0], closed[0])
+            ErbsKnots::uniform_patches(dom[0].0, dom[0].1, count[0], closed[0])
                 .map_err(|e| direction(e, "u"))?,
-            ErbsKnots::uniform(dom[1].0, dom[1].1, count[1], closed[1])
+            ErbsKnots::uniform_patches(dom[1].0, dom[1].1, count[1], closed[1])
                 .map_err(|e| direction(e, "v"))?,
         ];
         let n = degree[0].max(degree[1]);

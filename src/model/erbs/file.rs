@@ -241,9 +241,9 @@ pub fn erbs_surface(
     for (dir, name) in ["u", "v"].into_iter().enumerate() {
         let k = as_f64_list(at, "knots", format_args!("{name} knot"), &kv[dir])?;
         let k = if closed[dir] {
-            ErbsKnots::closed(k, count[dir])
+            ErbsKnots::closed_patches(k, count[dir])
         } else {
-            ErbsKnots::open(k, count[dir])
+            ErbsKnots::open_patches(k, count[dir])
         }
         .map_err(|mut e| {
             e.message = format!("{name} direction: {}", e.message);
