@@ -173,14 +173,10 @@ impl Bench {
             info = info.with("scene_samples", samples);
             info = info.with("redraw", args.redraw.name());
             // How many measured frames a static layer served (a gesture draws in full where a
-            // layer would not pay, docs/performance.md).
+            // layer would not pay, docs/performance.md); the table's "retained" line says it
+            // of the frames it describes.
             let retained = frames.iter().filter(|f| !f.warmup && f.retained).count();
             info = info.with("retained_frames", retained);
-            eprintln!(
-                "redraw {}: {retained} of {} measured frames drawn from the static layer",
-                args.redraw.name(),
-                args.frames
-            );
             let paths = write_all(&dir, &info, &frames).map_err(|e| CliError(e.to_string()))?;
             written.extend(paths);
             if !args.window {
@@ -304,13 +300,21 @@ impl Bench {
                 rec.add_bytes(stats.bytes as u64);
                 rec.phase_start(Phase::Record);
                 session.record(&mut frame, true).map_err(gpu)?;
-                rec.set_retained(session.hud.retained.is_some());
+                let d = session.last_draw();
+                rec.set_draw(d.retained, d.layer_built, d.triangles);
                 if k + 1 == total {
                     // Only the last image is written (final.png); no other frame is read back.
                     frame.capture();
                 }
                 rec.phase_start(Phase::Submit);
                 frame.finish().map_err(gpu)?;
+                if d.layer_built {
+                    // A layer build costs a full redraw and its saves, which the rasteriser
+                    // would otherwise charge to the next frame's wait: drained here, it stays
+                    // in its own frame (reported apart from the steady gesture).
+                    rec.phase_start(Phase::Present);
+                    renderer.wait_idle().map_err(gpu)?;
+                }
                 rec.end_frame();
                 session
                     .hud

@@ -7,7 +7,8 @@ use std::path::Path;
 /// Header of `frames.csv`; the suffix of each column is its unit. `warmup` is 1 or 0,
 /// `gpu_ms` is empty when the GPU time is unknown.
 pub const CSV_HEADER: &str = "frame,start_s,warmup,frame_ms,input_ms,delta_ms,upload_ms,\
-record_ms,submit_ms,present_ms,gpu_ms,bytes_uploaded,samples_touched";
+record_ms,submit_ms,present_ms,gpu_ms,bytes_uploaded,samples_touched,retained,layer_built,\
+triangles";
 
 pub fn write_frames_csv(path: &Path, frames: &[FrameRecord]) -> Result<(), ProfileError> {
     write_file(path, |w| write_frames_csv_to(w, frames))
@@ -41,6 +42,9 @@ fn row(f: &FrameRecord) -> Vec<String> {
     cells.push(f.gpu_ms.map_or_else(String::new, |gpu| format!("{gpu:.4}")));
     cells.push(f.bytes_uploaded.to_string());
     cells.push(f.samples_touched.to_string());
+    cells.push(u8::from(f.retained).to_string());
+    cells.push(u8::from(f.layer_built).to_string());
+    cells.push(f.triangles.to_string());
     cells
 }
 
@@ -70,16 +74,17 @@ mod tests {
         write_frames_csv_to(&mut out, &[f.clone()]).unwrap();
         f.gpu_ms = Some(2.0);
         f.warmup = false;
+        (f.retained, f.layer_built, f.triangles) = (true, true, 1200);
         write_frames_csv_to(&mut out, &[f]).unwrap();
         let text = String::from_utf8(out).unwrap();
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(
             lines[1],
-            "3,0.500000,1,16.0000,0.0000,1.2500,0.0000,0.0000,0.0000,0.0000,,64,9"
+            "3,0.500000,1,16.0000,0.0000,1.2500,0.0000,0.0000,0.0000,0.0000,,64,9,0,0,0"
         );
         assert_eq!(
             lines[3],
-            "3,0.500000,0,16.0000,0.0000,1.2500,0.0000,0.0000,0.0000,0.0000,2.0000,64,9"
+            "3,0.500000,0,16.0000,0.0000,1.2500,0.0000,0.0000,0.0000,0.0000,2.0000,64,9,1,1,1200"
         );
     }
 }

@@ -136,7 +136,7 @@ pub fn write_all(
     ];
     write_frames_csv(&paths[0], frames)?;
     write_summary_json(&paths[1], run, &summary)?;
-    write_file(&paths[2], |w| w.write_all(summary.report().as_bytes()))?;
+    write_file(&paths[2], |w| w.write_all(summary.report(run).as_bytes()))?;
     write_trace_json(&paths[3], run, frames)?;
     write_frame_times_svg(&paths[4], run, frames)?;
     write_histogram_svg(&paths[5], run, frames)?;

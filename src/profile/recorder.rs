@@ -24,6 +24,13 @@ pub struct FrameRecord {
     pub samples_touched: u64,
     /// Drawn from a gesture's static layer (`--redraw retained`).
     pub retained: bool,
+    /// Built a gesture's static layer: a full redraw plus the layer's saves, reported apart
+    /// from the steady frames (see [`super::Summary`]).
+    #[serde(default)]
+    pub layer_built: bool,
+    /// Surface triangles drawn (after level of detail; a retained frame's dynamic part).
+    #[serde(default)]
+    pub triangles: u64,
 }
 
 impl FrameRecord {
@@ -160,10 +167,13 @@ impl Recorder {
         }
     }
 
-    /// Marks the open frame as drawn from a static layer.
-    pub fn set_retained(&mut self, retained: bool) {
+    /// What the open frame's draw did: drawn from a static layer, built one, and the surface
+    /// triangles it drew.
+    pub fn set_draw(&mut self, retained: bool, layer_built: bool, triangles: u64) {
         if let Some(open) = &mut self.open {
             open.record.retained = retained;
+            open.record.layer_built = layer_built;
+            open.record.triangles = triangles;
         }
     }
 

@@ -35,6 +35,37 @@ impl RunInfo {
         self
     }
 
+    /// The lines that head `summary.txt`: the scenario on the scene, the size, the mode and
+    /// every extra (redraw mode, target…), then the device.
+    #[must_use]
+    pub fn header(&self) -> String {
+        let mut what = format!("{} on {}", self.scenario, self.scene);
+        for part in [&self.size, &self.mode] {
+            if !part.is_empty() {
+                what.push_str(&format!(", {part}"));
+            }
+        }
+        let extras: Vec<String> = self
+            .extra
+            .iter()
+            .map(|(k, v)| match v {
+                serde_json::Value::String(s) => format!("{k} {s}"),
+                other => format!("{k} {other}"),
+            })
+            .collect();
+        let mut out = format!(
+            "run: {what}; {} frames + {} warm-up\n",
+            self.frames, self.warmup_frames
+        );
+        if !extras.is_empty() {
+            out.push_str(&format!("     {}\n", extras.join(", ")));
+        }
+        if !self.device.is_empty() {
+            out.push_str(&format!("device: {}\n", self.device));
+        }
+        out
+    }
+
     /// One line naming the run, for titles: the non-empty descriptive fields joined by " · ".
     pub fn description(&self) -> String {
         [&self.scene, &self.size, &self.mode, &self.device]
@@ -64,6 +95,15 @@ pub struct Section {
     pub samples_touched: u64,
     pub bytes_per_frame: f64,
     pub samples_per_frame: f64,
+    /// Surface triangles drawn per frame (a retained frame counts what it drew again).
+    #[serde(default)]
+    pub triangles_per_frame: f64,
+    /// Frames drawn from a gesture's static layer.
+    #[serde(default)]
+    pub retained_frames: usize,
+    /// Frames that built a static layer (see [`Summary::layer_builds`]).
+    #[serde(default)]
+    pub layer_builds: usize,
 }
 
 impl Section {
@@ -80,6 +120,7 @@ impl Section {
         let duration_s = frames.iter().map(|f| f.frame_ms).sum::<f64>() / 1e3;
         let bytes_uploaded = frames.iter().map(|f| f.bytes_uploaded).sum();
         let samples_touched = frames.iter().map(|f| f.samples_touched).sum();
+        let triangles: u64 = frames.iter().map(|f| f.triangles).sum();
         Some(Section {
             frames: n,
             duration_s,
@@ -96,6 +137,9 @@ impl Section {
             samples_touched,
             bytes_per_frame: bytes_uploaded as f64 / n as f64,
             samples_per_frame: samples_touched as f64 / n as f64,
+            triangles_per_frame: triangles as f64 / n as f64,
+            retained_frames: frames.iter().filter(|f| f.retained).count(),
+            layer_builds: frames.iter().filter(|f| f.layer_built).count(),
         })
     }
 }
@@ -109,17 +153,31 @@ pub struct Summary {
     /// Totals over all frames, warm-up included.
     pub bytes_uploaded: u64,
     pub samples_touched: u64,
-    /// Frames not flagged warm-up; `None` if there are none.
+    /// Frames not flagged warm-up, but for those that built a static layer when they are
+    /// fewer than the others (a build per gesture; where most frames build one, as under
+    /// `bench --naive`, building is the steady state and stays in); `None` if there are none.
+    /// Percentiles then describe the steady gesture.
     pub measured: Option<Section>,
     /// Frames flagged warm-up; `None` if there are none.
     pub warmup: Option<Section>,
+    /// Frames after the warm-up that built a gesture's static layer (a full redraw and the
+    /// layer's saves, once per gesture), apart from `measured`; `None` if there are none.
+    #[serde(default)]
+    pub layer_builds: Option<Section>,
 }
 
 impl Summary {
     #[must_use]
     pub fn from_frames(frames: &[FrameRecord]) -> Summary {
-        let (warmup, measured): (Vec<&FrameRecord>, Vec<&FrameRecord>) =
+        let (warmup, after): (Vec<&FrameRecord>, Vec<&FrameRecord>) =
             frames.iter().partition(|f| f.warmup);
+        let (builds, steady): (Vec<&FrameRecord>, Vec<&FrameRecord>) =
+            after.iter().partition(|f| f.layer_built);
+        let (measured, builds) = if builds.len() < steady.len() {
+            (steady, builds)
+        } else {
+            (after, Vec::new())
+        };
         Summary {
             frames: frames.len(),
             warmup_frames: warmup.len(),
@@ -127,6 +185,7 @@ impl Summary {
             samples_touched: frames.iter().map(|f| f.samples_touched).sum(),
             measured: Section::from_frames(&measured),
             warmup: Section::from_frames(&warmup),
+            layer_builds: Section::from_frames(&builds),
         }
     }
 }
@@ -145,7 +204,7 @@ pub struct SummaryFile {
 
 impl SummaryFile {
     pub const FORMAT: &str = "prespline-profile-summary";
-    pub const VERSION: u32 = 1;
+    pub const VERSION: u32 = 2;
 
     #[must_use]
     pub fn new(run: &RunInfo, summary: &Summary) -> Self {

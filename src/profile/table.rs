@@ -1,8 +1,8 @@
 //! Plain-text tables for the terminal: [`Summary::table`] and [`compare`].
 
 use super::{
-    GPU_MEANING, LOW_1PCT_MEANING, OTHER_MEANING, PERCENTILE_MEANING, Phase, Section, Stats,
-    Summary,
+    GPU_MEANING, LOW_1PCT_MEANING, OTHER_MEANING, PERCENTILE_MEANING, Phase, RunInfo, Section,
+    Stats, Summary,
 };
 use comfy_table::CellAlignment;
 
@@ -136,6 +136,33 @@ impl Summary {
             human_count(m.samples_per_frame),
             human_count(m.samples_touched as f64)
         ));
+        out.push_str(&format!(
+            "triangles/frame {} (surface triangles drawn)\n",
+            human_count(m.triangles_per_frame)
+        ));
+        let apart = self.layer_builds.as_ref();
+        if m.retained_frames > 0 || m.layer_builds > 0 || apart.is_some() {
+            out.push_str(&format!(
+                "retained       {} of {} frames above drawn from the static layer\n",
+                m.retained_frames, m.frames
+            ));
+        }
+        if let Some(b) = apart {
+            out.push_str(&format!(
+                "layer builds   {} frame{}, mean {} ms, max {} ms (excluded above: a full redraw \
+                 that saves the static layer, once per gesture)\n",
+                b.frames,
+                if b.frames == 1 { "" } else { "s" },
+                ms(b.frame_ms.mean),
+                ms(b.frame_ms.max)
+            ));
+        } else if m.layer_builds > 0 {
+            out.push_str(&format!(
+                "layer builds   {} of {} frames above (edits left the layer stale: each drew \
+                 in full and saved it again)\n",
+                m.layer_builds, m.frames
+            ));
+        }
         if let Some(w) = &self.warmup {
             out.push_str(&warmup_line(w));
         }
@@ -144,11 +171,11 @@ impl Summary {
 }
 
 impl Summary {
-    /// The content of `summary.txt`: [`table`](Self::table), a blank line, then
-    /// [`definitions`].
+    /// The content of `summary.txt`: what ran ([`RunInfo::header`]), [`table`](Self::table),
+    /// a blank line, then [`definitions`].
     #[must_use]
-    pub fn report(&self) -> String {
-        format!("{}\n{}", self.table(), definitions())
+    pub fn report(&self, run: &RunInfo) -> String {
+        format!("{}\n{}\n{}", run.header(), self.table(), definitions())
     }
 }
 
@@ -222,6 +249,16 @@ pub fn compare(a_name: &str, a: &Summary, b_name: &str, b: &Summary) -> String {
     t.row(per_frame(
         "samples/frame",
         |m| m.samples_per_frame,
+        human_count,
+    ));
+    t.row(per_frame(
+        "triangles/frame",
+        |m| m.triangles_per_frame,
+        human_count,
+    ));
+    t.row(per_frame(
+        "layer builds",
+        |m| m.layer_builds as f64,
         human_count,
     ));
     format!("A = {a_name}, B = {b_name}\n{}", t.render())

@@ -280,12 +280,12 @@ fn write_all_writes_every_file() {
     );
     let read = |name: &str| std::fs::read_to_string(dir.join(name)).unwrap();
 
-    // CSV: header plus one row per frame, 13 columns each, empty gpu cell where unknown.
+    // CSV: header plus one row per frame, 16 columns each, empty gpu cell where unknown.
     let csv = read(FRAMES_CSV);
     let rows: Vec<Vec<&str>> = csv.lines().map(|l| l.split(',').collect()).collect();
     assert_eq!(rows[0].join(","), CSV_HEADER);
     assert_eq!(rows.len(), 1 + frames.len());
-    assert!(rows.iter().all(|r| r.len() == 13));
+    assert!(rows.iter().all(|r| r.len() == 16));
     let gpu_col = rows[0].iter().position(|c| *c == "gpu_ms").unwrap();
     assert_eq!(rows[1 + 3][gpu_col], "");
     assert!(rows[1][gpu_col].parse::<f64>().is_ok());
@@ -323,8 +323,21 @@ fn write_all_writes_every_file() {
     // summary.txt: the terminal table, then what its names mean.
     let summary = Summary::from_frames(&frames);
     let text = read(SUMMARY_TXT);
-    assert_eq!(text, summary.report());
-    assert_eq!(text, format!("{}\n{}", summary.table(), definitions()));
+    assert_eq!(text, summary.report(&run));
+    assert_eq!(
+        text,
+        format!("{}\n{}\n{}", run.header(), summary.table(), definitions())
+    );
+    // The header names the run: scenario, scene, size, mode, the extras and the device.
+    let head: Vec<&str> = text.lines().take(3).collect();
+    assert_eq!(
+        head,
+        [
+            "run: drag <fast> & \"loud\" on demo, 64x64 samples, incremental; 40 frames + 5 warm-up",
+            "     seed 7, window 900x600",
+            "device: test device",
+        ]
+    );
     for phase in Phase::ALL {
         let line = format!("{:<10}{}", phase.name(), phase.meaning());
         assert!(text.lines().any(|l| l == line), "{text}");
@@ -449,4 +462,69 @@ fn write_errors_name_the_path() {
     let err = read_summary_json(&blocker).unwrap_err();
     assert!(matches!(err, ProfileError::Parse { .. }), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A frame that built a gesture's static layer is reported on its own line, not among the
+/// measured frames, so their percentiles describe the steady gesture; the retained count and
+/// the triangles per frame are in the table and the comparison. Negative control: without the
+/// flag the build's frame is the measured maximum.
+#[test]
+fn layer_builds_are_reported_apart() {
+    let mut frames = synthetic_frames();
+    for f in frames.iter_mut().filter(|f| !f.warmup) {
+        f.retained = true;
+        f.triangles = 500;
+    }
+    frames[5].layer_built = true;
+    frames[5].frame_ms = 400.0;
+    frames[5].triangles = 80_000;
+    let summary = Summary::from_frames(&frames);
+    let m = summary.measured.as_ref().unwrap();
+    assert_eq!(m.frames, 34);
+    assert!(m.frame_ms.max < 100.0, "{}", m.frame_ms.max);
+    assert_eq!(m.retained_frames, 34);
+    assert_eq!(m.triangles_per_frame, 500.0);
+    let b = summary.layer_builds.as_ref().unwrap();
+    assert_eq!((b.frames, b.frame_ms.max), (1, 400.0));
+    let table = summary.table();
+    assert!(table.contains("retained       34 of 34 frames"), "{table}");
+    assert!(
+        table.contains("layer builds   1 frame, mean 400"),
+        "{table}"
+    );
+    assert!(table.contains("triangles/frame 500"), "{table}");
+    let mut naive = frames.clone();
+    for f in naive.iter_mut().filter(|f| !f.warmup) {
+        f.triangles *= 4;
+    }
+    let text = compare(
+        "incremental",
+        &summary,
+        "naive",
+        &Summary::from_frames(&naive),
+    );
+    let row = text
+        .lines()
+        .find(|l| l.starts_with("triangles/frame"))
+        .unwrap();
+    assert!(row.contains("4.00x"), "{text}");
+
+    frames[5].layer_built = false;
+    let flat = Summary::from_frames(&frames);
+    assert_eq!(flat.measured.as_ref().unwrap().frame_ms.max, 400.0);
+    assert!(flat.layer_builds.is_none());
+    // Most frames a build (`--naive`: every edit leaves the layer stale): building is the
+    // steady state, so they stay measured and the table says so.
+    let mut most = synthetic_frames();
+    most.iter_mut()
+        .for_each(|f| f.layer_built = !f.warmup && f.index % 4 != 0);
+    let s = Summary::from_frames(&most);
+    let m = s.measured.as_ref().unwrap();
+    assert_eq!((m.frames, m.layer_builds), (35, 27));
+    assert!(s.layer_builds.is_none());
+    assert!(
+        s.table().contains("layer builds   27 of 35 frames above"),
+        "{}",
+        s.table()
+    );
 }

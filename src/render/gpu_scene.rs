@@ -96,6 +96,8 @@ pub struct DrawReport {
     /// of a full redraw at the same levels of detail) were drawn.
     pub retained: bool,
     pub retained_of: u64,
+    /// The frame built the gesture's static layer (a full redraw and the layer's saves).
+    pub layer_built: bool,
 }
 
 /// The document's GPU side. Samples of all objects live in a few large *arena* mirrors
@@ -146,6 +148,8 @@ pub struct GpuScene {
     masks: Option<MaskSet>,
     /// Per mask, its blocks by class at every level of detail (made with the masks).
     blocks: Vec<TrimBlocks>,
+    /// Static layers built so far (a frame that builds one reports it).
+    layers_built: u64,
 }
 
 /// A static layer in the target and what it was built for.
@@ -205,6 +209,7 @@ impl GpuScene {
             controls_complete: doc.objects.is_empty(),
             masks: None,
             blocks: Vec::new(),
+            layers_built: 0,
         };
         // On failure, give back what was created.
         match scene.fill(renderer, doc, &places, &sizes) {
@@ -556,7 +561,10 @@ impl GpuScene {
             report.full_triangles += 2 * GridStride::FULL.cells(shape) * n;
         }
         let before = frame.stats().surface_triangles;
-        if self.draw_retained(frame, doc, opts, hl, &order, report.triangles)? {
+        let layers_before = self.layers_built;
+        let retained = self.draw_retained(frame, doc, opts, hl, &order, report.triangles)?;
+        report.layer_built = self.layers_built > layers_before;
+        if retained {
             report.retained = true;
             report.retained_of = report.triangles;
             report.triangles = frame.stats().surface_triangles - before;
@@ -932,6 +940,7 @@ impl GpuScene {
             self.unworthy = None;
             frame.keep_depth();
             self.build_layer(frame, doc, opts, hl, order, place, key, (support, cells))?;
+            self.layers_built += 1;
             if self.layer.is_none() {
                 return Ok(true);
             }

@@ -409,7 +409,8 @@ impl App {
                 r.session
                     .record(&mut frame, true)
                     .map_err(|e| e.to_string())?;
-                rec.set_retained(r.session.hud.retained.is_some());
+                let d = r.session.last_draw();
+                rec.set_draw(d.retained, d.layer_built, d.triangles);
                 rec.phase_start(Phase::Submit);
                 frame.finish().map_err(|e| e.to_string())?;
             }

@@ -25,7 +25,8 @@ use crate::render::maps::{
 };
 use crate::render::overlays::overlay_lines;
 use crate::render::{
-    Bounds, GpuScene, Highlight, NetMode, OrbitCamera, Palette, UploadStats, ViewOptions, Wire,
+    Bounds, DrawReport, GpuScene, Highlight, NetMode, OrbitCamera, Palette, UploadStats,
+    ViewOptions, Wire,
 };
 use crate::sampling::SampleMode;
 use crate::sampling::budget::MemoryBudget;
@@ -65,6 +66,8 @@ pub struct Session {
     map_families: Vec<(String, Vec<usize>)>,
     /// A scripted action that could not run (see [`Session::take_script_error`]).
     script_error: Option<String>,
+    /// What the last recorded frame's draw of the document did.
+    last_draw: DrawReport,
 }
 
 impl Session {
@@ -107,6 +110,7 @@ impl Session {
             save_path,
             status_echoed: String::new(),
             hud: Hud::new(),
+            last_draw: DrawReport::default(),
             show_help: false,
             quit: false,
             autosave: None,
@@ -288,6 +292,12 @@ impl Session {
         self.stage.editor.merge = merge;
     }
 
+    /// What the last recorded frame's draw of the document did (for profiles).
+    #[must_use]
+    pub fn last_draw(&self) -> DrawReport {
+        self.last_draw
+    }
+
     /// The status line's message (what the last action did or why it could not).
     #[must_use]
     pub fn status(&self) -> &str {
@@ -425,6 +435,7 @@ impl Session {
         );
         self.gpu.set_gesture(self.mode.gesture());
         let report = self.gpu.draw(frame, s.doc(), &self.options, &hl, &lod)?;
+        self.last_draw = report;
         if report.retained {
             self.hud.triangles = (report.retained_of, report.full_triangles);
             self.hud.retained = Some((report.triangles, report.retained_of));

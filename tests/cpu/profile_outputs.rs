@@ -67,6 +67,6 @@ fn recorded_run_writes_readable_reports() {
 
     let naive = Summary::from_frames(&record_run(50, 5, 200_000));
     let table = compare("incremental", &summary, "naive", &naive);
-    assert_eq!(table.lines().count(), 2 + 2 + Phase::ALL.len() + 4);
+    assert_eq!(table.lines().count(), 2 + 2 + Phase::ALL.len() + 6);
     assert!(summary.table().contains("1% low"));
 }
