@@ -15,7 +15,7 @@ use super::pipeline::{
 };
 use super::pod::{Pod, bytes_of};
 use super::region::{PointRun, SurfaceBatch, SurfaceGrid};
-use super::style::{MapStyle, PointStyle, PolylineStyle, SurfaceStyle};
+use super::style::{GripGrid, MapStyle, PointStyle, PolylineStyle, SurfaceStyle};
 use super::transient::TransientAlloc;
 use super::vertex::{LineVertex, OverlayVertex};
 
@@ -539,6 +539,7 @@ impl Frame<'_> {
         run.check(mirror.len(), 1)?;
         let large_points = self.ctx.device.caps.large_points;
         let index = |i: Option<u32>| i.and_then(|i| i32::try_from(i).ok()).unwrap_or(-1);
+        let grid = GripGrid::words(style.grid);
         let push = PointsPush {
             view_proj: self.view_proj(),
             points: mirror.slot(self.slot).address(),
@@ -552,6 +553,8 @@ impl Frame<'_> {
             hovered_color: pack_unorm(style.hovered_color),
             selected_color: pack_unorm(style.selected_color),
             quads: u32::from(!large_points),
+            grid_cols: grid[0],
+            grid_rows: grid[1],
             _pad: 0,
         };
         self.bind_and_push(self.ctx.eager(Which::Points), &push);

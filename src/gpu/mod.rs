@@ -115,7 +115,7 @@ pub use offscreen::{OFFSCREEN_FORMAT, OffscreenDesc, OffscreenTarget, Pixels};
 pub use pipeline::DEPTH_FORMAT;
 pub use region::{MaskRef, PointRun, SurfaceBatch, SurfaceGrid};
 pub use renderer::{Fault, Renderer, RendererDesc};
-pub use style::{Camera, MapStyle, PointStyle, PolylineStyle, SurfaceStyle};
+pub use style::{Camera, GripGrid, MapStyle, PointStyle, PolylineStyle, SurfaceStyle};
 pub use swapchain::{Swapchain, SwapchainDesc};
 pub use validation::{Severity, ValidationMessage, ValidationSink};
 pub use vertex::{LineVertex, OverlayVertex};

@@ -85,6 +85,9 @@ pub(crate) struct PointsPush {
     pub selected_color: u32,
     /// 1: one quad (6 vertices) per point; 0: one point primitive per point (`largePoints`).
     pub quads: u32,
+    /// [`super::style::GripGrid::words`].
+    pub grid_cols: u32,
+    pub grid_rows: u32,
     pub _pad: u32,
 }
 
@@ -129,8 +132,9 @@ const _: () = {
     assert!(offset_of!(MapPush, params) == 80);
     assert!(size_of::<WirePush>() == 80);
     assert!(size_of::<PolylinePush>() == 120);
-    assert!(size_of::<PointsPush>() == 120);
+    assert!(size_of::<PointsPush>() == 128);
     assert!(offset_of!(PointsPush, quads) == 112);
+    assert!(offset_of!(PointsPush, grid_cols) == 116);
     assert!(offset_of!(PolylinePush, thin) == 116);
     assert!(size_of::<Lines3dPush>() == 64);
     assert!(size_of::<OverlayPush>() == 24);

@@ -99,6 +99,50 @@ pub struct PointStyle {
     pub selected_color: [f32; 4],
     /// Whether points are hidden behind nearer geometry.
     pub depth_test: bool,
+    /// The run as rows of a control net, thinned on screen (`None`: every point drawn).
+    pub grid: Option<GripGrid>,
+}
+
+/// A run of points as rows of a `rows × cols` control net whose first row is `first_row`
+/// (a run may hold some rows of a larger net), of which only every `every`-th row and column
+/// (and the last of each) is drawn, besides the hovered and the selected point: a dense net
+/// stays readable and its surface visible.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct GripGrid {
+    pub rows: u32,
+    pub cols: u32,
+    pub first_row: u32,
+    /// A power of two up to [`GripGrid::MAX_EVERY`].
+    pub every: u32,
+}
+
+impl GripGrid {
+    pub const MAX_EVERY: u32 = 128;
+
+    /// The two push-constant words `points.vert` reads: columns (bits 0–23) with log2 of
+    /// `every` (bits 24–31), and the first row (bits 16–31) with the rows (bits 0–15).
+    /// `[0, 0]` (every point) when the net does not fit those bits.
+    #[must_use]
+    pub fn words(grid: Option<Self>) -> [u32; 2] {
+        match grid {
+            Some(g)
+                if g.every > 1
+                    && g.every.is_power_of_two()
+                    && g.every <= Self::MAX_EVERY
+                    && g.cols >= 1
+                    && g.cols < 1 << 24
+                    && g.rows >= 1
+                    && g.rows < 1 << 16
+                    && g.first_row < 1 << 16 =>
+            {
+                [
+                    g.cols | (g.every.trailing_zeros() << 24),
+                    g.rows | (g.first_row << 16),
+                ]
+            }
+            _ => [0, 0],
+        }
+    }
 }
 
 impl Default for PointStyle {
@@ -111,6 +155,7 @@ impl Default for PointStyle {
             hovered_color: [1.0, 0.8, 0.1, 1.0],
             selected_color: [1.0, 0.2, 0.1, 1.0],
             depth_test: false,
+            grid: None,
         }
     }
 }

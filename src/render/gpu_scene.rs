@@ -3,6 +3,7 @@
 //! changed since it was last written.
 
 use super::analysis::{CurvePiece, curve_pieces};
+use super::grips::grip_every;
 use super::lod::{GridMetrics, Lod};
 use super::map_mirror::{MapScalars, MapView, SurfaceSlot};
 use super::retained::{
@@ -16,9 +17,9 @@ use crate::editor::{
     LOCAL_PATCH_SAMPLES, LocalEntry,
 };
 use crate::gpu::{
-    FRAMES_IN_FLIGHT, Frame, GpuError, GpuResult, GridShape, GridStride, LayerPart, MapStyle,
-    MaskRef, MaskSet, MaskWords, Mirror, PointRun, PointStyle, PolylineStyle, Renderer, Restore,
-    SurfaceBatch, SurfaceGrid, SurfaceStyle,
+    FRAMES_IN_FLIGHT, Frame, GpuError, GpuResult, GridShape, GridStride, GripGrid, LayerPart,
+    MapStyle, MaskRef, MaskSet, MaskWords, Mirror, PointRun, PointStyle, PolylineStyle, Renderer,
+    Restore, SurfaceBatch, SurfaceGrid, SurfaceStyle,
 };
 use crate::model::Index2;
 use crate::sampling::{DirtyRegion, DirtySet};
@@ -44,6 +45,9 @@ struct ObjectGpu {
     controls_dirty: [DirtySet; FRAMES_IN_FLIGHT],
     /// The control display changed layout: the next upload replaces the control mirror.
     controls_resized: bool,
+    /// Every how many rows and columns its control grips are drawn ([`super::grips`]), for the
+    /// view in `GpuScene::lod_view` (kept while the view stands, also through edits).
+    grips: Option<u32>,
     /// Stride chosen for the view in `GpuScene::lod_view`, until the view or the samples change.
     lod: Option<GridStride>,
     /// World-space measures of the samples for choosing strides; `None` until measured after
@@ -243,6 +247,7 @@ impl GpuScene {
                 controls: None,
                 controls_dirty: Default::default(),
                 controls_resized: false,
+                grips: None,
                 lod: None,
                 metrics: None,
                 bounds: None,
@@ -305,6 +310,7 @@ impl GpuScene {
                 }
                 ControlsChange::Resized => {
                     o.controls_resized = true;
+                    o.grips = None;
                     o.controls_dirty = Default::default();
                 }
             }
@@ -551,8 +557,12 @@ impl GpuScene {
         self.make_controls(frame, doc, opts, hl)?;
         if self.lod_view != Some(*lod) {
             self.lod_view = Some(*lod);
-            self.objects.iter_mut().for_each(|o| o.lod = None);
+            self.objects.iter_mut().for_each(|o| {
+                o.lod = None;
+                o.grips = None;
+            });
         }
+        self.measure_grips(frame, doc, opts, hl);
         let order = self.surface_order(doc, opts, lod);
         for b in &order {
             let shape = self.groups[b.group].shape;
@@ -727,15 +737,48 @@ impl GpuScene {
                     mirror,
                     &controls.vertices,
                     [*rows, *cols],
+                    o.grips.unwrap_or(1),
                     opts,
                     hl,
                     c,
                 )?;
                 continue;
             }
-            ControlPass::new(i, mirror, opts, hl, &palette).draw(frame, &controls.layout)?;
+            ControlPass::new(i, mirror, opts, hl, &palette)
+                .with_grips(o.grips.unwrap_or(1))
+                .draw(frame, &controls.layout)?;
         }
         Ok(())
+    }
+
+    /// Chooses how densely the shown control nets and polygons draw their grips for this view,
+    /// where not chosen since the view changed.
+    fn measure_grips(
+        &mut self,
+        frame: &Frame<'_>,
+        doc: &Document,
+        opts: &ViewOptions,
+        hl: &Highlight,
+    ) {
+        let (camera, viewport) = (frame.camera(), frame.viewport());
+        for (i, o) in self.objects.iter_mut().enumerate() {
+            if o.grips.is_some() || !net_shown(opts, hl, i) {
+                continue;
+            }
+            let controls = &doc.objects[i].controls;
+            let shape = match controls.layout {
+                ControlLayout::Net { rows, cols } => [rows, cols],
+                ControlLayout::Polygon { count } => [1, count],
+                _ => continue,
+            };
+            o.grips = Some(grip_every(
+                &controls.vertices,
+                shape,
+                &camera,
+                viewport,
+                opts.point_size,
+            ));
+        }
     }
 
     /// The surfaces in draw order: per group, per stride (ascending), the members sharing it.
@@ -1240,6 +1283,8 @@ struct ControlPass<'a> {
     net: PolylineStyle,
     /// Whether the object's polygon or net is shown (a chosen local's always is).
     nets: bool,
+    /// Every how many rows and columns of its polygon or net grips are drawn.
+    grips: u32,
 }
 
 impl<'a> ControlPass<'a> {
@@ -1263,7 +1308,12 @@ impl<'a> ControlPass<'a> {
             palette,
             net,
             nets: net_shown(opts, hl, object),
+            grips: 1,
         }
+    }
+
+    fn with_grips(self, grips: u32) -> Self {
+        Self { grips, ..self }
     }
 
     fn draw(&self, frame: &mut Frame<'_>, layout: &ControlLayout) -> GpuResult<()> {
@@ -1282,6 +1332,7 @@ impl<'a> ControlPass<'a> {
         &self,
         frame: &mut Frame<'_>,
         run: PointRun,
+        grid: Option<GripGrid>,
         pick: impl Fn(Handle) -> Option<u32>,
     ) -> GpuResult<()> {
         let index_in = |h: Option<Handle>| h.filter(|h| h.object() == self.object).and_then(&pick);
@@ -1290,6 +1341,7 @@ impl<'a> ControlPass<'a> {
             size: self.opts.point_size,
             hovered: index_in(self.hl.hovered),
             selected: index_in(self.hl.selected),
+            grid,
             ..PointStyle::default()
         };
         frame.draw_points(self.controls, run, &style)
@@ -1299,7 +1351,8 @@ impl<'a> ControlPass<'a> {
     fn polygon(&self, frame: &mut Frame<'_>, count: usize) -> GpuResult<()> {
         let run = PointRun::packed(0, count);
         polyline(frame, self.controls, run, &self.net)?;
-        self.points(frame, run, |h| match h {
+        let grid = self.grip_grid(1, count);
+        self.points(frame, run, grid, |h| match h {
             Handle::Point {
                 point: Index2::One(k),
                 ..
@@ -1311,12 +1364,23 @@ impl<'a> ControlPass<'a> {
     /// A surface's control net and its points.
     fn net(&self, frame: &mut Frame<'_>, rows: usize, cols: usize) -> GpuResult<()> {
         control_net(frame, self.controls, 0, rows, cols, &self.net)?;
-        self.points(frame, PointRun::packed(0, rows * cols), |h| match h {
+        let grid = self.grip_grid(rows, cols);
+        self.points(frame, PointRun::packed(0, rows * cols), grid, |h| match h {
             Handle::Point {
                 point: Index2::Two(a, b),
                 ..
             } => Some((a * cols + b) as u32),
             _ => None,
+        })
+    }
+
+    /// The thinning of a `rows × cols` polygon or net's grips ([`super::grips`]).
+    fn grip_grid(&self, rows: usize, cols: usize) -> Option<GripGrid> {
+        (self.grips > 1).then(|| GripGrid {
+            rows: u32::try_from(rows).unwrap_or(u32::MAX),
+            cols: u32::try_from(cols).unwrap_or(u32::MAX),
+            first_row: 0,
+            every: self.grips,
         })
     }
 
@@ -1369,7 +1433,7 @@ impl<'a> ControlPass<'a> {
             count: e.rows,
         };
         polyline(frame, self.controls, run, &self.net)?;
-        self.points(frame, run, |h| match h {
+        self.points(frame, run, None, |h| match h {
             Handle::LocalPoint {
                 local,
                 point: Index2::One(q),
@@ -1437,7 +1501,7 @@ impl<'a> ControlPass<'a> {
             stride: 3,
             count: e.rows * e.cols,
         };
-        self.points(frame, run, |h| match h {
+        self.points(frame, run, None, |h| match h {
             Handle::LocalPoint {
                 local,
                 point: Index2::Two(a, b),
@@ -1497,6 +1561,7 @@ fn clipped_net(
     controls: &Mirror,
     vertices: &[DVec3],
     [rows, cols]: [usize; 2],
+    grips: u32,
     opts: &ViewOptions,
     hl: &Highlight,
     clip: &NetClip,
@@ -1549,6 +1614,12 @@ fn clipped_net(
             size: opts.point_size,
             hovered: index_of(hl.hovered, r),
             selected: index_of(hl.selected, r),
+            grid: (grips > 1).then(|| GripGrid {
+                rows: u32::try_from(rows).unwrap_or(u32::MAX),
+                cols: u32::try_from(cols).unwrap_or(u32::MAX),
+                first_row: u32::try_from(r).unwrap_or(u32::MAX),
+                every: grips,
+            }),
             ..PointStyle::default()
         };
         frame.draw_points(controls, run(r * cols, 1, cols), &style)?;

@@ -5,6 +5,7 @@
 pub mod analysis;
 pub mod camera;
 pub mod gpu_scene;
+mod grips;
 pub mod image_file;
 pub mod lod;
 pub mod map_mirror;

@@ -635,3 +635,54 @@ fn trimmed_surfaces_redraw_retained_exactly_as_in_full() {
         pair.finish();
     }
 }
+
+/// A dense control net (60 × 60 points a few pixels apart) draws only some of its grips
+/// (src/render/grips.rs): drags of points on and off the drawn rows and columns, the dragged
+/// grip shown wherever it is, redraw exactly as in full, with the net of a second, coarse
+/// surface over it.
+#[test]
+fn thinned_grips_of_a_dense_net_redraw_exactly() {
+    let mut rng = Rng::new(0x9e1d);
+    let n = 60;
+    let points: Vec<String> = (0..n)
+        .map(|i| {
+            let row: Vec<String> = (0..n)
+                .map(|j| {
+                    let (x, y) = (i as f64 * 0.12 - 3.5, j as f64 * 0.12 - 3.5);
+                    format!("[{x}, {y}, {}]", 0.3 * (x * 1.3).sin() * (y * 0.9).cos())
+                })
+                .collect();
+            format!("[{}]", row.join(", "))
+        })
+        .collect();
+    let knots: Vec<String> = (0..n + 4)
+        .map(|k| k.clamp(3, n) as f64)
+        .map(|k| k.to_string())
+        .collect();
+    let knots = knots.join(", ");
+    let coarse = points_json(&mut rng, 4, 4, -1.0);
+    let text = format!(
+        r#"{{"objects": [
+  {{"name": "dense", "type": "bspline_surface", "degree": [3, 3],
+    "knots": [[{knots}], [{knots}]], "points": [{}], "samples": [120, 120]}},
+  {{"name": "coarse", "type": "bezier_surface", "points": {coarse}, "samples": [30, 30]}}
+]}}"#,
+        points.join(", ")
+    );
+    let scene = parse_scene(&text).unwrap();
+    let mut pair = Pair::new(&scene, None);
+    check(&mut pair, &[vec![]], "first frame");
+    let on_and_off = [(8, 8), (8, 9), (13, 31), (59, 59), (0, 30), (31, 0)];
+    for (a, b) in on_and_off {
+        let h = Handle::Point {
+            object: 0,
+            point: prespline::model::Index2::Two(a, b),
+        };
+        let script = drag(&mut rng, h, false, 4);
+        check(&mut pair, &script, &format!("drag of ({a}, {b})"));
+    }
+    let h = handle_of(&pair, &mut rng, 1);
+    check(&mut pair, &drag(&mut rng, h, false, 4), "drag of the coarse net");
+    assert!(pair.retained_frames * 2 > pair.frames);
+    pair.finish();
+}
