@@ -682,7 +682,11 @@ fn thinned_grips_of_a_dense_net_redraw_exactly() {
         check(&mut pair, &script, &format!("drag of ({a}, {b})"));
     }
     let h = handle_of(&pair, &mut rng, 1);
-    check(&mut pair, &drag(&mut rng, h, false, 4), "drag of the coarse net");
+    check(
+        &mut pair,
+        &drag(&mut rng, h, false, 4),
+        "drag of the coarse net",
+    );
     assert!(pair.retained_frames * 2 > pair.frames);
     pair.finish();
 }
