@@ -29,6 +29,8 @@ pub struct Hud {
     /// Last frame came from the static layer: surface triangles drawn and those a full
     /// redraw draws (`None`: a full redraw).
     pub retained: Option<(u64, u64)>,
+    /// Last frame built the static layer (a full redraw, then the dragged part again).
+    pub layer_built: bool,
     pub visible: bool,
 }
 
@@ -79,7 +81,7 @@ impl Hud {
                 self.bytes as f64 / 1024.0
             ),
             lod_line(self.triangles),
-            redraw_line(self.retained),
+            redraw_line(self.retained, self.layer_built),
         ]
     }
 
@@ -267,10 +269,17 @@ fn count_text(n: u64) -> String {
     }
 }
 
-/// `redraw: retained, N of M triangles` for a frame drawn from the static layer, else
-/// `redraw: full`.
-fn redraw_line(retained: Option<(u64, u64)>) -> String {
+/// `redraw: retained, N of M triangles` for a frame drawn from the static layer (N ≤ M: the
+/// dragged part and what lies after it in draw order, of a full frame's M), `redraw: layer
+/// built, …` for the frame that made the layer (a full frame, then the dragged part again, so
+/// N > M there), else `redraw: full`.
+fn redraw_line(retained: Option<(u64, u64)>, layer_built: bool) -> String {
     match retained {
+        Some((n, m)) if layer_built => format!(
+            "redraw: layer built, {} triangles (a full frame of {} and the dragged part again)",
+            count_text(n),
+            count_text(m)
+        ),
         Some((n, m)) => format!(
             "redraw: retained, {} of {} triangles",
             count_text(n),
@@ -283,7 +292,9 @@ fn redraw_line(retained: Option<(u64, u64)>) -> String {
 /// The level-of-detail line: surface triangles drawn and what the full grids would take.
 fn lod_line((drawn, full): (u64, u64)) -> String {
     let k = count_text;
-    if drawn == full {
+    if full == 0 {
+        "LOD: no surfaces".into()
+    } else if drawn == full {
         format!("LOD full: {} triangles", k(full))
     } else {
         format!("LOD: {} of {} triangles", k(drawn), k(full))
@@ -386,10 +397,17 @@ mod tests {
     #[test]
     fn the_redraw_line_says_how_the_frame_was_drawn() {
         assert_eq!(
-            redraw_line(Some((1900, 522_200))),
+            redraw_line(Some((1900, 522_200)), false),
             "redraw: retained, 1.9 k of 522.2 k triangles"
         );
-        assert_eq!(redraw_line(None), "redraw: full");
+        assert_eq!(redraw_line(None, false), "redraw: full");
+        // The frame that builds the layer draws more than a full frame, and says why.
+        assert_eq!(
+            redraw_line(Some((23_600, 19_000)), true),
+            "redraw: layer built, 23.6 k triangles (a full frame of 19.0 k and the dragged part again)"
+        );
+        assert_eq!(lod_line((0, 0)), "LOD: no surfaces");
+        assert_eq!(lod_line((10, 10)), "LOD full: 10 triangles");
         let hud = Hud {
             retained: Some((12, 2_000_000)),
             ..Hud::new()

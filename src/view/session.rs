@@ -68,6 +68,8 @@ pub struct Session {
     script_error: Option<String>,
     /// What the last recorded frame's draw of the document did.
     last_draw: DrawReport,
+    /// An edit was applied since the last upload (the HUD's bytes are then that upload's).
+    edited_this_frame: bool,
 }
 
 impl Session {
@@ -111,6 +113,7 @@ impl Session {
             status_echoed: String::new(),
             hud: Hud::new(),
             last_draw: DrawReport::default(),
+            edited_this_frame: false,
             show_help: false,
             quit: false,
             autosave: None,
@@ -339,6 +342,7 @@ impl Session {
         self.stage.moved();
         self.hud.edit_us = applied.micros;
         self.hud.samples_touched = applied.samples;
+        self.edited_this_frame = true;
     }
 
     /// Copies this slot's dirty rows into the mirrors, and makes the control mirrors this
@@ -349,7 +353,11 @@ impl Session {
         stats.bytes += self
             .gpu
             .make_controls(frame, self.stage.doc(), &self.options, &hl)?;
-        self.hud.bytes = stats.bytes;
+        // The edit line's bytes are its edit's upload: frames without an edit (whose uploads
+        // bring the other frame slots up to date, or are empty) keep them.
+        if std::mem::take(&mut self.edited_this_frame) || stats.bytes > 0 {
+            self.hud.bytes = stats.bytes;
+        }
         Ok(stats)
     }
 
@@ -436,6 +444,7 @@ impl Session {
         self.gpu.set_gesture(self.mode.gesture());
         let report = self.gpu.draw(frame, s.doc(), &self.options, &hl, &lod)?;
         self.last_draw = report;
+        self.hud.layer_built = report.layer_built;
         if report.retained {
             self.hud.triangles = (report.retained_of, report.full_triangles);
             self.hud.retained = Some((report.triangles, report.retained_of));
