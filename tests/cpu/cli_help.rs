@@ -58,3 +58,34 @@ fn help_render_names_png_and_jpeg() {
         "{text}"
     );
 }
+
+/// docs/viewer.md's option table names exactly the options `view --help` lists, so neither
+/// can gain one the other lacks (negative control: a list with one left out differs).
+#[test]
+fn the_viewer_docs_list_every_view_option() {
+    let options = |text: &str, start: &str| -> Vec<String> {
+        let mut found: Vec<String> = text
+            .lines()
+            .filter_map(|l| l.trim_start().strip_prefix(start))
+            .filter_map(|rest| rest.split(['`', ' ', '[', '=', '<']).next())
+            .filter(|name| !name.is_empty() && *name != "help")
+            .map(str::to_string)
+            .collect();
+        found.sort();
+        found.dedup();
+        found
+    };
+    let raw = Command::new(env!("CARGO_BIN_EXE_prespline"))
+        .args(["help", "view"])
+        .output()
+        .unwrap();
+    let from_help = options(&String::from_utf8(raw.stdout).unwrap(), "--");
+    let doc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/viewer.md"))
+        .unwrap();
+    let from_doc = options(&doc, "| `--");
+    assert!(from_help.len() >= 12, "{from_help:?}");
+    assert_eq!(from_doc, from_help);
+    let mut short = from_doc.clone();
+    short.pop();
+    assert_ne!(short, from_help);
+}

@@ -106,3 +106,52 @@ fn unsafe_code_is_only_in_gpu_and_always_explained() {
     }
     assert!(blocks > 0, "no unsafe blocks found: the scan is broken");
 }
+
+/// Every repository path the documentation names in backticks (`src/…`, `tests/…`,
+/// `examples/…`, …) exists, so moved files cannot leave the docs pointing nowhere. A path
+/// may end in `:LINE` or name a folder; globs and placeholders (`*`, `…`, `<`, `{`, a word
+/// in capitals) are skipped. Negative control: a made-up path in the same text is reported.
+#[test]
+fn paths_named_in_the_docs_exist() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut docs: Vec<PathBuf> = std::fs::read_dir(root.join("docs"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "md"))
+        .collect();
+    docs.push(root.join("README.md"));
+    docs.push(root.join("src/gpu/README.md"));
+    let mut missing = Vec::new();
+    for doc in &docs {
+        let text = std::fs::read_to_string(doc).unwrap();
+        for path in named_paths(&text) {
+            if !root.join(&path).exists() {
+                missing.push(format!("{}: {path}", doc.display()));
+            }
+        }
+    }
+    assert!(missing.is_empty(), "paths that do not exist:\n{}", missing.join("\n"));
+    let control = named_paths("see `src/sampling/no_such_file.rs:12` and `tests/cpu/lints.rs`");
+    assert_eq!(control, ["src/sampling/no_such_file.rs", "tests/cpu/lints.rs"]);
+    assert!(!root.join(&control[0]).exists() && root.join(&control[1]).exists());
+}
+
+/// The repository paths in backticks in `text`, without a `:LINE` suffix.
+fn named_paths(text: &str) -> Vec<String> {
+    const ROOTS: [&str; 9] = [
+        "src/", "tests/", "examples/", "benches/", "shaders/", "docs/", "scripts/", ".ci/",
+        "build.rs",
+    ];
+    text.split('`')
+        .skip(1)
+        .step_by(2)
+        .filter(|s| ROOTS.iter().any(|r| s.starts_with(r)))
+        .filter(|s| !s.contains(['*', '…', '<', '{', ' ', '$']))
+        // A placeholder in capitals (`tests/golden/NAME.png`).
+        .filter(|s| {
+            !s.split(['/', '.'])
+                .any(|w| w.len() > 1 && w.chars().all(|c| c.is_ascii_uppercase()))
+        })
+        .map(|s| s.split(':').next().unwrap_or(s).trim_end_matches('/').to_string())
+        .collect()
+}
