@@ -611,11 +611,12 @@ fn kb_to_gpu(shot: &std::path::Path) -> (String, String) {
     (edit, kb)
 }
 
-/// A viewer screenshot shows the figures of the window frame it reproduces: the bytes that
-/// frame copied to the GPU as the profile recorded them (the screenshot's own upload, of its
-/// own frame slot, used to replace them, often by 0).
+/// A viewer screenshot shows the HUD's figures as the window showed them: the edit line's
+/// "KB to GPU" is what its edit's frame copied, as the profile recorded it, also on later frames
+/// that copy nothing (the screenshot's own upload of its frame slot used to replace it, and a
+/// frame without an edit used to show 0.0 KB beside the last edit's time and samples).
 #[test]
-fn screenshots_show_the_bytes_their_frame_copied() {
+fn screenshots_show_the_bytes_of_the_last_edit() {
     if !common::display() {
         return;
     }
@@ -639,26 +640,34 @@ fn screenshots_show_the_bytes_their_frame_copied() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "viewer failed: {err}");
     let csv = std::fs::read_to_string(profile.join("frames.csv")).unwrap();
-    let bytes: Vec<u64> = csv
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').nth(11).unwrap().parse().unwrap())
-        .collect();
-    let mut nonzero = 0;
+    let column = |name: &str| {
+        let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+        let k = header.iter().position(|c| *c == name).unwrap();
+        csv.lines()
+            .skip(1)
+            .map(|l| l.split(',').nth(k).unwrap().parse::<u64>().unwrap())
+            .collect::<Vec<u64>>()
+    };
+    let (bytes, samples) = (column("bytes_uploaded"), column("samples_touched"));
     for f in frames {
         let (line, kb) = kb_to_gpu(&dir.join(format!("shot{f}.png")));
-        let recorded = format!("{:.1}", bytes[f] as f64 / 1024.0);
-        assert_eq!(kb, recorded, "frame {f}: {line:?}, profile {bytes:?}");
-        nonzero += usize::from(bytes[f] > 0);
+        // The last frame up to f that applied an edit.
+        let edit = (0..=f).rev().find(|&k| samples[k] > 0).unwrap();
+        let recorded = format!("{:.1}", bytes[edit] as f64 / 1024.0);
+        assert_eq!(
+            kb, recorded,
+            "frame {f} (edit at {edit}): {line:?}, profile {bytes:?}"
+        );
+        assert!(bytes[edit] > 0, "the drag's frames copied rows: {bytes:?}");
     }
-    assert_eq!(nonzero, 1, "frame 7 copies frame 6's rows: {bytes:?}");
-    // The one with a figure is the screenshot taken during the drag (never "0.0 KB").
-    assert!(bytes[7] > 0, "the drag's frame copied rows: {bytes:?}");
-    eprintln!("frame 7: {:?}", kb_to_gpu(&dir.join("shot7.png")).0);
+    // Negative control: frame 12 copied nothing itself, yet its screenshot shows the edit's.
+    assert_eq!(bytes[12], 0, "{bytes:?}");
+    eprintln!("frame 12: {:?}", kb_to_gpu(&dir.join("shot12.png")).0);
 }
 
-/// A status message the window can only show with its middle elided (saving an expo ERBS
-/// surface as OBJ, with its advice at the end) goes to stderr whole, once; a short one does not.
+/// A status message the window can only show with its middle elided (a save into a folder
+/// that does not exist, with the reason at the end) goes to stderr whole, once; a short one
+/// does not.
 #[test]
 fn an_elided_status_goes_to_stderr_whole() {
     if !common::display() {
@@ -670,7 +679,9 @@ fn an_elided_status_goes_to_stderr_whole() {
     let out = run(prespline(&dir)
         .arg("view")
         .arg(&example)
-        .args(["--size", "320x240", "--save-as", "x.obj", "--script"])
+        .args(["--size", "320x240", "--save-as"])
+        .arg(dir.join("no such folder, so the save fails and says why/x.json"))
+        .arg("--script")
         .arg(dir.file(
             "save.json",
             r#"[{"frame": 2, "key": "s", "ctrl": true}, {"frame": 4, "key": "j"}, {"frame": 6, "quit": true}]"#,
@@ -690,7 +701,11 @@ fn an_elided_status_goes_to_stderr_whole() {
         echoed[0].starts_with("prespline: save failed: ") && echoed[0].ends_with(')'),
         "the whole message, advice included: {err}"
     );
-    assert!(!dir.join("x.obj").exists());
+    assert!(
+        !dir.path()
+            .join("no such folder, so the save fails and says why")
+            .exists()
+    );
 }
 
 /// A drag in the window, screenshots in the middle of it and after it: `--redraw retained`

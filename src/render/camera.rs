@@ -152,13 +152,41 @@ impl OrbitCamera {
         self.distance = hi;
     }
 
-    /// The default viewing direction for a scene: oblique, or from above for flat (xy-planar)
-    /// scenes where an oblique view would squash everything into a band.
+    /// The default viewing direction for a scene: straight down the normal of a planar scene
+    /// that lies in a coordinate plane (a circle must look round), obliquely from above for a
+    /// nearly flat (xy) one, where an oblique view would squash everything into a band, and
+    /// oblique otherwise.
     #[must_use]
     pub fn default_for(bounds: &Bounds) -> Self {
+        if bounds.is_empty() {
+            return Self::default();
+        }
         let size = bounds.max - bounds.min;
-        let flat = !bounds.is_empty() && size.z <= 0.02 * size.x.max(size.y);
-        if flat {
+        let largest = size.max_element();
+        // Planar: thinner than a rounding error of the scene's size across.
+        let planar = |thickness: f64| thickness <= 1e-9 * largest && largest > 0.0;
+        if planar(size.z) {
+            // Looking down −z with +x right and +y up.
+            Self {
+                yaw: 0.0,
+                pitch: Self::MAX_PITCH,
+                ..Self::default()
+            }
+        } else if planar(size.y) {
+            // Looking along +y: +x right, +z up.
+            Self {
+                yaw: 0.0,
+                pitch: 0.0,
+                ..Self::default()
+            }
+        } else if planar(size.x) {
+            // Looking along −x from +x: +y right, +z up.
+            Self {
+                yaw: std::f64::consts::FRAC_PI_2,
+                pitch: 0.0,
+                ..Self::default()
+            }
+        } else if size.z <= 0.02 * size.x.max(size.y) {
             Self {
                 yaw: -0.25,
                 pitch: 1.2,
@@ -295,6 +323,39 @@ pub fn v32(p: DVec3) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A scene in a coordinate plane is seen straight down that plane's normal (to within the
+    /// pitch limit), with the plane's first axis to the right; a nearly flat one obliquely
+    /// from above; others from the default direction. Negative control: a scene 1e-6 thick is
+    /// not planar.
+    #[test]
+    fn planar_scenes_are_seen_down_their_normal() {
+        let bounds = |size: DVec3| {
+            let mut b = Bounds::EMPTY;
+            b.include(DVec3::new(1.0, 2.0, 3.0));
+            b.include(DVec3::new(1.0, 2.0, 3.0) + size);
+            b
+        };
+        for (size, normal, right) in [
+            (DVec3::new(4.0, 4.0, 0.0), DVec3::Z, DVec3::X),
+            (DVec3::new(4.0, 0.0, 4.0), -DVec3::Y, DVec3::X),
+            (DVec3::new(0.0, 4.0, 4.0), DVec3::X, DVec3::Y),
+        ] {
+            let c = OrbitCamera::default_for(&bounds(size));
+            assert!(
+                c.direction().dot(normal) > 0.999,
+                "{size}: {}",
+                c.direction()
+            );
+            assert!(c.basis().0.dot(right) > 0.999, "{size}: {:?}", c.basis());
+        }
+        let near = OrbitCamera::default_for(&bounds(DVec3::new(4.0, 4.0, 0.05)));
+        assert_eq!((near.yaw, near.pitch), (-0.25, 1.2));
+        let thick = OrbitCamera::default_for(&bounds(DVec3::new(4.0, 4.0, 4e-6)));
+        assert_eq!((thick.yaw, thick.pitch), (-0.25, 1.2));
+        let solid = OrbitCamera::default_for(&bounds(DVec3::splat(4.0)));
+        assert_eq!(solid, OrbitCamera::default());
+    }
 
     #[test]
     fn parse_round_trips_eye_and_target() {

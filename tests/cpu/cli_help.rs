@@ -80,8 +80,8 @@ fn the_viewer_docs_list_every_view_option() {
         .output()
         .unwrap();
     let from_help = options(&String::from_utf8(raw.stdout).unwrap(), "--");
-    let doc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/viewer.md"))
-        .unwrap();
+    let doc =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/viewer.md")).unwrap();
     let from_doc = options(&doc, "| `--");
     assert!(from_help.len() >= 12, "{from_help:?}");
     assert_eq!(from_doc, from_help);

@@ -130,16 +130,30 @@ fn paths_named_in_the_docs_exist() {
             }
         }
     }
-    assert!(missing.is_empty(), "paths that do not exist:\n{}", missing.join("\n"));
+    assert!(
+        missing.is_empty(),
+        "paths that do not exist:\n{}",
+        missing.join("\n")
+    );
     let control = named_paths("see `src/sampling/no_such_file.rs:12` and `tests/cpu/lints.rs`");
-    assert_eq!(control, ["src/sampling/no_such_file.rs", "tests/cpu/lints.rs"]);
+    assert_eq!(
+        control,
+        ["src/sampling/no_such_file.rs", "tests/cpu/lints.rs"]
+    );
     assert!(!root.join(&control[0]).exists() && root.join(&control[1]).exists());
 }
 
 /// The repository paths in backticks in `text`, without a `:LINE` suffix.
 fn named_paths(text: &str) -> Vec<String> {
     const ROOTS: [&str; 9] = [
-        "src/", "tests/", "examples/", "benches/", "shaders/", "docs/", "scripts/", ".ci/",
+        "src/",
+        "tests/",
+        "examples/",
+        "benches/",
+        "shaders/",
+        "docs/",
+        "scripts/",
+        ".ci/",
         "build.rs",
     ];
     text.split('`')
@@ -152,6 +166,12 @@ fn named_paths(text: &str) -> Vec<String> {
             !s.split(['/', '.'])
                 .any(|w| w.len() > 1 && w.chars().all(|c| c.is_ascii_uppercase()))
         })
-        .map(|s| s.split(':').next().unwrap_or(s).trim_end_matches('/').to_string())
+        .map(|s| {
+            s.split(':')
+                .next()
+                .unwrap_or(s)
+                .trim_end_matches('/')
+                .to_string()
+        })
         .collect()
 }
