@@ -3,7 +3,7 @@
 use super::CliError;
 use super::args::{DisplayArgs, MemoryArgs, SamplesArgs, parse_size};
 use super::load::load_scene;
-use super::resident::{MemoryReport, Resident};
+use super::resident::{MemoryReport, Resident, image_bytes};
 use super::samples::SampleOverride;
 use crate::editor::{Document, Editor, EditorOptions, ListRefused};
 use crate::gpu::{Renderer, RendererDesc};
@@ -298,6 +298,10 @@ pub fn render_image(
     let pixels = render_document(&mut renderer, doc, &shot).map_err(|e| CliError(e.to_string()))?;
     let sink = renderer.validation_sink();
     let device = renderer.caps().name.clone();
+    let samples = match shot.msaa {
+        0 => renderer.caps().default_samples(),
+        n => n,
+    };
     // Teardown first: the layer reports leaked objects when the device is destroyed.
     drop(renderer);
     if let Some(errors) = sink.map(|s| s.errors()).filter(|e| !e.is_empty()) {
@@ -320,6 +324,7 @@ pub fn render_image(
     let report = probe.map(|p| match (before_driver, after_driver, Resident::read()) {
         (Some(a), Some(b), Some(end)) => MemoryReport {
             estimate: p.estimate,
+            image: image_bytes(width, height, samples),
             peak: end.peak,
             program: p.before.now,
             driver: b.now.saturating_sub(a.now),
