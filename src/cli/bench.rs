@@ -10,7 +10,7 @@
 
 use super::CliError;
 use super::args::{MapRangeArgs, MemoryArgs, SamplesArgs, parse_size};
-use super::load::load_scene;
+use super::load::{Notes, load_scene};
 use super::render::validation_mode;
 use crate::formats::demo::demo_scene;
 use crate::gpu::{FRAMES_IN_FLIGHT, OffscreenDesc, Renderer, RendererDesc};
@@ -111,15 +111,15 @@ impl Bench {
         if args.frames == 0 {
             return Err(CliError("--frames must be at least 1".into()));
         }
-        let (scene, scene_name) = match &args.scene {
-            Some(p) => (
-                load_scene(p, &args.samples.counts(), &self.budget)?,
-                p.display().to_string(),
-            ),
+        let (scene, scene_name, notes) = match &args.scene {
+            Some(p) => {
+                let (scene, notes) = load_scene(p, &args.samples.counts(), &self.budget)?;
+                (scene, p.display().to_string(), notes)
+            }
             None => {
                 let mut demo = demo_scene();
                 args.samples.counts().apply(&mut demo)?;
-                (demo, "demo".to_string())
+                (demo, "demo".to_string(), Notes::default())
             }
         };
         super::render::check_drawable(&scene, Path::new(&scene_name), &self.budget)?;
@@ -133,6 +133,7 @@ impl Bench {
                 frames * (std::mem::size_of::<crate::profile::FrameRecord>() as u128 + 8),
             )
             .map_err(CliError)?;
+        notes.print();
         let modes: &[bool] = if args.naive { &[false, true] } else { &[false] };
         let mut summaries = Vec::new();
         let mut written = Vec::new();

@@ -42,9 +42,10 @@ pub fn run(args: ConvertArgs) -> Result<(), CliError> {
             known_extensions(true)
         )));
     }
-    let scene = load_scene(input, &args.samples.counts(), &args.memory.budget())?;
+    let (scene, notes) = load_scene(input, &args.samples.counts(), &args.memory.budget())?;
     let dropped =
         formats::save(&scene, output).map_err(|e| CliError(format!("{}: {e}", input.display())))?;
+    notes.print();
     if !dropped.is_empty() {
         eprintln!(
             "warning: {}: written without: {}",

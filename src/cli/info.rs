@@ -41,7 +41,7 @@ struct Row<'a> {
 
 /// Loads, measures and prints.
 pub fn run(args: InfoArgs) -> Result<(), CliError> {
-    let import = load_import(&args.file, &args.samples.counts(), &args.memory.budget())?;
+    let (import, notes) = load_import(&args.file, &args.samples.counts(), &args.memory.budget())?;
     let measured = crate::parallel::map(&import.scene.objects, SceneObject::measure);
     let mut rows = Vec::with_capacity(measured.len());
     for (o, m) in import.scene.objects.iter().zip(measured) {
@@ -54,6 +54,7 @@ pub fn run(args: InfoArgs) -> Result<(), CliError> {
     } else {
         table(&args.file.display().to_string(), &import, &rows)
     };
+    notes.print();
     super::print_stdout(&text)
 }
 

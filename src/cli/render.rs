@@ -2,7 +2,7 @@
 
 use super::CliError;
 use super::args::{DisplayArgs, MemoryArgs, SamplesArgs, parse_size};
-use super::load::load_scene;
+use super::load::{Notes, load_scene};
 use super::resident::{MemoryReport, Resident, image_bytes};
 use super::samples::SampleOverride;
 use crate::editor::{Document, Editor, EditorOptions, ListRefused};
@@ -96,7 +96,7 @@ pub fn run(args: RenderArgs) -> Result<(), CliError> {
     };
     // The device thread has finished either way: a process must not exit while the driver
     // starts on another thread (its exit handlers would free what that thread still uses).
-    let (doc, estimate) = loaded_doc?;
+    let (doc, estimate, notes) = loaded_doc?;
     let renderer = renderer.transpose()?;
     let waited = start.elapsed() - loaded;
     let mut options = args.display.options();
@@ -119,6 +119,7 @@ pub fn run(args: RenderArgs) -> Result<(), CliError> {
     // (two per object and more) would only delay the exit.
     std::mem::forget(doc);
     let (line, report, phases) = lines?;
+    notes.print();
     eprintln!("{}", escape_controls(&line));
     if let Some(r) = report {
         eprintln!("{r}");
@@ -198,8 +199,8 @@ pub fn load_document(
     budget: &MemoryBudget,
     map: Option<SurfaceMap>,
     nets: bool,
-) -> Result<(Document, u64), CliError> {
-    let scene = load_scene(scene_path, samples, budget)?;
+) -> Result<(Document, u64, Notes), CliError> {
+    let (scene, notes) = load_scene(scene_path, samples, budget)?;
     let options = EditorOptions {
         mode: SampleMode::Render,
         uses: render_uses(nets),
@@ -221,7 +222,7 @@ pub fn load_document(
             .map_err(|e| CliError(format!("--analysis {}: {e}", m.name())))?;
     }
     let estimate = editor.estimated_bytes();
-    Ok((editor.into_document(), estimate))
+    Ok((editor.into_document(), estimate, notes))
 }
 
 /// Budgets `scene` for `map` (`--analysis`): a curvature map keeps second partials, K and H

@@ -3,7 +3,7 @@
 
 use super::CliError;
 use super::args::{MemoryArgs, SamplesArgs};
-use super::load::load_scene;
+use super::load::{Notes, load_scene};
 use crate::editor::{Editor, EditorOptions, ListRefused, TrimCoverage};
 use crate::model::SampledObject;
 use crate::sampling::SampleMode;
@@ -39,12 +39,13 @@ pub struct SampleArgs {
 /// Runs the command and prints the output; nothing is printed on error, so a failure never
 /// leaves partial output.
 pub fn run(args: SampleArgs) -> Result<(), CliError> {
-    let text = sample_text(&args)?;
+    let (text, notes) = sample_text(&args)?;
+    notes.print();
     super::print_stdout(&text)
 }
 
 /// The complete output text.
-fn sample_text(args: &SampleArgs) -> Result<String, CliError> {
+fn sample_text(args: &SampleArgs) -> Result<(String, Notes), CliError> {
     if args.derivatives > MAX_DERIVATIVES {
         return Err(CliError(format!(
             "--derivatives {} exceeds the supported maximum {MAX_DERIVATIVES}",
@@ -52,7 +53,7 @@ fn sample_text(args: &SampleArgs) -> Result<String, CliError> {
         )));
     }
     let budget = args.memory.budget();
-    let scene = load_scene(&args.scene, &args.samples.counts(), &budget)?;
+    let (scene, notes) = load_scene(&args.scene, &args.samples.counts(), &budget)?;
     let edits = match &args.edits {
         Some(path) => {
             let text = std::fs::read_to_string(path)
@@ -93,7 +94,7 @@ fn sample_text(args: &SampleArgs) -> Result<String, CliError> {
         out.push_str(if i + 1 < objects.len() { ",\n" } else { "\n" });
     }
     out.push_str("]}\n");
-    Ok(out)
+    Ok((out, notes))
 }
 
 fn write_object(

@@ -2,7 +2,7 @@
 
 use super::CliError;
 use super::args::{MapRangeArgs, MemoryArgs, SamplesArgs, parse_size};
-use super::load::load_scene;
+use super::load::{Notes, load_scene};
 use crate::formats::demo::demo_scene;
 use crate::formats::{self, LoadOptions};
 use crate::profile::{RunInfo, Summary, TerminalProgress, write_all};
@@ -77,6 +77,7 @@ pub fn run(opts: ViewArgs) -> Result<(), CliError> {
         Some(named) => Some(recover_file(&places, named.as_deref())?),
         None => None,
     };
+    let mut notes = Notes::default();
     let (scene, title, default_save) = match (&recovered, opts.scene.as_deref()) {
         (Some(file), scene) => {
             let options = LoadOptions {
@@ -93,11 +94,11 @@ pub fn run(opts: ViewArgs) -> Result<(), CliError> {
             };
             (loaded, format!("{title} (recovered)"), save)
         }
-        (None, Some(p)) => (
-            load_scene(p, &samples, &budget)?,
-            p.display().to_string(),
-            p.to_path_buf(),
-        ),
+        (None, Some(p)) => {
+            let (loaded, said) = load_scene(p, &samples, &budget)?;
+            notes = said;
+            (loaded, p.display().to_string(), p.to_path_buf())
+        }
         (None, None) => {
             let mut demo = demo_scene();
             samples.apply(&mut demo)?;
@@ -133,6 +134,7 @@ pub fn run(opts: ViewArgs) -> Result<(), CliError> {
         }
         None => None,
     };
+    notes.print();
     let args = app::ViewArgs {
         scene,
         title,

@@ -843,6 +843,79 @@ fn a_samples_count_no_object_takes_is_noted() {
     assert!(!err.contains("note:"), "every count applies: {err}");
 }
 
+/// The `--samples` note is held back until the command's own checks pass: an error found
+/// after loading (an unwritable output, a bad view script, bad edits) is still one line, and a
+/// command that succeeds prints the note (the negative control).
+#[test]
+fn a_samples_note_never_stands_before_an_error() {
+    let dir = Scratch::new("cli-samples-held");
+    let teapot = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/teapot.json");
+    let script = dir.file("bad.json", r#"[{"frame": 1, "jump": 1}]"#);
+    let edits = dir.file(
+        "edits.json",
+        r#"[{"object": "nobody", "point": [0, 0], "delta": [0, 0, 1]}]"#,
+    );
+    let stderr = |args: &[&std::ffi::OsStr]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_prespline"))
+            .args(args)
+            .env("DISPLAY", ":99")
+            .output()
+            .unwrap();
+        (out.status.success(), String::from_utf8(out.stderr).unwrap())
+    };
+    let os = |s: &str| std::ffi::OsString::from(s);
+    let t = teapot.as_os_str().to_owned();
+    for args in [
+        vec![
+            os("convert"),
+            t.clone(),
+            os("--samples"),
+            os("2"),
+            os("/nonexistent/x.json"),
+        ],
+        vec![
+            os("view"),
+            t.clone(),
+            os("--samples"),
+            os("2"),
+            os("--script"),
+            script.clone().into(),
+        ],
+        vec![
+            os("sample"),
+            t.clone(),
+            os("--samples"),
+            os("2"),
+            os("--edits"),
+            edits.clone().into(),
+        ],
+    ] {
+        let args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_os_str()).collect();
+        let (ok, err) = stderr(&args);
+        assert!(!ok, "{args:?}");
+        assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
+        assert!(
+            err.starts_with("error: ") && !err.contains("note:"),
+            "{err}"
+        );
+    }
+    let out = dir.path().join("ok.json");
+    let (ok, err) = stderr(&[
+        os("convert").as_os_str(),
+        t.as_os_str(),
+        os("--samples").as_os_str(),
+        os("2").as_os_str(),
+        out.as_os_str(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        err.lines()
+            .next()
+            .is_some_and(|l| l.starts_with("note: --samples 2")),
+        "{err}"
+    );
+}
+
 /// Command-line mistakes get one line like every other error, naming what is wrong and
 /// pointing to `--help` (clap writes a usage block and a hint over several lines).
 #[test]
