@@ -6,7 +6,7 @@
 use super::applied::Applied;
 use super::document::Document;
 use super::undo::{UndoStack, UndoStep};
-use crate::model::{Edit, EditError, Model, merge_edits};
+use crate::model::{Build, Edit, EditError, Model, merge_edits};
 use crate::sampling::budget::{Extent, MemoryBudget, Uses, check_extents};
 use crate::sampling::{DirtyRegion, SampleMode};
 use crate::scene::{EditList, Scene, SceneError};
@@ -135,6 +135,7 @@ impl Editor {
                 .budget
                 .check_build(&b.what, b.bytes)
                 .map_err(|e| Refused::Invalid(EditError::new(b.field, e)))?;
+            self.check_build_peak(edit.object, &b)?;
         }
         let model = self.doc.objects[edit.object].sampled.model();
         let result = edit.edit.prepare(model)?;
@@ -154,6 +155,46 @@ impl Editor {
         self.undo.record(&self.doc, &edit);
         self.apply_now(&edit, result);
         Ok(())
+    }
+
+    /// Holds an edit that builds from a count to the budget before it builds anything, at its
+    /// peak: the scene with the grown object, the object it replaces (alive until the new one
+    /// is in place) and the prepared structure being handed to the object's sampler (one more
+    /// copy of what it builds, [`Build::bytes`]); the grown scene is extrapolated from the same
+    /// edit with two small counts ([`Build::proxies`]), which cost next to nothing. A proxy that
+    /// cannot be prepared leaves the check to the real edit (its own error, or the check of
+    /// the extents it leaves).
+    fn check_build_peak(&self, object: usize, b: &Build) -> Result<(), Refused> {
+        let model = self.doc.objects[object].sampled.model();
+        let o = &self.options;
+        let unlimited = MemoryBudget::from_flag(Some(u64::MAX));
+        let mut points = Vec::with_capacity(b.proxies.len());
+        for (locals, proxy) in &b.proxies {
+            let Ok(Some(after)) = proxy.prepare(model) else {
+                return Ok(());
+            };
+            let mut extents = self.extents();
+            let old = std::mem::replace(&mut extents[object].1, after.kind().extent());
+            extents.push((extents[object].0, old));
+            let Ok(bytes) = check_extents(&extents, o.mode, o.uses, &unlimited) else {
+                return Ok(());
+            };
+            points.push((*locals as f64, bytes as f64));
+        }
+        let [(n0, b0), (n1, b1)] = points[..] else {
+            return Ok(());
+        };
+        if n1 <= n0 || b.locals as f64 <= n1 {
+            return Ok(());
+        }
+        let grown = b1 + ((b1 - b0) / (n1 - n0)).max(0.0) * (b.locals as f64 - n1);
+        let need = grown + b.bytes as f64;
+        o.budget
+            .check_build(
+                format_args!("{} (with the scene and the object they replace)", b.what),
+                need as u128,
+            )
+            .map_err(|e| Refused::Invalid(EditError::new(b.field, e)))
     }
 
     /// Submits every edit of an edits file in order, each parsed against its object as the

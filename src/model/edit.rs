@@ -64,12 +64,17 @@ fn significant(x: f64) -> String {
 }
 
 /// What an edit will build: `what` in words ("3 local curves of degree 2") and about how many
-/// bytes, for the field `field` of the edit.
-#[derive(Debug, Clone, PartialEq, Eq)]
+/// bytes, for the field `field` of the edit; and, where the object it leaves grows with a count
+/// (`locals`), the same edit with two small counts (`proxies`): the editor prepares those, reads
+/// what the object would need with each, and extrapolates to `locals` to hold the whole object,
+/// with the one it replaces, to the budget before the real edit builds anything.
+#[derive(Debug, Clone, PartialEq)]
 pub struct Build {
     pub field: &'static str,
     pub what: String,
     pub bytes: u128,
+    pub locals: u128,
+    pub proxies: Vec<(u128, super::ObjectEdit)>,
 }
 
 /// What an edit acts on. Edits on different targets commute; consecutive edits on one target

@@ -262,3 +262,53 @@ fn curve_to_erbs_edits_with_huge_local_counts_are_refused_before_building() {
     let (code, _, stderr) = run_limited(&dir, &["sample", "scene.json", "--edits", "small.json"]);
     assert_eq!(code, Some(0), "{stderr}");
 }
+
+/// Issue 34.17: a `to_erbs` count whose structure alone fits the budget but whose object, with
+/// its samplers and control display (and the object it replaces), does not, is refused before
+/// anything is built: under an address space of 768 MiB the million locals (about 2 GiB when
+/// built) would abort the process, and the refusal names the whole need. Negative control: a
+/// count the budget takes is built under the same limit.
+#[test]
+fn to_erbs_is_held_to_its_whole_peak_before_building() {
+    let dir = Scratch::new("budget-peak");
+    dir.file("scene.json", &ERBS_CURVE_FROM.replace("1000000000000", "4"));
+    let edits = |n: u64| {
+        format!(r#"[{{"object":"e","local":0,"to_erbs":{{"local_curves":{n},"local_degree":3}}}}]"#)
+    };
+    dir.file("huge.json", &edits(1_000_000));
+    dir.file("modest.json", &edits(2_000));
+    let run = |edits: &str| {
+        let out = Command::new("sh")
+            .arg("-c")
+            .arg("ulimit -v 786432 && exec \"$0\" \"$@\"")
+            .arg(env!("CARGO_BIN_EXE_prespline"))
+            .args([
+                "sample",
+                "scene.json",
+                "--memory-limit",
+                "512M",
+                "--edits",
+                edits,
+            ])
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    let (code, stderr) = run("huge.json");
+    assert_eq!(code, Some(1), "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.contains("field 'to_erbs'")
+            && stderr.contains(
+                "1000000 local curves of degree 3 (with the scene and the object they replace)"
+            )
+            && stderr.contains("over the memory budget of 512.0 MiB"),
+        "{stderr}"
+    );
+    let (code, stderr) = run("modest.json");
+    assert_eq!(code, Some(0), "{stderr}");
+}

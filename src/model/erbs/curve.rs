@@ -130,6 +130,14 @@ impl ErbsNet for ErbsCurve {
         }
     }
 
+    fn count_of(side: usize) -> usize {
+        side
+    }
+
+    fn locals_in(count: usize) -> u128 {
+        count as u128
+    }
+
     fn build_size(n: usize, degree: usize) -> (String, u128) {
         (
             format!("{n} local curves of degree {degree}"),

@@ -55,6 +55,9 @@ pub trait ErbsNet: Clone + PartialEq + Debug + Sized {
     ) -> Result<Self, GeomError>;
     /// What [`ErbsNet::build`] with these counts allocates, in words and bytes.
     fn build_size(count: Self::Count, degree: Self::Degree) -> (String, u128);
+    /// The count of `side` locals per direction, and how many locals a count makes.
+    fn count_of(side: usize) -> Self::Count;
+    fn locals_in(count: Self::Count) -> u128;
     fn bfunction(&self) -> BFunctionKind;
     fn check_degree(d: Self::Degree) -> Result<(), EditError>;
 
@@ -368,7 +371,7 @@ impl<N: ErbsNet> ErbsEdit<N> {
 
 impl<N: ErbsNet> KindEdit for ErbsEdit<N>
 where
-    ErbsEdit<N>: IntoObject,
+    ErbsEdit<N>: IntoObject<Object = crate::model::ObjectEdit>,
 {
     type Model = N::Model;
 
@@ -401,18 +404,37 @@ where
 
     fn builds(&self) -> Option<Build> {
         match self {
-            ErbsEdit::ToErbs { count, degree, .. } => {
+            ErbsEdit::ToErbs {
+                local,
+                count,
+                degree,
+            } => {
                 let (what, bytes) = N::build_size(*count, *degree);
+                let proxy = |side: usize| {
+                    let count = N::count_of(side);
+                    let edit = ErbsEdit::ToErbs {
+                        local: *local,
+                        count,
+                        degree: *degree,
+                    };
+                    (N::locals_in(count), edit.into_object())
+                };
                 Some(Build {
                     field: "to_erbs",
                     what,
                     bytes,
+                    locals: N::locals_in(*count),
+                    proxies: vec![proxy(BUILD_PROXY_SIDES[0]), proxy(BUILD_PROXY_SIDES[1])],
                 })
             }
             _ => None,
         }
     }
 }
+
+/// Locals per direction of the two small builds whose needs the editor extrapolates from: past
+/// the few locals where the samples in their supports still weigh, each local costs the same.
+const BUILD_PROXY_SIDES: [usize; 2] = [8, 16];
 
 /// Applies `edit` to `model` (taking its prepared `result` where there is one) and hands back
 /// the model as it was, for samplers that follow a refinement from the old net to the new one.

@@ -138,6 +138,14 @@ impl ErbsNet for ErbsSurface {
         }
     }
 
+    fn count_of(side: usize) -> [usize; 2] {
+        [side, side]
+    }
+
+    fn locals_in(count: [usize; 2]) -> u128 {
+        count[0] as u128 * count[1] as u128
+    }
+
     fn build_size(count: [usize; 2], degree: [usize; 2]) -> (String, u128) {
         (
             format!(
