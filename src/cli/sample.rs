@@ -90,11 +90,30 @@ fn sample_text(args: &SampleArgs) -> Result<(String, Notes), CliError> {
     let mut out = String::with_capacity(1 << 16);
     out.push_str("{\"objects\": [\n");
     for (i, (meta, obj)) in doc.objects.iter().zip(&objects).enumerate() {
-        write_object(&mut out, &meta.name, obj, meta.trim.as_deref())?;
+        write_object(&mut out, &meta.name, obj, meta.trim.as_deref())
+            .map_err(|e| CliError::in_file(&args.scene, e.0))?;
         out.push_str(if i + 1 < objects.len() { ",\n" } else { "\n" });
     }
     out.push_str("]}\n");
     Ok((out, notes))
+}
+
+/// Why sampling can overflow: a rational object whose weights lie far apart (its derivatives
+/// divide by the weighted sum, which a tiny weight makes tiny near its point), else
+/// coordinates too large for their powers.
+fn overflow_cause(weights: Option<&[f64]>) -> String {
+    let range = weights.and_then(|w| {
+        let lo = w.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = w.iter().copied().fold(0.0f64, f64::max);
+        (lo > 0.0 && hi / lo > 1e12).then_some((lo, hi))
+    });
+    match range {
+        Some((lo, hi)) => format!(
+            "its weights range from {lo:e} to {hi:e}, and rational derivatives divide by the \
+             weighted sum: bring the weights within 1e12 of each other"
+        ),
+        None => "scale the coordinates down".into(),
+    }
 }
 
 fn write_object(
@@ -105,9 +124,10 @@ fn write_object(
 ) -> Result<(), CliError> {
     let grid = obj.grid();
     if let Some(bad) = grid.data.iter().position(|v| !v.is_finite()) {
+        let sample = bad / grid.stride();
         return Err(CliError(format!(
-            "object '{name}': evaluation overflowed (non-finite value in sample {}); scale the coordinates down",
-            bad / grid.stride()
+            "object '{name}': evaluation overflowed (non-finite value in sample {sample}); {}",
+            overflow_cause(obj.model().kind().weights())
         )));
     }
     let name_json = serde_json::to_string(name).expect("strings serialise");

@@ -74,6 +74,13 @@ pub trait Kind: Clone + Debug + PartialEq + Sized + 'static {
         Vec::new()
     }
 
+    /// The weights of a rational kind's control points; `None` for a polynomial one. For
+    /// messages: a rational derivative divides by the weighted sum, so weights far apart
+    /// explain a derivative that overflows.
+    fn weights(&self) -> Option<&[f64]> {
+        None
+    }
+
     /// Per direction, the parameters where the geometry's pieces meet, ends included (the
     /// distinct knots in the domain): quadrature lines its cells up with them, since the
     /// geometry is smooth only in between. Default: the domain's ends.

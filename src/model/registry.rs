@@ -231,6 +231,8 @@ pub trait DynKind {
     fn tensor(&self) -> Option<&TensorSurface>;
     /// The degree per direction, where the kind has one ([`Kind::degrees`]).
     fn degrees(&self) -> Vec<usize>;
+    /// A rational kind's weights ([`Kind::weights`]).
+    fn weights(&self) -> Option<&[f64]>;
     /// Where the geometry's pieces meet, per direction ([`Kind::breakpoints`]).
     fn breakpoints(&self) -> Vec<Vec<f64>>;
     /// The model with other sample counts ([`Kind::with_samples`]).
@@ -298,6 +300,10 @@ where
 
     fn degrees(&self) -> Vec<usize> {
         Kind::degrees(self)
+    }
+
+    fn weights(&self) -> Option<&[f64]> {
+        Kind::weights(self)
     }
 
     fn tensor(&self) -> Option<&TensorSurface> {

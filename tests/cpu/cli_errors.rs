@@ -994,3 +994,45 @@ fn view_refuses_a_save_path_that_cannot_hold_the_scene() {
     let err = view("x.json");
     assert!(err.contains("no display"), "{err}");
 }
+
+/// A sample that overflows is one line naming the file and the object and saying why: a
+/// rational patch whose corner weight is 1e-300 has finite points but derivatives that divide
+/// by a sum near 1e-300 (the weights' range is named); huge coordinates overflow their
+/// powers (scale down). Negative control: the same patch at `--derivatives 0` samples.
+#[test]
+fn an_overflowing_sample_names_the_file_and_the_cause() {
+    let dir = Scratch::new("cli-overflow");
+    let tiny = dir.file(
+        "tiny.json",
+        r#"{"objects": [{"name": "tiny", "type": "bezier_surface", "points": [[[0,0,0],[0,1,0]],[[1,0,0],[1,1,0]]], "weights": [[1e-300, 1],[1, 1]], "samples": [5, 5]}]}"#,
+    );
+    let huge = dir.file(
+        "huge.json",
+        r#"{"objects": [{"name": "huge", "type": "bezier_curve", "points": [[0,0,0],[1e307,1e308,0],[1e308,0,0]], "samples": 5}]}"#,
+    );
+    let run = |path: &std::path::Path, d: &str| {
+        let out = Command::new(env!("CARGO_BIN_EXE_prespline"))
+            .arg("sample")
+            .arg(path)
+            .args(["--derivatives", d])
+            .output()
+            .unwrap();
+        (out.status.success(), String::from_utf8(out.stderr).unwrap())
+    };
+    let (ok, err) = run(&tiny, "1");
+    assert!(!ok);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("tiny.json: object 'tiny': evaluation overflowed")
+            && err.contains("weights range from 1e-300 to 1e0"),
+        "{err}"
+    );
+    let (ok, err) = run(&tiny, "0");
+    assert!(ok, "{err}");
+    let (ok, err) = run(&huge, "2");
+    assert!(!ok);
+    assert!(
+        err.contains("huge.json: object 'huge'") && err.contains("scale the coordinates down"),
+        "{err}"
+    );
+}

@@ -67,6 +67,10 @@ impl Kind for CurveModel {
         vec![self.curve().degree()]
     }
 
+    fn weights(&self) -> Option<&[f64]> {
+        self.curve().weights()
+    }
+
     fn breakpoints(&self) -> Vec<Vec<f64>> {
         let (a, b) = self.curve().domain();
         vec![distinct_in(self.curve().knots().as_slice(), a, b)]
@@ -174,6 +178,10 @@ impl Kind for SurfaceModel {
 
     fn degrees(&self) -> Vec<usize> {
         self.surface().degree().to_vec()
+    }
+
+    fn weights(&self) -> Option<&[f64]> {
+        self.surface().weights()
     }
 
     fn tensor(&self) -> Option<&TensorSurface> {
