@@ -1607,3 +1607,116 @@ fn nesting_deeper_than_the_limit_is_one_line() {
         &["'deep'", "'to_erbs'", &format!("{MAX_NESTING}")],
     );
 }
+
+// --- refinement with B-functions whose derivatives do not vanish at the knots ---------------------
+
+/// Issue 34.20: with smoothstep, smootherstep, rational and trigonometric B-functions the
+/// blend's second derivative at 0 and 1 is not zero, so a refinement inside an interval also
+/// changes the derivatives (order ≥ 2) of the samples at the interval's two knots (the
+/// non-flat branch of `touched_by_refinement`). The samples fall exactly on the knots here (57
+/// samples over 4 intervals; 17 × 17 over 4 × 4), and the refined interval holds a knot of
+/// the source the ERBS object was built from. Curves: the delta path and `--full` to order
+/// 3 against the oracle's refinement at every sample, and C'' or C''' on the knots does change (so a
+/// knot sample left out of the touched range would be seen). Surfaces: to order 1 against the
+/// oracle, and on the refined interval's two knot rows the delta path equals `--full` to
+/// order 2 within 1e-12 of the order's magnitude (docs/scene-format.md,
+/// "The delta path and `--full` after structural edits"); the oracle is not the reference
+/// for surface second partials here: smootherstep's already differ from it by 1.0e-12 of
+/// their magnitude before any refinement, and by 4.5e-12 after.
+#[test]
+fn refinement_with_non_flat_b_functions_updates_the_samples_on_the_knots() {
+    for bf in ["smoothstep", "smootherstep", "rational", "trigonometric"] {
+        let mut obj = constructed_curve(&bspline_curve_source(false), 5, 3, false, 57);
+        obj["bfunction"] = json!(bf);
+        let scene = scene_of(&obj);
+        let before = Curve::from_json(&obj);
+        let (a, b) = before.dir.window;
+        // Inside interval 2 of [−1, 2] cut in four: its knots −1 + 3·2/4 = 0.5 and 1.25.
+        let t = a + 0.6 * (b - a);
+        let (refined, _) = before.clone().insert_knot(t, None).unwrap();
+        let edits = json!([{"object": "e", "insert_knot": t}]);
+        for full in [false, true] {
+            let out = sample_cli(&scene, Some(&edits), 3, full);
+            let (params, product) = curve_output(&out, 0);
+            for knot in [0.5, 1.25] {
+                assert!(params.contains(&knot), "{bf}: no sample on the knot {knot}");
+            }
+            assert_agrees(
+                &format!("{bf} full={full}: refined curve"),
+                &product,
+                &oracle_curve_samples(&refined, &params, 3),
+                TOL,
+            );
+        }
+        // The samples on the knots did change (else this would test nothing there).
+        let (params, old) = curve_output(&sample_cli(&scene, None, 3, true), 0);
+        let (_, new) = curve_output(&sample_cli(&scene, Some(&edits), 3, true), 0);
+        let k = params.iter().position(|&x| x == 0.5).unwrap();
+        // C'' or C''' (smootherstep's B'' vanishes at the ends, its B''' does not).
+        assert!(
+            (2..=3).any(|r| (0..3).any(|c| (old[k][r][c] - new[k][r][c]).abs() > 1e-6)),
+            "{bf}: C'' and C''' at the knot 0.5 unchanged"
+        );
+
+        let mut obj =
+            constructed_surface(&bspline_surface_source(false), [5, 5], [3, 2], [false; 2]);
+        obj["bfunction"] = json!(bf);
+        obj["samples"] = json!([17, 17]);
+        let scene = scene_of(&obj);
+        let before = Surface::from_json(&obj);
+        let (u0, u1) = before.dirs[0].window;
+        // Inside [0.25, 0.5] of u ∈ [0, 1], which holds the source's knot 0.4: there the
+        // locals only approximate the source, and the refinement changes the blend's second
+        // partials at the interval's knots.
+        let u = u0 + 0.3 * (u1 - u0);
+        let (refined, _) = before.clone().insert_knot(0, u, None).unwrap();
+        let edits = json!([{"object": "s", "insert_knot": {"u": u}}]);
+        for full in [false, true] {
+            let out = sample_cli(&scene, Some(&edits), 1, full);
+            let (params, product) = surface_output(&out, 0);
+            assert_agrees(
+                &format!("{bf} full={full}: refined surface"),
+                &product,
+                &oracle_surface_samples(&refined, &params, 1),
+                TOL,
+            );
+        }
+        let (params, delta) = surface_output(&sample_cli(&scene, Some(&edits), 2, false), 0);
+        let (_, full) = surface_output(&sample_cli(&scene, Some(&edits), 2, true), 0);
+        // The slots of order 2 in the sample's partial list ((a, b) with a + b ≤ 2, a outer).
+        let second: Vec<usize> = (0..=2usize)
+            .flat_map(|a| (0..=2 - a).map(move |b| (a, b)))
+            .enumerate()
+            .filter(|(_, (a, b))| a + b == 2)
+            .map(|(k, _)| k)
+            .collect();
+        let rows: Vec<usize> = [0.25, 0.5]
+            .iter()
+            .map(|k| params[0].iter().position(|x| x == k).unwrap())
+            .collect();
+        let m = params[1].len();
+        let on_rows = |grid: &[Vec<Point3>]| -> Vec<Point3> {
+            rows.iter()
+                .flat_map(|&i| (0..m).map(move |j| i * m + j))
+                .flat_map(|s| second.iter().map(move |&slot| grid[s][slot]))
+                .collect()
+        };
+        let (d, f) = (on_rows(&delta), on_rows(&full));
+        let scale = f.iter().fold(0.0f64, |m, p| {
+            nan_max(m, p.iter().fold(0.0, |a, c| nan_max(a, c.abs())))
+        });
+        let differ = |x: &[Point3], y: &[Point3]| {
+            x.iter().zip(y).fold(0.0f64, |m, (p, q)| {
+                (0..3).fold(m, |m, c| nan_max(m, (p[c] - q[c]).abs()))
+            }) / scale
+        };
+        assert!(
+            differ(&d, &f) <= 1e-12,
+            "{bf}: delta against --full on the knot rows: {:e}",
+            differ(&d, &f)
+        );
+        // The surface's refinement keeps its old knot rows' partials (measured: 1.7e-14 of
+        // their magnitude); the curve's above changes C'' at its knots, which is what a
+        // stale knot sample would show.
+    }
+}
