@@ -401,8 +401,11 @@ fn closed_torus_refines_across_its_seam_and_inside_a_detail_there() {
     assert_eq!((detail.count(), detail.closed()), ([3, 3], [false, false]));
     // I on one of the detail's patches refines the detail, whichever side of the seam the
     // cursor's parameter is on (the torus's parameter is taken one period off where needed).
-    for dir in ['u', 'v'] {
+    for (dir, at) in [('u', [0.08, 0.09]), ('v', [0.91, 0.92])] {
         v.click(patch(&[[0, 0], [1, 1]], [1, 1]));
+        // The cursor onto the surface inside the detail, on either side of the seam (a
+        // control point's projection may fall on the surface elsewhere).
+        v.session.perform(Action::MoveOnto { object, at });
         v.key(Key::Char('i'), false);
         v.key(Key::Char(dir), false);
         v.key(Key::Enter, false);

@@ -84,20 +84,43 @@ impl OrbitCamera {
     /// view plane by the projected box's offset; perspective makes each move approximate, so a
     /// few rounds.
     pub fn frame_points(&mut self, points: &[DVec3], bounds: &Bounds, aspect: f64) {
+        self.frame_points_in(points, bounds, aspect, Self::WHOLE);
+    }
+
+    /// The whole image as an NDC region `[x0, x1, y0, y1]` (y up).
+    pub const WHOLE: [f64; 4] = [-1.0, 1.0, -1.0, 1.0];
+
+    /// [`OrbitCamera::frame_points`] into `region`, an NDC rectangle `[x0, x1, y0, y1]` (y up)
+    /// of the image: the part that overlays (a performance panel, a status line) leave free.
+    /// The projections are centred in it and fill 90 % of it in the tighter direction.
+    pub fn frame_points_in(
+        &mut self,
+        points: &[DVec3],
+        bounds: &Bounds,
+        aspect: f64,
+        region: [f64; 4],
+    ) {
+        let region = if region[0] < region[1] && region[2] < region[3] {
+            region
+        } else {
+            Self::WHOLE
+        };
         self.target = bounds.centre();
         let half = 0.5 * self.fov_y;
         let half_h = (half.tan() * aspect.min(1.0)).atan();
-        let safe = bounds.radius() / half_h.min(half).sin() * 1.05;
+        let shrink = 0.5 * (region[1] - region[0]).min(region[3] - region[2]);
+        let safe = bounds.radius() / half_h.min(half).sin() * 1.05 / shrink.max(1e-3);
         if bounds.is_empty() || points.is_empty() {
             self.distance = safe;
             return;
         }
+        let centre = [0.5 * (region[0] + region[1]), 0.5 * (region[2] + region[3])];
         for _ in 0..8 {
-            self.fit_distance(points, bounds, aspect, safe);
+            self.fit_distance(points, bounds, aspect, safe, region);
             let Some([x0, x1, y0, y1]) = self.projected_box(points, bounds, aspect) else {
                 break;
             };
-            let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+            let (cx, cy) = (0.5 * (x0 + x1) - centre[0], 0.5 * (y0 + y1) - centre[1]);
             if cx.abs().max(cy.abs()) < 1e-5 {
                 break;
             }
@@ -105,7 +128,7 @@ impl OrbitCamera {
             let h = self.distance * half.tan();
             self.target += right * (cx * h * aspect) + up * (cy * h);
         }
-        self.fit_distance(points, bounds, aspect, safe);
+        self.fit_distance(points, bounds, aspect, safe, region);
     }
 
     /// The NDC box [x0, x1, y0, y1] of `points`; `None` when one is behind the eye.
@@ -128,14 +151,29 @@ impl OrbitCamera {
         Some(b)
     }
 
-    /// The smallest distance (bisection) at which every point projects inside 90 % of the
-    /// image, from the current target and direction; `safe` is a first upper bound.
-    fn fit_distance(&mut self, points: &[DVec3], bounds: &Bounds, aspect: f64, safe: f64) {
+    /// The smallest distance (bisection) at which every point projects inside 90 % of
+    /// `region` (about its centre), from the current target and direction; `safe` is a first
+    /// upper bound.
+    fn fit_distance(
+        &mut self,
+        points: &[DVec3],
+        bounds: &Bounds,
+        aspect: f64,
+        safe: f64,
+        region: [f64; 4],
+    ) {
+        let (cx, cy) = (0.5 * (region[0] + region[1]), 0.5 * (region[2] + region[3]));
+        let (hx, hy) = (
+            0.45 * (region[1] - region[0]),
+            0.45 * (region[3] - region[2]),
+        );
         let fits = |distance: f64| {
             let probe = OrbitCamera { distance, ..*self };
             probe
                 .projected_box(points, bounds, aspect)
-                .is_some_and(|[x0, x1, y0, y1]| x0 >= -0.9 && x1 <= 0.9 && y0 >= -0.9 && y1 <= 0.9)
+                .is_some_and(|[x0, x1, y0, y1]| {
+                    x0 >= cx - hx && x1 <= cx + hx && y0 >= cy - hy && y1 <= cy + hy
+                })
         };
         let mut hi = safe.max(f64::MIN_POSITIVE);
         for _ in 0..60 {

@@ -8,6 +8,9 @@ use std::collections::VecDeque;
 
 /// Frames kept in the graph.
 const HISTORY: usize = 240;
+/// The frame-time graph's size in pixels: two per frame, and its height.
+const GRAPH_W: f32 = HISTORY as f32 * 2.0;
+const GRAPH_H: f32 = 60.0;
 /// Colour of overlay text.
 pub const TEXT: [u8; 4] = [230, 232, 238, 255];
 const DIM: [u8; 4] = [150, 155, 165, 255];
@@ -106,24 +109,36 @@ impl Hud {
         v
     }
 
+    /// The performance panel's rectangle `[x, y, width, height]` in pixels (top-left origin)
+    /// when it is shown: framing keeps the model out of it.
+    #[must_use]
+    pub fn panel_rect(&self, font: &Font) -> Option<[f32; 4]> {
+        self.visible.then(|| {
+            let size = TextSize::Normal;
+            let line = font.metrics(size).line_height as f32 + 2.0;
+            let lines = self.lines();
+            let text_w = lines
+                .iter()
+                .map(|l| font.text_size(l, size)[0])
+                .fold(0.0f32, f32::max);
+            let [label_w, _] = font.text_size("1000 ms", size);
+            [
+                8.0,
+                8.0,
+                text_w.max(GRAPH_W + 6.0 + label_w) + 16.0,
+                lines.len() as f32 * line + GRAPH_H + 24.0,
+            ]
+        })
+    }
+
     fn push_panel(&self, v: &mut Vec<OverlayVertex>, font: &Font) {
         let size = TextSize::Normal;
         let line = font.metrics(size).line_height as f32 + 2.0;
         let lines = self.lines();
-        let (gw, gh) = (HISTORY as f32 * 2.0, 60.0);
-        let text_w = lines
-            .iter()
-            .map(|l| font.text_size(l, size)[0])
-            .fold(0.0f32, f32::max);
-        let [label_w, _] = font.text_size("1000 ms", size);
-        push_rect(
-            v,
-            8.0,
-            8.0,
-            text_w.max(gw + 6.0 + label_w) + 16.0,
-            lines.len() as f32 * line + gh + 24.0,
-            PANEL,
-        );
+        let (gw, gh) = (GRAPH_W, GRAPH_H);
+        if let Some([x, y, w, h]) = self.panel_rect(font) {
+            push_rect(v, x, y, w, h, PANEL);
+        }
         for (k, l) in lines.iter().enumerate() {
             font.push_text(v, l, 16.0, 14.0 + k as f32 * line, size, TEXT);
         }
@@ -154,6 +169,36 @@ impl Hud {
             push_rect(v, gx + k as f32 * 2.0, gy + gh - h, 2.0, h, c);
         }
     }
+}
+
+/// The part of a `size` window (pixels) that the overlays leave free, `[left, right, top,
+/// bottom]` (top-left origin): above the status line's band (`status` pixels high), and of
+/// the parts beside and below the performance `panel` (`[x, y, width, height]`, while shown)
+/// the larger, never less than half the window either way. Framing (open, F, A) fills it.
+#[must_use]
+pub fn free_rect(size: [f64; 2], panel: Option<[f32; 4]>, status: f64) -> [f64; 4] {
+    let [w, h] = size;
+    let bottom = (h - status).max(h * 0.5);
+    match panel {
+        None => [0.0, w, 0.0, bottom],
+        Some([x, y, pw, ph]) => {
+            let (right, below) = (f64::from(x + pw) + 4.0, f64::from(y + ph) + 4.0);
+            let beside = [right.min(w * 0.5), w, 0.0, bottom];
+            let under = [0.0, w, below.min(bottom * 0.5), bottom];
+            let area = |r: [f64; 4]| (r[1] - r[0]) * (r[3] - r[2]);
+            if area(beside) > area(under) {
+                beside
+            } else {
+                under
+            }
+        }
+    }
+}
+
+/// The status line's band height at the bottom of the window, in pixels (one line).
+#[must_use]
+pub fn status_band(font: &Font) -> f64 {
+    font.metrics(TextSize::Normal).line_height as f64 + 16.0
 }
 
 /// Left margin of the status text, in pixels.

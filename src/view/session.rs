@@ -5,7 +5,7 @@
 //! same type.
 
 use super::autosave::{Autosave, Kept, Lost};
-use super::hud::{Hud, help_overlay, status_elided};
+use super::hud::{Hud, free_rect, help_overlay, status_band, status_elided};
 use super::input::{InputEvent, Key};
 use super::keymap::{Command, command};
 use super::modes::{self, Mode};
@@ -66,6 +66,8 @@ pub struct Session {
     map_families: Vec<(String, Vec<usize>)>,
     /// A scripted action that could not run (see [`Session::take_script_error`]).
     script_error: Option<String>,
+    /// Where the performance panel and the status line stand, for framing.
+    overlays: OverlayPlaces,
     /// What the last recorded frame's draw of the document did.
     last_draw: DrawReport,
     /// An edit was applied since the last upload (the HUD's bytes are then that upload's).
@@ -101,7 +103,12 @@ impl Session {
     ) -> GpuResult<Self> {
         let nets = default_nets(editor.doc());
         let gpu = GpuScene::new(renderer, editor.doc())?;
-        Ok(Self {
+        let hud = Hud::new();
+        let overlays = OverlayPlaces {
+            panel: hud.panel_rect(renderer.font()),
+            status: status_band(renderer.font()),
+        };
+        let mut session = Self {
             stage: Stage::new(editor, size, nets),
             mode: Mode::Idle,
             gpu,
@@ -111,7 +118,8 @@ impl Session {
             },
             save_path,
             status_echoed: String::new(),
-            hud: Hud::new(),
+            hud,
+            overlays,
             last_draw: DrawReport::default(),
             edited_this_frame: false,
             show_help: false,
@@ -121,7 +129,27 @@ impl Session {
             map_scales: Vec::new(),
             map_families: Vec::new(),
             script_error: None,
-        })
+        };
+        // Open framed into what the overlays leave free, and make that the home view.
+        session.update_free_region();
+        session.stage.frame_all(nets);
+        session.stage.set_home();
+        Ok(session)
+    }
+
+    /// The window region the overlays leave free (NDC `[x0, x1, y0, y1]`): above the status
+    /// line, and of the parts beside and below the performance panel (while it is shown) the
+    /// larger. Framing (open, F, A) fills it, so no model starts under the panel.
+    fn update_free_region(&mut self) {
+        let [w, h] = self.stage.size;
+        let panel = self.overlays.panel.filter(|_| self.hud.visible);
+        let px = free_rect([w, h], panel, self.overlays.status);
+        self.stage.set_free([
+            2.0 * px[0] / w - 1.0,
+            2.0 * px[1] / w - 1.0,
+            1.0 - 2.0 * px[3] / h,
+            1.0 - 2.0 * px[2] / h,
+        ]);
     }
 
     /// Keeps unsaved edits in an autosave file (see [`super::autosave`]); its start-up notes
@@ -210,6 +238,7 @@ impl Session {
 
     pub fn resize(&mut self, width: u32, height: u32) {
         self.stage.resize(width, height);
+        self.update_free_region();
     }
 
     #[must_use]
@@ -602,7 +631,10 @@ impl Session {
                     "level of detail: off (every sample drawn)"
                 });
             }
-            Command::ToggleHud => toggle(&mut self.hud.visible),
+            Command::ToggleHud => {
+                toggle(&mut self.hud.visible);
+                self.update_free_region();
+            }
             Command::ToggleHelp => toggle(&mut self.show_help),
             Command::FrameSelection => s.frame_selection(self.options.control_nets),
             Command::FrameAll => s.frame_all(self.options.control_nets),
@@ -744,6 +776,15 @@ impl Session {
     pub fn frame_all(&mut self) {
         self.stage.frame_all(self.options.control_nets);
     }
+}
+
+/// The overlays framing keeps the model out of: the performance panel's rectangle as it opened
+/// (`[x, y, width, height]` pixels, top-left origin; `None` when hidden) and the status line's
+/// band height at the bottom.
+#[derive(Debug, Clone, Copy)]
+struct OverlayPlaces {
+    panel: Option<[f32; 4]>,
+    status: f64,
 }
 
 fn toggle(flag: &mut bool) {

@@ -87,6 +87,8 @@ pub struct Stage {
     pub refit_map: bool,
     /// Projected handles, recomputed when the camera or the model changes.
     projected: Option<Vec<Projected>>,
+    /// The NDC region `[x0, x1, y0, y1]` the overlays leave free, which framing fills.
+    free: [f64; 4],
 }
 
 impl Stage {
@@ -113,6 +115,7 @@ impl Stage {
             status: Status::new("H or F1: keys"),
             refit_map: false,
             projected: None,
+            free: OrbitCamera::WHOLE,
         }
     }
 
@@ -363,9 +366,23 @@ impl Stage {
             NetMode::Off => false,
         };
         let points = framing_points(self.editor.doc(), shown);
-        self.camera
-            .frame_points(&points, &self.bounds, self.size[0] / self.size[1]);
+        self.camera.frame_points_in(
+            &points,
+            &self.bounds,
+            self.size[0] / self.size[1],
+            self.free,
+        );
         self.moved();
+    }
+
+    /// Sets the NDC region `[x0, x1, y0, y1]` the overlays leave free: framing fills it.
+    pub fn set_free(&mut self, region: [f64; 4]) {
+        self.free = region;
+    }
+
+    /// Makes the current camera the one Home returns to.
+    pub fn set_home(&mut self) {
+        self.home = self.camera;
     }
 
     /// Frames the selected local, or the selected point's object, or everything.
@@ -383,7 +400,7 @@ impl Stage {
         let mut b = Bounds::EMPTY;
         points.iter().for_each(|&p| b.include(p));
         self.camera
-            .frame_points(&points, &b, self.size[0] / self.size[1]);
+            .frame_points_in(&points, &b, self.size[0] / self.size[1], self.free);
         self.moved();
     }
 
