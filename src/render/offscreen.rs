@@ -176,22 +176,77 @@ fn legends(
         let scale = scale.unwrap_or(MapScale::symmetric(1.0));
         return legend(view.map, scale, font, place(None, 0));
     }
-    let shown = legends_shown(families.len(), height, legend_note_height(font));
-    let mut v: Vec<_> = families[..shown]
+    let groups = legend_groups(doc, &families, &view.scales);
+    let shown = legends_shown(groups.len(), height, legend_note_height(font));
+    let mut v: Vec<_> = groups[..shown]
         .iter()
         .enumerate()
-        .flat_map(|(k, (name, members))| {
-            let scale = view.scales[members[0]];
-            legend(view.map, scale, font, place(Some(name), shown - 1 - k))
+        .flat_map(|(k, (name, scale, _))| {
+            legend(view.map, *scale, font, place(Some(name), shown - 1 - k))
         })
         .collect();
-    if shown < families.len() {
-        let hidden = &families[shown..];
-        let surfaces = hidden.iter().map(|(_, m)| m.len()).sum();
+    if shown < groups.len() {
+        let hidden = &groups[shown..];
+        let surfaces = hidden.iter().map(|(_, _, n)| n).sum();
         let note = legend_note_text(hidden.len(), surfaces);
         v.extend(legend_note(&note, font, place(None, shown)));
     }
     v
+}
+
+/// The families' legends with one scale merged into one, in scene order: a legend per range
+/// shown, named by its one family, or by the first and last surface of its families with
+/// their count (`t0_teapot_00 … t63_teapot_31 (2,048 surfaces)`). Ranges within a millionth
+/// of each other are the same range: the legend shows four digits, and copies of one model
+/// placed apart differ in the last bits of their curvature.
+#[must_use]
+pub fn legend_groups(
+    doc: &Document,
+    families: &[(String, Vec<usize>)],
+    scales: &[MapScale],
+) -> Vec<(String, MapScale, usize)> {
+    let same = |a: MapScale, b: MapScale| {
+        let close = |x: f64, y: f64| (x - y).abs() <= 1e-6 * x.abs().max(y.abs());
+        close(a.low, b.low) && close(a.high, b.high)
+    };
+    // (scale, family indices) in the order each range first appears.
+    let mut groups: Vec<(MapScale, Vec<usize>)> = Vec::new();
+    for (k, (_, members)) in families.iter().enumerate() {
+        let scale = scales[members[0]];
+        match groups.iter_mut().find(|(s, _)| same(*s, scale)) {
+            Some((_, ks)) => ks.push(k),
+            None => groups.push((scale, vec![k])),
+        }
+    }
+    groups
+        .into_iter()
+        .map(|(scale, ks)| {
+            let surfaces: usize = ks.iter().map(|&k| families[k].1.len()).sum();
+            let name = match ks.as_slice() {
+                [one] => families[*one].0.clone(),
+                [first, .., last] => {
+                    let a = &doc.objects[families[*first].1[0]].name;
+                    let b = &doc.objects[*families[*last].1.last().unwrap_or(&0)].name;
+                    format!("{a} … {b} ({} surfaces)", thousands(surfaces))
+                }
+                [] => String::new(),
+            };
+            (name, scale, surfaces)
+        })
+        .collect()
+}
+
+/// `2048` as `2,048`.
+fn thousands(n: usize) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (k, c) in digits.chars().enumerate() {
+        if k > 0 && (digits.len() - k) % 3 == 0 {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
 }
 
 /// How many of `families` legends a still image `height` pixels high shows: all that fit

@@ -466,3 +466,40 @@ fn scale(v: &mut serde_json::Value, k: f64) {
         _ => {}
     }
 }
+
+/// Issue 34.2: families whose colour ranges are the same share one legend, named by their
+/// first and last surface with the count; a family with another range keeps its own. Two
+/// copies of the teapot placed apart (two families, one range) and a scaled copy (its own
+/// range): two legends, not three. Negative control: the scaled one is not merged.
+#[test]
+fn families_with_one_range_share_a_legend() {
+    use prespline::render::maps::{MapRange, SurfaceMap, map_scales, surface_families};
+    use prespline::render::offscreen::legend_groups;
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/teapot.json");
+    let teapot: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    let mut objects = moved(&teapot, 0.0, str::to_string);
+    objects.extend(moved(&teapot, 10.0, |n| n.replace("teapot", "copy")));
+    let mut big = moved(&teapot, 0.0, |n| n.replace("teapot", "big"));
+    for o in &mut big {
+        scale(&mut o["points"], 4.0);
+    }
+    objects.extend(moved(
+        &serde_json::json!({ "objects": big }),
+        40.0,
+        str::to_string,
+    ));
+    let text = serde_json::json!({ "objects": objects }).to_string();
+    let scene = prespline::formats::parse_scene(&text).unwrap();
+    let doc = common::editor(&scene, Some(SurfaceMap::Mean)).into_document();
+    let families = surface_families(&doc);
+    assert_eq!(families.len(), 3, "{families:?}");
+    let scales = map_scales(&doc, SurfaceMap::Mean, MapRange::PerObject);
+    let groups = legend_groups(&doc, &families, &scales);
+    let names: Vec<(&str, usize)> = groups.iter().map(|(n, _, k)| (n.as_str(), *k)).collect();
+    assert_eq!(
+        names,
+        [("teapot_00 … copy_31 (64 surfaces)", 64), ("big", 32)]
+    );
+    assert_ne!(groups[0].1, groups[1].1);
+}
