@@ -57,8 +57,8 @@ pub struct BenchArgs {
     /// naive run turns off the delta path only: every edit re-samples its whole object and
     /// uploads all of it, so the retained redraw (still on) must draw the whole object again
     /// each frame instead of the touched cells. Reports in DIR/incremental and DIR/naive; the
-    /// comparison, with the samples and bytes each run rewrote per frame, is printed and saved
-    /// as DIR/comparison.txt.
+    /// comparison, with the samples, bytes and triangles of each run's frames and the static
+    /// layers it rebuilt, is printed and saved as DIR/comparison.txt.
     #[arg(long)]
     pub naive: bool,
     /// Output directory for the reports.
