@@ -4,6 +4,7 @@
 
 pub mod analysis;
 pub mod camera;
+mod control_pass;
 pub mod gpu_scene;
 mod grips;
 pub mod image_file;
