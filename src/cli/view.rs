@@ -36,7 +36,8 @@ pub struct ViewArgs {
     /// Replay timed input events from a JSON script (format: docs/viewer.md, "Scripts").
     #[arg(long, value_name = "SCRIPT.json")]
     pub script: Option<PathBuf>,
-    /// Where Ctrl+S writes (default: the scene file, or prespline-demo.json for the demo);
+    /// Where Ctrl+S writes (default: the scene file, its .json beside it for a STEP or IGES
+    /// model, or prespline-demo.json for the demo);
     /// a path ending in .obj is written as Wavefront OBJ.
     #[arg(long, value_name = "PATH")]
     pub save_as: Option<PathBuf>,
@@ -89,7 +90,7 @@ pub fn run(opts: ViewArgs) -> Result<(), CliError> {
             let mut loaded = formats::load_json(file, options).map_err(CliError)?;
             samples.apply(&mut loaded)?;
             let (title, save) = match scene {
-                Some(p) => (p.display().to_string(), p.to_path_buf()),
+                Some(p) => (p.display().to_string(), save_path_for(p)),
                 None => ("demo".to_string(), Path::new(DEMO_SAVE).to_path_buf()),
             };
             (loaded, format!("{title} (recovered)"), save)
@@ -97,7 +98,7 @@ pub fn run(opts: ViewArgs) -> Result<(), CliError> {
         (None, Some(p)) => {
             let (loaded, said) = load_scene(p, &samples, &budget)?;
             notes = said;
-            (loaded, p.display().to_string(), p.to_path_buf())
+            (loaded, p.display().to_string(), save_path_for(p))
         }
         (None, None) => {
             let mut demo = demo_scene();
@@ -216,5 +217,36 @@ fn recover_file(places: &Places, named: Option<&Path>) -> Result<PathBuf, CliErr
                 listed()
             ))
         }),
+    }
+}
+
+/// Where Ctrl+S writes a scene opened from `scene` without `--save-as`: the file itself, or,
+/// for a format prespline reads but does not write (STEP, IGES), the JSON scene beside it
+/// (`part.step` → `part.json`), so that saving a CAD model never fails.
+#[must_use]
+fn save_path_for(scene: &Path) -> std::path::PathBuf {
+    if formats::format_of(scene).is_some_and(|f| f.writes()) {
+        scene.to_path_buf()
+    } else {
+        scene.with_extension("json")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cad_models_save_as_json_beside_them() {
+        for (scene, save) in [
+            ("m/part.step", "m/part.json"),
+            ("m/part.STP", "m/part.json"),
+            ("part.igs", "part.json"),
+            ("a.iges", "a.json"),
+            ("vase.obj", "vase.obj"),
+            ("scene.json", "scene.json"),
+        ] {
+            assert_eq!(save_path_for(Path::new(scene)), Path::new(save), "{scene}");
+        }
     }
 }
