@@ -760,7 +760,23 @@ impl GpuScene {
         hl: &Highlight,
     ) {
         let (camera, viewport) = (frame.camera(), frame.viewport());
-        for (i, o) in self.objects.iter_mut().enumerate() {
+        // Every frame calls this: with focused nets only the few focused objects are looked
+        // at, not every object of a large scene.
+        let focused = [
+            hl.hovered.map(|h| h.object()),
+            hl.selected.map(|h| h.object()),
+            hl.selected_local.map(|(o, _)| o),
+            hl.hovered_object,
+        ];
+        let candidates: Box<dyn Iterator<Item = usize>> = match opts.control_nets {
+            NetMode::Off => return,
+            NetMode::All => Box::new(0..self.objects.len()),
+            NetMode::Focused => Box::new(focused.into_iter().flatten()),
+        };
+        for i in candidates {
+            let Some(o) = self.objects.get_mut(i) else {
+                continue;
+            };
             if o.grips.is_some() || !net_shown(opts, hl, i) {
                 continue;
             }

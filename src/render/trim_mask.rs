@@ -5,6 +5,7 @@
 //! test ([`TrimBlocks`]).
 
 use crate::geom::trim::{CellClass, Coverage};
+use std::borrow::Cow;
 
 /// Words before the cell words: the offsets of the cells, records and segments, the sample
 /// cell rows and columns, and the mask cells per sample cell and direction.
@@ -152,11 +153,11 @@ impl BlockRanges {
 
     /// `cells` (index ranges of the same list, drawn in their order; `None`: all of it) cut
     /// into the parts inside the trim and the parts that test it; the parts outside are left
-    /// out.
+    /// out. A whole draw (`None`, every frame of a full redraw) borrows the ranges.
     #[must_use]
-    pub fn split(&self, cells: Option<&[(u32, u32)]>) -> [Vec<(u32, u32)>; 2] {
+    pub fn split(&self, cells: Option<&[(u32, u32)]>) -> [Cow<'_, [(u32, u32)]>; 2] {
         let Some(cells) = cells else {
-            return [self.inside.clone(), self.mixed.clone()];
+            return [Cow::Borrowed(&self.inside), Cow::Borrowed(&self.mixed)];
         };
         let cut = |ranges: &[(u32, u32)]| {
             let mut out = Vec::new();
@@ -170,7 +171,7 @@ impl BlockRanges {
                     }
                 }
             }
-            out
+            Cow::Owned(out)
         };
         [cut(&self.inside), cut(&self.mixed)]
     }
@@ -382,6 +383,7 @@ mod tests {
         assert_eq!(expand(&inside), want(INSIDE));
         assert_eq!(expand(&mixed), want(MIXED));
         assert!(!inside.is_empty() && !mixed.is_empty());
-        assert_eq!(r.split(None), [r.inside.clone(), r.mixed.clone()]);
+        let [all_inside, all_mixed] = r.split(None);
+        assert_eq!((&*all_inside, &*all_mixed), (&r.inside[..], &r.mixed[..]));
     }
 }

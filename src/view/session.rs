@@ -108,8 +108,13 @@ impl Session {
             panel: hud.panel_rect(renderer.font()),
             status: status_band(renderer.font()),
         };
-        let mut session = Self {
-            stage: Stage::new(editor, size, nets),
+        let free = free_ndc(
+            [f64::from(size[0].max(1)), f64::from(size[1].max(1))],
+            overlays.panel,
+            overlays.status,
+        );
+        Ok(Self {
+            stage: Stage::new(editor, size, nets, free),
             mode: Mode::Idle,
             gpu,
             options: ViewOptions {
@@ -129,27 +134,16 @@ impl Session {
             map_scales: Vec::new(),
             map_families: Vec::new(),
             script_error: None,
-        };
-        // Open framed into what the overlays leave free, and make that the home view.
-        session.update_free_region();
-        session.stage.frame_all(nets);
-        session.stage.set_home();
-        Ok(session)
+        })
     }
 
     /// The window region the overlays leave free (NDC `[x0, x1, y0, y1]`): above the status
     /// line, and of the parts beside and below the performance panel (while it is shown) the
     /// larger. Framing (open, F, A) fills it, so no model starts under the panel.
     fn update_free_region(&mut self) {
-        let [w, h] = self.stage.size;
         let panel = self.overlays.panel.filter(|_| self.hud.visible);
-        let px = free_rect([w, h], panel, self.overlays.status);
-        self.stage.set_free([
-            2.0 * px[0] / w - 1.0,
-            2.0 * px[1] / w - 1.0,
-            1.0 - 2.0 * px[3] / h,
-            1.0 - 2.0 * px[2] / h,
-        ]);
+        let free = free_ndc(self.stage.size, panel, self.overlays.status);
+        self.stage.set_free(free);
     }
 
     /// Keeps unsaved edits in an autosave file (see [`super::autosave`]); its start-up notes
@@ -785,6 +779,19 @@ impl Session {
 struct OverlayPlaces {
     panel: Option<[f32; 4]>,
     status: f64,
+}
+
+/// [`free_rect`] of a `size` window as an NDC region `[x0, x1, y0, y1]` (y up), which framing
+/// fills.
+fn free_ndc(size: [f64; 2], panel: Option<[f32; 4]>, status: f64) -> [f64; 4] {
+    let [w, h] = size;
+    let px = free_rect(size, panel, status);
+    [
+        2.0 * px[0] / w - 1.0,
+        2.0 * px[1] / w - 1.0,
+        1.0 - 2.0 * px[3] / h,
+        1.0 - 2.0 * px[2] / h,
+    ]
 }
 
 fn toggle(flag: &mut bool) {

@@ -92,16 +92,19 @@ pub struct Stage {
 }
 
 impl Stage {
-    /// The editor's document framed for a `size` image as [`Stage::frame_all`] frames it.
+    /// The editor's document framed for a `size` image as [`Stage::frame_all`] frames it,
+    /// into `free` (the NDC region the overlays leave free, [`Stage::set_free`]); that view is
+    /// the home view.
     #[must_use]
-    pub fn new(editor: Editor, size: [u32; 2], nets: NetMode) -> Self {
+    pub fn new(editor: Editor, size: [u32; 2], nets: NetMode, free: [f64; 4]) -> Self {
         let bounds = editor.doc().bounds();
         let size = [size[0].max(1) as f64, size[1].max(1) as f64];
         let mut camera = OrbitCamera::default_for(&bounds);
-        camera.frame_points(
+        camera.frame_points_in(
             &framing_points(editor.doc(), |_| nets == NetMode::All),
             &bounds,
             size[0] / size[1],
+            free,
         );
         Self {
             editor,
@@ -115,7 +118,7 @@ impl Stage {
             status: Status::new("H or F1: keys"),
             refit_map: false,
             projected: None,
-            free: OrbitCamera::WHOLE,
+            free,
         }
     }
 
@@ -378,11 +381,6 @@ impl Stage {
     /// Sets the NDC region `[x0, x1, y0, y1]` the overlays leave free: framing fills it.
     pub fn set_free(&mut self, region: [f64; 4]) {
         self.free = region;
-    }
-
-    /// Makes the current camera the one Home returns to.
-    pub fn set_home(&mut self) {
-        self.home = self.camera;
     }
 
     /// Frames the selected local, or the selected point's object, or everything.
